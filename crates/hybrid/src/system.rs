@@ -1,0 +1,174 @@
+//! The problem statement of a piecewise-smooth (hybrid) system: what a system *is*, separate
+//! from how it is integrated.
+//!
+//! A hybrid system here is an ODE `x' = f_m(t, x)` whose right-hand side depends on a discrete
+//! *mode* `m`, together with `K` scalar *switching functions* `h_k(t, x)`. The state space is cut
+//! by the surfaces `h_k = 0`; the mode records on which side of every surface the state lies
+//! (bit `k` of the mode is set when `h_k < 0`). When a trajectory reaches a surface the solver
+//! stops exactly there, and either
+//!
+//! * flips the mode bit and carries on with the same state (a *crossing*; this is how a
+//!   continuous contact force such as Hertz contact is expressed), or
+//! * applies the system's *reset map* `x+ = R(t, x-)` (a hard impact with restitution) and
+//!   chooses the new mode from the sign of `dh/dt` after the reset.
+//!
+//! A mode may also provide an *exact flow*: when the dynamics in that region are linear with
+//! harmonic forcing (the free flight of a cantilever), the solver propagates the state and its
+//! state-transition matrix in closed form instead of integrating.
+//!
+//! Every system carries one scalar *parameter* `p` (for the AFM model, the separation `Z`); the
+//! derivatives with respect to it let the solver compute `dx(t)/dp` along with the monodromy
+//! matrix, as pseudo-arclength continuation needs.
+
+use nalgebra::DMatrix;
+
+/// Which side of every switching surface a state lies on: bit `k` is set when `h_k < 0`.
+///
+/// With at most 32 surfaces, a `u32` names every region of state space.
+pub type Mode = u32;
+
+/// The maximum number of switching surfaces a system may declare (the bits of a [`Mode`]).
+pub const MAX_SURFACES: usize = 32;
+
+/// Direction in which a trajectory crosses a switching surface `h = 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Direction {
+    /// From `h > 0` to `h < 0` (`dh/dt < 0`): for a gap, the onset of contact.
+    Down,
+    /// From `h < 0` to `h > 0` (`dh/dt > 0`): for a gap, the release of contact.
+    Up,
+}
+
+/// The partial derivatives of a switching function `h_k(t, x; p)` other than the gradient
+/// with respect to the state.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SwitchingPartials {
+    /// `dh/dt` at fixed state (non-zero when the surface moves, e.g. a separation ramp `Z(t)`).
+    pub t: f64,
+    /// `dh/dp` with respect to the system's parameter.
+    pub p: f64,
+}
+
+/// A piecewise-smooth dynamical system: vector fields per mode, switching surfaces, optional
+/// reset maps and optional exact flows.
+///
+/// All vectors are slices of length [`HybridSystem::dim`]; all matrices are `dim x dim`
+/// `nalgebra` matrices supplied (already sized) by the caller, so that an implementation never
+/// allocates.
+pub trait HybridSystem {
+    /// Dimension `n` of the state vector `x`.
+    fn dim(&self) -> usize;
+
+    /// Number `K` of switching functions (at most [`MAX_SURFACES`]).
+    fn surface_count(&self) -> usize;
+
+    /// The vector field `f_m(t, x)` of mode `mode`, written into `dxdt`.
+    ///
+    /// The solver evaluates the field of the current mode even at states that lie a rounding
+    /// error on the other side of a surface (Runge-Kutta stages, the point just past an event),
+    /// so `f_m` must be defined (finite) on a neighbourhood of its region.
+    fn vector_field(&self, mode: Mode, t: f64, x: &[f64], dxdt: &mut [f64]);
+
+    /// The Jacobian `df_m/dx` at `(t, x)`, written into `jacobian` (`n x n`).
+    fn jacobian(&self, mode: Mode, t: f64, x: &[f64], jacobian: &mut DMatrix<f64>);
+
+    /// The derivative `df_m/dp` of the vector field with respect to the system's parameter,
+    /// written into `dfdp`. The default is zero (the parameter does not enter the field).
+    fn parameter_derivative(&self, mode: Mode, t: f64, x: &[f64], dfdp: &mut [f64]) {
+        let _ = (mode, t, x);
+        dfdp.fill(0.0);
+    }
+
+    /// The switching function `h_k(t, x)`; the surface is `h_k = 0`.
+    fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64;
+
+    /// The time derivative of `h_k` along the flow of mode `mode`:
+    /// `dh_k/dt = dh_k/dt|_x + (grad_x h_k) . f_m(t, x)`.
+    ///
+    /// Local minima of `h_k` (grazing and near-grazing) are the zeros of this function.
+    fn switching_rate(&self, k: usize, mode: Mode, t: f64, x: &[f64]) -> f64;
+
+    /// The gradient `grad_x h_k` written into `gradient`, and the partials with respect to time
+    /// and to the parameter. Used for saltation matrices and event-time sensitivities.
+    fn switching_gradient(
+        &self,
+        k: usize,
+        t: f64,
+        x: &[f64],
+        gradient: &mut [f64],
+    ) -> SwitchingPartials;
+
+    /// Whether reaching surface `k` in `direction` applies a reset map (a hard impact) rather
+    /// than a plain crossing. The default is `false` for every surface.
+    fn has_reset(&self, k: usize, direction: Direction) -> bool {
+        let _ = (k, direction);
+        false
+    }
+
+    /// Apply the reset map `x+ = R(t, x-)` at surface `k` in place, and write its Jacobian
+    /// `dR/dx` into `jacobian` and its parameter derivative `dR/dp` into `dxdp`.
+    ///
+    /// Called only where [`HybridSystem::has_reset`] is `true`; the default is the identity.
+    fn reset(
+        &self,
+        k: usize,
+        direction: Direction,
+        t: f64,
+        x: &mut [f64],
+        jacobian: &mut DMatrix<f64>,
+        dxdp: &mut [f64],
+    ) {
+        let _ = (k, direction, t, x);
+        jacobian.fill_with_identity();
+        dxdp.fill(0.0);
+    }
+
+    /// Whether mode `mode` has a closed-form flow ([`HybridSystem::exact_flow`]).
+    /// The default is `false`: every mode is integrated numerically.
+    fn has_exact_flow(&self, mode: Mode) -> bool {
+        let _ = mode;
+        false
+    }
+
+    /// The longest time the solver may advance an exact flow in one step of mode `mode`.
+    ///
+    /// The flow has no truncation error; the bound exists so that the extrema of every
+    /// switching function can be found by sampling inside each step. It should be a fraction
+    /// (at most a quarter) of the shortest oscillation period present in that mode.
+    fn exact_step_limit(&self, mode: Mode) -> f64 {
+        let _ = mode;
+        f64::INFINITY
+    }
+
+    /// The exact flow of mode `mode` from `(t0, x0)` over a time `dt` (which may be negative
+    /// or zero): the state `x(t0 + dt)` into `x`, and optionally the state-transition matrix
+    /// `dx(t0 + dt)/dx0` into `transition` and the parameter sensitivity `dx(t0 + dt)/dp`
+    /// (for fixed `x0`) into `dxdp`.
+    ///
+    /// Called only where [`HybridSystem::has_exact_flow`] is `true`. The default leaves its
+    /// outputs untouched, so a system that claims an exact flow must implement it.
+    fn exact_flow(
+        &self,
+        mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        dt: f64,
+        x: &mut [f64],
+        transition: Option<&mut DMatrix<f64>>,
+        dxdp: Option<&mut [f64]>,
+    ) {
+        let _ = (mode, t0, x0, dt, x, transition, dxdp);
+    }
+
+    /// The mode of state `x` at time `t`, from the signs of the switching functions
+    /// (bit `k` set when `h_k(t, x) < 0`). Used to start an integration.
+    fn mode_of(&self, t: f64, x: &[f64]) -> Mode {
+        (0..self.surface_count()).fold(0, |mode, k| {
+            if self.switching(k, t, x) < 0.0 {
+                mode | (1 << k)
+            } else {
+                mode
+            }
+        })
+    }
+}
