@@ -1,0 +1,6 @@
+//! The `drumroll` command line: argument parsing, output formatting and figures. The physics
+//! lives in the library crates (`hybrid`, `continuation`, `afm`, `beam`).
+#![warn(missing_docs)]
+
+pub mod output;
+pub mod plot;

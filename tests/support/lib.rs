@@ -1,0 +1,1 @@
+//! Support code for the workspace's acceptance tests in `tests/`.
