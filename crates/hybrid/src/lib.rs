@@ -5,8 +5,32 @@
 //! at every switching surface, finds every local extremum of every switching function (so that a
 //! grazing contact is never missed), and carries the state-transition (monodromy) matrix and the
 //! parameter sensitivity through events with saltation matrices.
+//!
+//! * [`Solver::step`] is the primitive: one DOP853 step (Hairer's Dormand-Prince 8(5,3) with
+//!   7th-order dense output) or one exact-flow step, truncated at the earliest event.
+//! * [`flow_map`] integrates over an interval on top of it.
+//!
+//! The rules that make events unique and the exact-grazing convention are documented in
+//! [`solver`].
 #![warn(missing_docs)]
 
+mod dop853;
+pub mod error;
+pub mod event;
+mod event_location;
+mod extrema;
+pub mod flow_map;
+mod saltation;
+pub mod sensitivity;
+pub mod settings;
+pub mod solver;
 pub mod system;
+mod tableau;
 
+pub use error::HybridError;
+pub use event::{Event, Extremum, ExtremumKind};
+pub use flow_map::{flow_map, flow_map_observed, FlowMap};
+pub use sensitivity::Sensitivity;
+pub use settings::Settings;
+pub use solver::{Solver, Statistics, StepOutcome};
 pub use system::{Direction, HybridSystem, Mode, SwitchingPartials, MAX_SURFACES};

@@ -147,6 +147,7 @@ pub trait HybridSystem {
     ///
     /// Called only where [`HybridSystem::has_exact_flow`] is `true`. The default leaves its
     /// outputs untouched, so a system that claims an exact flow must implement it.
+    #[allow(clippy::too_many_arguments)]
     fn exact_flow(
         &self,
         mode: Mode,

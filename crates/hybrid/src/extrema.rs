@@ -1,0 +1,171 @@
+//! Sampling the switching functions inside a step, and locating the smooth extrema of each
+//! `h_k` (the zeros of `dh_k/dt`).
+//!
+//! Every step is sampled at its two ends and at `m = samples_per_step` equally spaced interior
+//! points. A sign change of `dh_k/dt` between neighbouring samples is a local extremum, located
+//! by root finding on `dh_k/dt` along the step's interpolant. Between the samples and extrema,
+//! each `h_k` is monotone, which is what event location relies on (a brief dip through a surface
+//! shows as a negative minimum even when both ends of the step are positive).
+
+use crate::error::HybridError;
+use crate::event::{Extremum, ExtremumKind};
+use crate::event_location::locate_sign_change;
+use crate::system::{HybridSystem, Mode};
+
+/// The state at time `t` inside the current step, written into the slice.
+pub(crate) type StateAt<'a> = dyn FnMut(f64, &mut [f64]) + 'a;
+
+/// Samples of every switching function over one step, and the extrema found between them.
+pub(crate) struct Samples {
+    surfaces: usize,
+    points: usize,
+    /// Sample times `t0 = times[0] < ... < times[m + 1] = t1`.
+    pub times: Vec<f64>,
+    /// `h_k(times[i])` at `values[k * points + i]`.
+    pub values: Vec<f64>,
+    /// `dh_k/dt(times[i])` at `rates[k * points + i]`.
+    pub rates: Vec<f64>,
+    /// Time of the extremum of `h_k` in sample interval `i` at `[k * (points - 1) + i]`, NaN if
+    /// none.
+    pub extremum_time: Vec<f64>,
+    /// Value of `h_k` at that extremum.
+    pub extremum_value: Vec<f64>,
+    /// Whether column 0 already holds the samples at the step start (carried over from the end
+    /// of the previous step in the same mode).
+    pub start_valid: bool,
+}
+
+impl Samples {
+    pub fn new(surfaces: usize, interior: usize) -> Self {
+        let points = interior + 2;
+        Self {
+            surfaces,
+            points,
+            times: vec![0.0; points],
+            values: vec![0.0; surfaces * points],
+            rates: vec![0.0; surfaces * points],
+            extremum_time: vec![f64::NAN; surfaces * (points - 1)],
+            extremum_value: vec![f64::NAN; surfaces * (points - 1)],
+            start_valid: false,
+        }
+    }
+
+    /// Number of sample points per step (interior plus both ends).
+    pub fn points(&self) -> usize {
+        self.points
+    }
+
+    /// Sample `h_k` and `dh_k/dt` (in `mode`) at the step's points between `t0` and `t1`.
+    ///
+    /// # Errors
+    /// [`HybridError::NonFiniteSwitching`] if a sample is NaN or infinite.
+    #[allow(clippy::too_many_arguments)]
+    pub fn sample<S: HybridSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        mode: Mode,
+        t0: f64,
+        t1: f64,
+        state_at: &mut StateAt<'_>,
+        x: &mut [f64],
+    ) -> Result<(), HybridError> {
+        let p = self.points;
+        let last = p - 1;
+        for i in 0..p {
+            self.times[i] = if i == 0 {
+                t0
+            } else if i == last {
+                t1
+            } else {
+                t0 + (t1 - t0) * (i as f64 / last as f64)
+            };
+        }
+        let first = usize::from(self.start_valid);
+        for i in first..p {
+            let t = self.times[i];
+            state_at(t, x);
+            for k in 0..self.surfaces {
+                let value = system.switching(k, t, x);
+                let rate = system.switching_rate(k, mode, t, x);
+                if !value.is_finite() || !rate.is_finite() {
+                    return Err(HybridError::NonFiniteSwitching { t, surface: k });
+                }
+                self.values[k * p + i] = value;
+                self.rates[k * p + i] = rate;
+            }
+        }
+        Ok(())
+    }
+
+    /// Make the end samples of this step the start samples of the next one.
+    pub fn carry_over(&mut self) {
+        let p = self.points;
+        for k in 0..self.surfaces {
+            self.values[k * p] = self.values[k * p + p - 1];
+            self.rates[k * p] = self.rates[k * p + p - 1];
+        }
+        self.start_valid = true;
+    }
+
+    /// Locate every extremum of every `h_k` in the step: a sign change of `dh_k/dt` from `< 0`
+    /// to `>= 0` is a minimum, from `> 0` to `<= 0` a maximum (a zero of the rate exactly at
+    /// the step start is therefore never reported: it belongs to the previous step's end).
+    /// Appends to `found` (unsorted) and records per-interval extrema for event location.
+    #[allow(clippy::too_many_arguments)]
+    pub fn locate_extrema<S: HybridSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        mode: Mode,
+        state_at: &mut StateAt<'_>,
+        x: &mut [f64],
+        time_tolerance: f64,
+        found: &mut Vec<Extremum>,
+    ) {
+        let p = self.points;
+        self.extremum_time.fill(f64::NAN);
+        self.extremum_value.fill(f64::NAN);
+        for k in 0..self.surfaces {
+            for i in 0..p - 1 {
+                let ra = self.rates[k * p + i];
+                let rb = self.rates[k * p + i + 1];
+                let kind = if ra < 0.0 && rb >= 0.0 {
+                    ExtremumKind::Minimum
+                } else if ra > 0.0 && rb <= 0.0 {
+                    ExtremumKind::Maximum
+                } else {
+                    continue;
+                };
+                // Orient so that g > 0 at the interval start and g <= 0 at its end.
+                let sign = match kind {
+                    ExtremumKind::Minimum => -1.0,
+                    ExtremumKind::Maximum => 1.0,
+                };
+                let (a, b) = (self.times[i], self.times[i + 1]);
+                let bracket = {
+                    let mut g = |t: f64| {
+                        state_at(t, x);
+                        sign * system.switching_rate(k, mode, t, x)
+                    };
+                    locate_sign_change(a, sign * ra, b, sign * rb, &mut g, time_tolerance, 0.0)
+                };
+                let t = bracket.far;
+                let value = if t == b {
+                    self.values[k * p + i + 1]
+                } else {
+                    state_at(t, x);
+                    system.switching(k, t, x)
+                };
+                self.extremum_time[k * (p - 1) + i] = t;
+                self.extremum_value[k * (p - 1) + i] = value;
+                if found.len() < found.capacity() {
+                    found.push(Extremum {
+                        t,
+                        surface: k,
+                        kind,
+                        value,
+                    });
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,98 @@
+//! Solving over an interval, built on [`Solver::step`]: the flow map `x0 -> x(t0 + T)` with its
+//! derivatives, events and extrema.
+
+use nalgebra::DMatrix;
+
+use crate::error::HybridError;
+use crate::event::{Event, Extremum};
+use crate::sensitivity::Sensitivity;
+use crate::settings::Settings;
+use crate::solver::{Solver, Statistics, StepOutcome};
+use crate::system::HybridSystem;
+
+/// The result of integrating over `[t0, t0 + duration]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowMap {
+    /// `x(t0 + duration)`.
+    pub state: Vec<f64>,
+    /// `dx(t0 + duration)/dx0` through every event (saltation included): the monodromy matrix
+    /// when the duration is a period. The identity if not tracked.
+    pub transition: DMatrix<f64>,
+    /// `dx(t0 + duration)/dp` for fixed `x0`; zeros if not tracked.
+    pub parameter_sensitivity: Vec<f64>,
+    /// Every event, in time order.
+    pub events: Vec<Event>,
+    /// Every extremum of every switching function, in time order.
+    pub extrema: Vec<Extremum>,
+    /// Work counters.
+    pub statistics: Statistics,
+}
+
+/// Integrate `system` from `(t0, x0)` over `duration` (system time units, `>= 0`).
+///
+/// # Errors
+/// Any [`HybridError`] of [`Solver::new`] or [`Solver::step`];
+/// [`HybridError::InvalidEndTime`] for a negative or non-finite duration.
+pub fn flow_map<S: HybridSystem + ?Sized>(
+    system: &S,
+    t0: f64,
+    x0: &[f64],
+    duration: f64,
+    sensitivity: Sensitivity,
+    settings: &Settings,
+) -> Result<FlowMap, HybridError> {
+    flow_map_observed(
+        system,
+        t0,
+        x0,
+        duration,
+        sensitivity,
+        settings,
+        &mut |_: &Solver<S>, _: &StepOutcome| {},
+    )
+}
+
+/// As [`flow_map`], calling `observer(&solver, &outcome)` after every step (for quadratures
+/// over the dense output via [`Solver::interpolate`] on [`Solver::last_step`], or plots).
+///
+/// # Errors
+/// As [`flow_map`].
+pub fn flow_map_observed<S, O>(
+    system: &S,
+    t0: f64,
+    x0: &[f64],
+    duration: f64,
+    sensitivity: Sensitivity,
+    settings: &Settings,
+    observer: &mut O,
+) -> Result<FlowMap, HybridError>
+where
+    S: HybridSystem + ?Sized,
+    O: FnMut(&Solver<S>, &StepOutcome),
+{
+    let t_end = t0 + duration;
+    if !duration.is_finite() || duration < 0.0 || !t_end.is_finite() {
+        return Err(HybridError::InvalidEndTime { t: t0, t_end });
+    }
+    let mut solver = Solver::new(system, t0, x0, sensitivity, settings.clone())?;
+    let mut events = Vec::new();
+    let mut extrema = Vec::new();
+    loop {
+        let outcome = solver.step(t_end)?;
+        extrema.extend_from_slice(solver.step_extrema());
+        observer(&solver, &outcome);
+        match outcome {
+            StepOutcome::Internal => {}
+            StepOutcome::Event(event) => events.push(event),
+            StepOutcome::EndTime => break,
+        }
+    }
+    Ok(FlowMap {
+        state: solver.state().to_vec(),
+        transition: solver.transition().clone(),
+        parameter_sensitivity: solver.parameter_sensitivity().to_vec(),
+        events,
+        extrema,
+        statistics: *solver.statistics(),
+    })
+}

@@ -1,0 +1,186 @@
+//! Settings of the hybrid solver: Runge-Kutta tolerances, step limits, and event location.
+
+use crate::error::HybridError;
+
+/// Integration and event-location settings, validated by [`Settings::validate`] (called by
+/// [`crate::Solver::new`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Relative local error tolerance of the DOP853 steps (applied to the state, not to the
+    /// sensitivities). Allowed: `1e-16 ..= 1` (finite). Default `1e-12`.
+    pub relative_tolerance: f64,
+    /// Absolute local error tolerance, in state units. Allowed: `> 0`, finite. Default `1e-12`.
+    pub absolute_tolerance: f64,
+    /// First Runge-Kutta step (system time units); `None` uses Hairer's starting-step heuristic
+    /// (Hairer, Norsett, Wanner, *Solving ODEs I*, Sec. II.4). Allowed: `> 0`, finite.
+    pub initial_step: Option<f64>,
+    /// Longest step, Runge-Kutta or exact-flow (system time units). Allowed: `> 0` (may be
+    /// infinite). Default `f64::INFINITY`.
+    pub max_step: f64,
+    /// Step attempts (accepted plus rejected) allowed per solver; exceeding it gives
+    /// [`HybridError::TooManySteps`]. Allowed: `>= 1`. Default `1_000_000`.
+    pub max_steps: usize,
+    /// Events allowed per solver; the next one gives [`HybridError::TooManyEvents`].
+    /// Allowed: any. Default `100_000`.
+    pub max_events: usize,
+    /// Event and extremum times are located to `event_time_tolerance * max(|t|, |step|)`.
+    /// Allowed: `1e-16 ..= 1e-3`. Default `1e-13`.
+    pub event_time_tolerance: f64,
+    /// An event root is also accepted once both ends of the bracket have `|h| <=` this value
+    /// (switching-function units). Allowed: `>= 0`, finite. Default `1e-14`.
+    pub event_value_tolerance: f64,
+    /// Interior sample points per step at which `h_k` and `dh_k/dt` are evaluated (besides both
+    /// ends) to find extrema and brief dips through a surface. Allowed: `1 ..= 1000`. Default 8.
+    pub samples_per_step: usize,
+    /// A crossing with `|dh/dt| <` this value (switching-function units per time unit) is
+    /// flagged `grazing`. Allowed: `>= 0`, finite. Default `1e-6`.
+    pub grazing_rate: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            relative_tolerance: 1e-12,
+            absolute_tolerance: 1e-12,
+            initial_step: None,
+            max_step: f64::INFINITY,
+            max_steps: 1_000_000,
+            max_events: 100_000,
+            event_time_tolerance: 1e-13,
+            event_value_tolerance: 1e-14,
+            samples_per_step: 8,
+            grazing_rate: 1e-6,
+        }
+    }
+}
+
+fn check(
+    ok: bool,
+    field: &'static str,
+    value: f64,
+    allowed: &'static str,
+) -> Result<(), HybridError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(HybridError::InvalidSettings {
+            field,
+            value,
+            allowed,
+        })
+    }
+}
+
+impl Settings {
+    /// Check every field against its documented range.
+    ///
+    /// # Errors
+    /// [`HybridError::InvalidSettings`] naming the first field out of range.
+    pub fn validate(&self) -> Result<(), HybridError> {
+        let r = self.relative_tolerance;
+        check(
+            r.is_finite() && (1e-16..=1.0).contains(&r),
+            "relative_tolerance",
+            r,
+            "1e-16 ..= 1",
+        )?;
+        let a = self.absolute_tolerance;
+        check(
+            a.is_finite() && a > 0.0,
+            "absolute_tolerance",
+            a,
+            "> 0, finite",
+        )?;
+        if let Some(h) = self.initial_step {
+            check(h.is_finite() && h > 0.0, "initial_step", h, "> 0, finite")?;
+        }
+        let m = self.max_step;
+        check(m > 0.0, "max_step", m, "> 0 (infinity allowed)")?;
+        check(
+            self.max_steps >= 1,
+            "max_steps",
+            self.max_steps as f64,
+            ">= 1",
+        )?;
+        let e = self.event_time_tolerance;
+        check(
+            e.is_finite() && (1e-16..=1e-3).contains(&e),
+            "event_time_tolerance",
+            e,
+            "1e-16 ..= 1e-3",
+        )?;
+        let v = self.event_value_tolerance;
+        check(
+            v.is_finite() && v >= 0.0,
+            "event_value_tolerance",
+            v,
+            ">= 0, finite",
+        )?;
+        check(
+            (1..=1000).contains(&self.samples_per_step),
+            "samples_per_step",
+            self.samples_per_step as f64,
+            "1 ..= 1000",
+        )?;
+        let g = self.grazing_rate;
+        check(g.is_finite() && g >= 0.0, "grazing_rate", g, ">= 0, finite")?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_valid() {
+        assert_eq!(Settings::default().validate(), Ok(()));
+    }
+
+    #[test]
+    fn bad_fields_are_named() {
+        let cases: [(Settings, &str); 5] = [
+            (
+                Settings {
+                    relative_tolerance: f64::NAN,
+                    ..Settings::default()
+                },
+                "relative_tolerance",
+            ),
+            (
+                Settings {
+                    absolute_tolerance: 0.0,
+                    ..Settings::default()
+                },
+                "absolute_tolerance",
+            ),
+            (
+                Settings {
+                    initial_step: Some(-1.0),
+                    ..Settings::default()
+                },
+                "initial_step",
+            ),
+            (
+                Settings {
+                    samples_per_step: 0,
+                    ..Settings::default()
+                },
+                "samples_per_step",
+            ),
+            (
+                Settings {
+                    event_time_tolerance: 1e-20,
+                    ..Settings::default()
+                },
+                "event_time_tolerance",
+            ),
+        ];
+        for (settings, name) in cases {
+            match settings.validate() {
+                Err(HybridError::InvalidSettings { field, .. }) => assert_eq!(field, name),
+                other => panic!("expected InvalidSettings for {name}, got {other:?}"),
+            }
+        }
+    }
+}

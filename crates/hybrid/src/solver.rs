@@ -1,0 +1,849 @@
+//! The hybrid solver: one step at a time ([`Solver::step`] is the primitive), Runge-Kutta
+//! (DOP853) or exact-flow steps, never across a switching surface.
+//!
+//! # Events and the rules that keep them unique
+//!
+//! * At the start of every step, each `h_k` is *taken* to have the sign its mode bit says
+//!   (bit set: negative), whatever its computed value; a zero at the very start of a step is
+//!   therefore never a new crossing, and an event never fires twice.
+//! * A crossing needs `h_k` strictly on the other side at a sample point or at a located
+//!   extremum. The event is located on the first monotone piece where that happens (pieces are
+//!   delimited by samples and extrema), to `event_time_tolerance * max(|t|, |step|)`, or until
+//!   both bracket ends have `|h| <= event_value_tolerance`.
+//! * The returned state is on the side of the *new* mode (or exactly on the surface): for a
+//!   crossing the bracket end past the surface; for a reset that sends the state back to the
+//!   side it came from (a bounce), the bracket end before the surface.
+//! * **Exact grazing.** A minimum of `h_k` that touches zero without going strictly negative
+//!   fires no event: it is reported as an [`Extremum`] with value `0` (the grazing quantity
+//!   continuation tracks). A minimum that dips strictly below zero, however little, fires two
+//!   events (down, then up), both flagged `grazing` when `|dh/dt| < grazing_rate`; each event
+//!   advances time past its bracket, so neither repeats.
+//! * After a reset, the new mode bit of surface `k` is set iff `dh_k/dt < 0` just after the
+//!   reset (evaluated with the pre-event mode's field); other bits are unchanged. A reset that
+//!   leaves `dh/dt = 0` on the surface (a Zeno accumulation such as a bouncing ball coming to
+//!   rest) ends in [`HybridError::TooManyEvents`].
+
+use nalgebra::{DMatrix, DMatrixView};
+
+use crate::dop853::Dop853;
+use crate::error::HybridError;
+use crate::event::{Event, Extremum};
+use crate::event_location::{locate_sign_change, Bracket};
+use crate::extrema::Samples;
+use crate::saltation::Saltation;
+use crate::sensitivity::{Sensitivity, VariationalField};
+use crate::settings::Settings;
+use crate::system::{Direction, HybridSystem, Mode, MAX_SURFACES};
+
+/// Why [`Solver::step`] returned.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepOutcome {
+    /// An ordinary step ended before `t_end`, with no event.
+    Internal,
+    /// The step was truncated at an event on a switching surface (already applied: the solver
+    /// is in the new mode, with the post-event state).
+    Event(Event),
+    /// The solver reached `t_end` exactly.
+    EndTime,
+}
+
+/// Work counters of a solver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Statistics {
+    /// Accepted steps, Runge-Kutta and exact-flow.
+    pub steps: usize,
+    /// Rejected Runge-Kutta step attempts.
+    pub rejected_steps: usize,
+    /// Accepted exact-flow steps (included in `steps`).
+    pub exact_steps: usize,
+    /// Evaluations of `HybridSystem::vector_field` by the integrator (stages, dense output,
+    /// events; each augmented evaluation counts once).
+    pub rhs_evaluations: usize,
+    /// Events fired.
+    pub events: usize,
+}
+
+/// What produced the last step, for interpolation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StepKind {
+    /// No step taken yet.
+    None,
+    /// A DOP853 step with dense output.
+    RungeKutta,
+    /// An exact-flow step.
+    Exact,
+}
+
+/// A stepper for a [`HybridSystem`]: integrates mode by mode, stops at every event, and carries
+/// the state-transition matrix and parameter sensitivity through events (saltation).
+pub struct Solver<'a, S: HybridSystem + ?Sized> {
+    system: &'a S,
+    settings: Settings,
+    sensitivity: Sensitivity,
+    n: usize,
+    surfaces: usize,
+    dim: usize,
+    t: f64,
+    mode: Mode,
+    z: Vec<f64>,
+    z_start: Vec<f64>,
+    z_new: Vec<f64>,
+    transition: DMatrix<f64>,
+    zero_parameter: Vec<f64>,
+    field: VariationalField,
+    rk: Dop853,
+    proposed_step: Option<f64>,
+    first_same_as_last: bool,
+    kind: StepKind,
+    step_mode: Mode,
+    step_start: f64,
+    step_end: f64,
+    full_dense: bool,
+    samples: Samples,
+    extrema: Vec<Extremum>,
+    x: Vec<f64>,
+    x_after: Vec<f64>,
+    f_minus: Vec<f64>,
+    f_plus: Vec<f64>,
+    gradient: Vec<f64>,
+    reset_jacobian: DMatrix<f64>,
+    reset_dxdp: Vec<f64>,
+    identity: DMatrix<f64>,
+    saltation: Saltation,
+    flow_transition: DMatrix<f64>,
+    flow_dxdp: Vec<f64>,
+    product: DMatrix<f64>,
+    statistics: Statistics,
+}
+
+impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
+    /// A solver at `(t0, x0)`, in the mode [`HybridSystem::mode_of`] gives, with the
+    /// transition matrix the identity and the parameter sensitivity zero. Allocates every
+    /// buffer the steps use.
+    ///
+    /// # Errors
+    /// [`HybridError::InvalidSettings`], [`HybridError::DimensionMismatch`] (`x0` length),
+    /// [`HybridError::TooManySurfaces`], [`HybridError::NonFiniteState`] (`t0` or `x0`).
+    pub fn new(
+        system: &'a S,
+        t0: f64,
+        x0: &[f64],
+        sensitivity: Sensitivity,
+        settings: Settings,
+    ) -> Result<Self, HybridError> {
+        settings.validate()?;
+        let n = system.dim();
+        if x0.len() != n {
+            return Err(HybridError::DimensionMismatch {
+                expected: n,
+                found: x0.len(),
+            });
+        }
+        let surfaces = system.surface_count();
+        if surfaces > MAX_SURFACES {
+            return Err(HybridError::TooManySurfaces {
+                surfaces,
+                max: MAX_SURFACES,
+            });
+        }
+        if !t0.is_finite() || x0.iter().any(|v| !v.is_finite()) {
+            return Err(HybridError::NonFiniteState { t: t0 });
+        }
+        let dim = sensitivity.augmented_dim(n);
+        let mut z = vec![0.0; dim];
+        z[..n].copy_from_slice(x0);
+        if sensitivity.transition() {
+            for i in 0..n {
+                z[n + i * n + i] = 1.0;
+            }
+        }
+        let samples = Samples::new(surfaces, settings.samples_per_step);
+        let extrema_capacity = surfaces * (samples.points() - 1);
+        Ok(Self {
+            system,
+            sensitivity,
+            n,
+            surfaces,
+            dim,
+            t: t0,
+            mode: system.mode_of(t0, x0),
+            z_start: z.clone(),
+            z_new: z.clone(),
+            z,
+            transition: DMatrix::identity(n, n),
+            zero_parameter: vec![0.0; n],
+            field: VariationalField::new(n, sensitivity),
+            rk: Dop853::new(dim, n),
+            proposed_step: settings.initial_step,
+            first_same_as_last: false,
+            kind: StepKind::None,
+            step_mode: 0,
+            step_start: t0,
+            step_end: t0,
+            full_dense: false,
+            samples,
+            extrema: Vec::with_capacity(extrema_capacity),
+            x: vec![0.0; n],
+            x_after: vec![0.0; n],
+            f_minus: vec![0.0; n],
+            f_plus: vec![0.0; n],
+            gradient: vec![0.0; n],
+            reset_jacobian: DMatrix::identity(n, n),
+            reset_dxdp: vec![0.0; n],
+            identity: DMatrix::identity(n, n),
+            saltation: Saltation::new(n),
+            flow_transition: DMatrix::identity(n, n),
+            flow_dxdp: vec![0.0; n],
+            product: DMatrix::zeros(n, n),
+            statistics: Statistics::default(),
+            settings,
+        })
+    }
+
+    /// Current time (system time units).
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Current state `x(t)`.
+    pub fn state(&self) -> &[f64] {
+        &self.z[..self.n]
+    }
+
+    /// Current mode (bit `k` set when the state is on the negative side of surface `k`).
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// The state-transition matrix `dx(t)/dx(t0)` through all events so far (saltation
+    /// included); the identity if the transition is not tracked.
+    pub fn transition(&self) -> &DMatrix<f64> {
+        &self.transition
+    }
+
+    /// The parameter sensitivity `dx(t)/dp` (for fixed `x(t0)`); zeros if not tracked.
+    pub fn parameter_sensitivity(&self) -> &[f64] {
+        if self.sensitivity.parameter() {
+            let offset = self.n + self.n * self.n;
+            &self.z[offset..offset + self.n]
+        } else {
+            &self.zero_parameter
+        }
+    }
+
+    /// `[t_start, t_end]` of the last step (truncated at the event if there was one).
+    pub fn last_step(&self) -> (f64, f64) {
+        (self.step_start, self.step_end)
+    }
+
+    /// The state at time `t` inside the last step, written into `x` (length `n`; a shorter
+    /// slice receives the leading components): the 7th-order DOP853 dense output, or the exact
+    /// flow from the step start. Before the first step, the current state.
+    pub fn interpolate(&self, t: f64, x: &mut [f64]) {
+        let m = x.len().min(self.n);
+        let x = &mut x[..m];
+        match self.kind {
+            StepKind::None => x.copy_from_slice(&self.z[..m]),
+            StepKind::RungeKutta => {
+                let theta = (t - self.step_start) / self.rk.h;
+                self.rk.interpolate(&self.z_start, theta, x);
+            }
+            StepKind::Exact => {
+                if m == self.n {
+                    self.system.exact_flow(
+                        self.step_mode,
+                        self.step_start,
+                        &self.z_start[..self.n],
+                        t - self.step_start,
+                        x,
+                        None,
+                        None,
+                    );
+                } else {
+                    let mut full = vec![0.0; self.n];
+                    self.system.exact_flow(
+                        self.step_mode,
+                        self.step_start,
+                        &self.z_start[..self.n],
+                        t - self.step_start,
+                        &mut full,
+                        None,
+                        None,
+                    );
+                    x.copy_from_slice(&full[..m]);
+                }
+            }
+        }
+    }
+
+    /// Extrema of the switching functions found in the last step (up to its end or its event),
+    /// sorted by time.
+    pub fn step_extrema(&self) -> &[Extremum] {
+        &self.extrema
+    }
+
+    /// Work counters since [`Solver::new`].
+    pub fn statistics(&self) -> &Statistics {
+        &self.statistics
+    }
+
+    /// The settings in use.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// The sensitivities tracked.
+    pub fn sensitivity(&self) -> Sensitivity {
+        self.sensitivity
+    }
+
+    /// The system integrated.
+    pub fn system(&self) -> &'a S {
+        self.system
+    }
+
+    fn check_attempts(&self) -> Result<(), HybridError> {
+        let attempts = self.statistics.steps + self.statistics.rejected_steps;
+        if attempts >= self.settings.max_steps {
+            return Err(HybridError::TooManySteps {
+                t: self.t,
+                steps: attempts,
+            });
+        }
+        Ok(())
+    }
+
+    /// Advance by one step: a DOP853 step with error control or an exact-flow step, never past
+    /// `t_end` and never across a switching surface (the step is truncated at the earliest
+    /// event, which is then applied). Allocates nothing (except `Event::state`).
+    ///
+    /// # Errors
+    /// [`HybridError::InvalidEndTime`] if `t_end` is not finite or before `t`; step-size
+    /// underflow, too many steps or events, non-finite states or switching values, singular
+    /// saltation.
+    pub fn step(&mut self, t_end: f64) -> Result<StepOutcome, HybridError> {
+        if !t_end.is_finite() || t_end < self.t {
+            return Err(HybridError::InvalidEndTime { t: self.t, t_end });
+        }
+        if t_end == self.t {
+            return Ok(StepOutcome::EndTime);
+        }
+        self.extrema.clear();
+        let t0 = self.t;
+        let mode = self.mode;
+        self.z_start.copy_from_slice(&self.z);
+        let t1 = if self.system.has_exact_flow(mode) {
+            self.exact_step(t_end)?
+        } else {
+            self.runge_kutta_step(t_end)?
+        };
+        self.step_mode = mode;
+        self.step_start = t0;
+        self.step_end = t1;
+        self.full_dense = false;
+
+        // Sample h and dh/dt, locate extrema, then the earliest crossing.
+        let time_tolerance =
+            self.settings.event_time_tolerance * t0.abs().max(t1.abs()).max(t1 - t0);
+        {
+            let system = self.system;
+            let n = self.n;
+            let kind = self.kind;
+            let rk = &self.rk;
+            let z_start = &self.z_start;
+            let z_new = &self.z_new;
+            let mut state_at = |t: f64, out: &mut [f64]| {
+                state_in_step(system, kind, mode, rk, z_start, z_new, t0, t1, n, t, out);
+            };
+            self.samples
+                .sample(system, mode, t0, t1, &mut state_at, &mut self.x)?;
+            self.samples.locate_extrema(
+                system,
+                mode,
+                &mut state_at,
+                &mut self.x,
+                time_tolerance,
+                &mut self.extrema,
+            );
+        }
+        let crossing = self.earliest_crossing(mode, t0, t1, time_tolerance);
+        match crossing {
+            None => {
+                self.z.copy_from_slice(&self.z_new);
+                self.t = t1;
+                self.sync_transition();
+                self.samples.carry_over();
+                if self.kind == StepKind::RungeKutta {
+                    self.rk.reuse_last_derivative();
+                    self.first_same_as_last = true;
+                }
+                self.extrema
+                    .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
+                Ok(if t1 == t_end {
+                    StepOutcome::EndTime
+                } else {
+                    StepOutcome::Internal
+                })
+            }
+            Some((k, bracket)) => {
+                let event = self.fire(k, bracket, time_tolerance)?;
+                self.extrema.retain(|e| e.t <= event.t);
+                self.extrema
+                    .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
+                Ok(StepOutcome::Event(event))
+            }
+        }
+    }
+
+    /// An exact-flow step of length `min(exact_step_limit, max_step, t_end - t)`; returns the
+    /// end time. Writes `z_new`.
+    fn exact_step(&mut self, t_end: f64) -> Result<f64, HybridError> {
+        self.check_attempts()?;
+        let mode = self.mode;
+        let limit = self
+            .system
+            .exact_step_limit(mode)
+            .min(self.settings.max_step);
+        if limit.is_nan() || limit <= 0.0 {
+            return Err(HybridError::InvalidSettings {
+                field: "exact_step_limit",
+                value: limit,
+                allowed: "> 0 (a property of the system's mode)",
+            });
+        }
+        let t0 = self.t;
+        let remaining = t_end - t0;
+        let (dt, t1) = if limit >= remaining {
+            (remaining, t_end)
+        } else {
+            (limit, t0 + limit)
+        };
+        self.exact_advance(mode, t0, dt);
+        if self.z_new.iter().any(|v| !v.is_finite()) {
+            return Err(HybridError::NonFiniteState { t: t1 });
+        }
+        self.kind = StepKind::Exact;
+        self.first_same_as_last = false;
+        self.statistics.steps += 1;
+        self.statistics.exact_steps += 1;
+        Ok(t1)
+    }
+
+    /// `z_new` = exact flow of the augmented state from `z_start` over `dt`:
+    /// `x = phi(dt, x0)`, `Phi_new = Phi_step Phi_old`, `s_new = Phi_step s_old + dxdp_step`.
+    fn exact_advance(&mut self, mode: Mode, t0: f64, dt: f64) {
+        let n = self.n;
+        let (x_start, _) = self.z_start.split_at(n);
+        let (x_new, rest) = self.z_new.split_at_mut(n);
+        match self.sensitivity {
+            Sensitivity::None => {
+                self.system
+                    .exact_flow(mode, t0, x_start, dt, x_new, None, None);
+            }
+            Sensitivity::Transition => {
+                self.system.exact_flow(
+                    mode,
+                    t0,
+                    x_start,
+                    dt,
+                    x_new,
+                    Some(&mut self.flow_transition),
+                    None,
+                );
+            }
+            Sensitivity::TransitionAndParameter => {
+                self.system.exact_flow(
+                    mode,
+                    t0,
+                    x_start,
+                    dt,
+                    x_new,
+                    Some(&mut self.flow_transition),
+                    Some(&mut self.flow_dxdp),
+                );
+            }
+        }
+        if self.sensitivity.transition() {
+            let nn = n * n;
+            {
+                let phi_old = DMatrixView::from_slice(&self.z_start[n..n + nn], n, n);
+                self.product.gemm(1.0, &self.flow_transition, &phi_old, 0.0);
+            }
+            rest[..nn].copy_from_slice(self.product.as_slice());
+            if self.sensitivity.parameter() {
+                let s_old = &self.z_start[n + nn..n + nn + n];
+                let s_new = &mut rest[nn..nn + n];
+                for (i, out) in s_new.iter_mut().enumerate() {
+                    let mut v = self.flow_dxdp[i];
+                    for (j, &sj) in s_old.iter().enumerate() {
+                        v += self.flow_transition[(i, j)] * sj;
+                    }
+                    *out = v;
+                }
+            }
+        }
+    }
+
+    /// One accepted DOP853 step (with as many rejected attempts as needed); returns the end
+    /// time. Writes `z_new`, stage 12 and the state's dense output.
+    fn runge_kutta_step(&mut self, t_end: f64) -> Result<f64, HybridError> {
+        let system = self.system;
+        let mode = self.mode;
+        let t0 = self.t;
+        let rtol = self.settings.relative_tolerance;
+        let atol = self.settings.absolute_tolerance;
+        let max_step = self.settings.max_step;
+        let field = &mut self.field;
+        let mut rhs = |t: f64, z: &[f64], dz: &mut [f64]| {
+            field.eval(system, mode, t, z, dz, true);
+        };
+        if !self.first_same_as_last {
+            rhs(t0, &self.z, self.rk.stage_mut(0));
+        }
+        let mut h = match self.proposed_step {
+            Some(h) => h,
+            None => self
+                .rk
+                .initial_step(&mut rhs, t0, &self.z, rtol, atol, max_step),
+        }
+        .min(max_step);
+        let mut rejected = false;
+        let mut non_finite = false;
+        let (hs, lands, error) = loop {
+            let attempts = self.statistics.steps + self.statistics.rejected_steps;
+            if attempts >= self.settings.max_steps {
+                return Err(HybridError::TooManySteps {
+                    t: t0,
+                    steps: attempts,
+                });
+            }
+            if h.is_nan() || h <= 8.0 * f64::EPSILON * t0.abs() || !h.is_finite() {
+                return Err(if non_finite {
+                    HybridError::NonFiniteState { t: t0 }
+                } else {
+                    HybridError::StepSizeUnderflow { t: t0, step: h }
+                });
+            }
+            let remaining = t_end - t0;
+            let (hs, lands) = if h >= remaining {
+                (remaining, true)
+            } else {
+                (h, false)
+            };
+            let error = self
+                .rk
+                .attempt(&mut rhs, t0, &self.z, hs, &mut self.z_new, rtol, atol);
+            if error.is_finite() && error <= 1.0 {
+                break (hs, lands, error);
+            }
+            self.statistics.rejected_steps += 1;
+            rejected = true;
+            if error.is_finite() {
+                non_finite = false;
+                h = Dop853::next_step(hs, error, false);
+            } else {
+                non_finite = true;
+                h = 0.1 * hs;
+            }
+        };
+        let mut next = Dop853::next_step(hs, error, rejected).min(max_step);
+        if lands && !rejected {
+            next = next.max(h);
+        }
+        self.proposed_step = Some(next);
+        let t1 = if lands { t_end } else { t0 + hs };
+        self.rk.derivative_at_end(&mut rhs, t0, &self.z_new);
+        {
+            let mut state_rhs = |t: f64, z: &[f64], dz: &mut [f64]| {
+                field.eval(system, mode, t, z, dz, false);
+            };
+            self.rk
+                .dense_coefficients(&mut state_rhs, t0, &self.z, &self.z_new, self.n);
+        }
+        self.statistics.rhs_evaluations = self.field.evaluations;
+        if self.z_new.iter().any(|v| !v.is_finite()) {
+            return Err(HybridError::NonFiniteState { t: t1 });
+        }
+        self.kind = StepKind::RungeKutta;
+        self.first_same_as_last = false;
+        self.statistics.steps += 1;
+        Ok(t1)
+    }
+
+    /// Scan every surface for its first strict crossing in the step (through samples and
+    /// located extrema, so a brief dip is found through its negative minimum), locate each,
+    /// and return the earliest.
+    fn earliest_crossing(
+        &mut self,
+        mode: Mode,
+        t0: f64,
+        t1: f64,
+        time_tolerance: f64,
+    ) -> Option<(usize, Bracket)> {
+        let p = self.samples.points();
+        let mut best: Option<(usize, Bracket)> = None;
+        for k in 0..self.surfaces {
+            let sigma = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
+            // At the step start the side is the mode's, whatever the computed value.
+            let mut prev = (t0, (sigma * self.samples.values[k * p]).abs());
+            let mut candidate = None;
+            for i in 0..p - 1 {
+                let te = self.samples.extremum_time[k * (p - 1) + i];
+                if !te.is_nan() && te > prev.0 {
+                    let ge = sigma * self.samples.extremum_value[k * (p - 1) + i];
+                    if ge < 0.0 {
+                        candidate = Some((prev, (te, ge)));
+                        break;
+                    }
+                    prev = (te, ge);
+                }
+                let tb = self.samples.times[i + 1];
+                let gb = sigma * self.samples.values[k * p + i + 1];
+                if gb < 0.0 {
+                    candidate = Some((prev, (tb, gb)));
+                    break;
+                }
+                if tb > prev.0 {
+                    prev = (tb, gb);
+                }
+            }
+            let Some(((a, ga), (b, gb))) = candidate else {
+                continue;
+            };
+            if let Some((_, found)) = &best {
+                if a >= found.far {
+                    continue;
+                }
+            }
+            let system = self.system;
+            let n = self.n;
+            let kind = self.kind;
+            let rk = &self.rk;
+            let z_start = &self.z_start;
+            let z_new = &self.z_new;
+            let x = &mut self.x;
+            let mut g = |t: f64| {
+                state_in_step(system, kind, mode, rk, z_start, z_new, t0, t1, n, t, x);
+                sigma * system.switching(k, t, x)
+            };
+            let bracket = locate_sign_change(
+                a,
+                ga,
+                b,
+                gb,
+                &mut g,
+                time_tolerance,
+                self.settings.event_value_tolerance,
+            );
+            let better = match &best {
+                None => true,
+                Some((_, found)) => bracket.far < found.far,
+            };
+            if better {
+                best = Some((k, bracket));
+            }
+        }
+        best
+    }
+
+    /// The augmented state (state, transition, parameter sensitivity) at time `t` of the
+    /// current step, into `z`.
+    fn augmented_at(&mut self, t: f64) {
+        let (t0, t1, mode) = (self.step_start, self.step_end, self.step_mode);
+        if t == t1 {
+            self.z.copy_from_slice(&self.z_new);
+            return;
+        }
+        match self.kind {
+            StepKind::RungeKutta => {
+                if !self.full_dense && self.dim > self.n {
+                    let system = self.system;
+                    let field = &mut self.field;
+                    let mut rhs = |tt: f64, z: &[f64], dz: &mut [f64]| {
+                        field.eval(system, mode, tt, z, dz, true);
+                    };
+                    self.rk
+                        .dense_coefficients(&mut rhs, t0, &self.z_start, &self.z_new, self.dim);
+                    self.statistics.rhs_evaluations = self.field.evaluations;
+                    self.full_dense = true;
+                }
+                let theta = (t - t0) / self.rk.h;
+                self.rk.interpolate(&self.z_start, theta, &mut self.z);
+            }
+            StepKind::Exact => {
+                // Reuse z_new as scratch: the step is being truncated.
+                self.exact_advance(mode, t0, t - t0);
+                self.z.copy_from_slice(&self.z_new);
+            }
+            StepKind::None => {}
+        }
+    }
+
+    /// Apply the event on surface `k` located in `bracket`: choose the side, reset or flip the
+    /// mode, apply saltation, and truncate the step there.
+    fn fire(
+        &mut self,
+        k: usize,
+        bracket: Bracket,
+        time_tolerance: f64,
+    ) -> Result<Event, HybridError> {
+        let system = self.system;
+        let n = self.n;
+        let mode = self.step_mode;
+        let was_negative = mode & (1 << k) != 0;
+        let direction = if was_negative {
+            Direction::Up
+        } else {
+            Direction::Down
+        };
+        if self.statistics.events >= self.settings.max_events {
+            return Err(HybridError::TooManyEvents {
+                t: bracket.far,
+                events: self.statistics.events,
+            });
+        }
+        let reset = system.has_reset(k, direction);
+        let mut t_event = bracket.far;
+        self.augmented_at(t_event);
+        let mut negative_after = !was_negative;
+        if reset {
+            // Does the reset send the state back to the side it came from (a bounce)?
+            self.x_after.copy_from_slice(&self.z[..n]);
+            system.reset(
+                k,
+                direction,
+                t_event,
+                &mut self.x_after,
+                &mut self.reset_jacobian,
+                &mut self.reset_dxdp,
+            );
+            negative_after = system.switching_rate(k, mode, t_event, &self.x_after) < 0.0;
+            let near_usable = bracket.far - bracket.near <= time_tolerance
+                || bracket.near_value <= self.settings.event_value_tolerance;
+            if negative_after == was_negative && near_usable && bracket.near != t_event {
+                t_event = bracket.near;
+                self.augmented_at(t_event);
+            }
+        }
+        self.x.copy_from_slice(&self.z[..n]);
+        let rate = system.switching_rate(k, mode, t_event, &self.x);
+        system.vector_field(mode, t_event, &self.x, &mut self.f_minus);
+        self.field.evaluations += 1;
+        if reset {
+            system.reset(
+                k,
+                direction,
+                t_event,
+                &mut self.z[..n],
+                &mut self.reset_jacobian,
+                &mut self.reset_dxdp,
+            );
+            negative_after = system.switching_rate(k, mode, t_event, &self.z[..n]) < 0.0;
+        }
+        if self.z[..n].iter().any(|v| !v.is_finite()) {
+            return Err(HybridError::NonFiniteState { t: t_event });
+        }
+        let new_mode = if negative_after {
+            mode | (1 << k)
+        } else {
+            mode & !(1 << k)
+        };
+        if self.sensitivity.transition() {
+            system.vector_field(new_mode, t_event, &self.z[..n], &mut self.f_plus);
+            self.field.evaluations += 1;
+            let partials = system.switching_gradient(k, t_event, &self.x, &mut self.gradient);
+            let hdot = partials.t
+                + self
+                    .gradient
+                    .iter()
+                    .zip(&self.f_minus)
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>();
+            let reset_jacobian = if reset {
+                &self.reset_jacobian
+            } else {
+                &self.identity
+            };
+            if !reset {
+                self.reset_dxdp.fill(0.0);
+            }
+            let nn = n * n;
+            let (_, rest) = self.z.split_at_mut(n);
+            let (phi, s) = rest.split_at_mut(nn);
+            let parameter = if self.sensitivity.parameter() {
+                Some((&mut s[..n], &self.reset_dxdp[..], partials.p))
+            } else {
+                None
+            };
+            self.saltation.apply(
+                reset_jacobian,
+                &self.f_minus,
+                &self.f_plus,
+                &self.gradient,
+                hdot,
+                phi,
+                parameter,
+                t_event,
+                k,
+            )?;
+        }
+        self.statistics.rhs_evaluations = self.field.evaluations;
+        self.statistics.events += 1;
+        self.t = t_event;
+        self.mode = new_mode;
+        self.step_end = t_event;
+        self.first_same_as_last = false;
+        self.samples.start_valid = false;
+        self.sync_transition();
+        Ok(Event {
+            t: t_event,
+            surface: k,
+            direction,
+            rate,
+            grazing: rate.abs() < self.settings.grazing_rate,
+            reset,
+            state: self.z[..n].to_vec(),
+        })
+    }
+
+    fn sync_transition(&mut self) {
+        if self.sensitivity.transition() {
+            let n = self.n;
+            self.transition
+                .as_mut_slice()
+                .copy_from_slice(&self.z[n..n + n * n]);
+        }
+    }
+}
+
+/// The state at `t` in the current (not yet accepted) step: dense output or exact flow.
+#[allow(clippy::too_many_arguments)]
+fn state_in_step<S: HybridSystem + ?Sized>(
+    system: &S,
+    kind: StepKind,
+    mode: Mode,
+    rk: &Dop853,
+    z_start: &[f64],
+    z_new: &[f64],
+    t0: f64,
+    t1: f64,
+    n: usize,
+    t: f64,
+    out: &mut [f64],
+) {
+    if t == t1 {
+        out.copy_from_slice(&z_new[..n]);
+        return;
+    }
+    if t == t0 {
+        out.copy_from_slice(&z_start[..n]);
+        return;
+    }
+    match kind {
+        StepKind::RungeKutta => rk.interpolate(z_start, (t - t0) / rk.h, out),
+        StepKind::Exact => {
+            system.exact_flow(mode, t0, &z_start[..n], t - t0, out, None, None);
+        }
+        StepKind::None => out.copy_from_slice(&z_start[..n]),
+    }
+}
