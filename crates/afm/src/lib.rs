@@ -1,1 +1,49 @@
-//! placeholder
+//! `afm`: the cantilever model of Melcher, Xu and Raman, "Multiple impact regimes in liquid
+//! environment dynamic atomic force microscopy", Appl. Phys. Lett. 93, 093111 (2008).
+//!
+//! Eq. 1 of the paper generalised to N eigenmodes (`/work/shared/MODEL.md` section 1),
+//!
+//! ```text
+//! q_i'' / w_i^2 + q_i' / (w_i Q_i) + q_i = (F_i / k_i) cos(w t) + F_ts(d) / k_i,
+//! d = Z + sum_i q_i,   u = sum_i chi_i q_i,
+//! ```
+//!
+//! with Hertz contact `F_ts(d) = (4/3) E* sqrt(R) (-d)^{3/2}` for `d < 0`, expressed as a
+//! [`hybrid::HybridSystem`] ([`TappingModel`]) whose free flight has an exact flow.
+//!
+//! Internal units: time in microseconds, lengths in nm, velocities in nm/us, forces in nN,
+//! stiffness in N/m (= nN/nm), angular frequencies in rad/us (`w = 2 pi f[kHz] / 1000`).
+//! The state is `x = [q_1, q_1', q_2, q_2', ..., q_N, q_N']`; `t = 0` is a zero of the drive
+//! phase (`cos(w t) = 1`).
+#![warn(missing_docs)]
+
+pub mod cantilever;
+pub mod case;
+pub mod drive;
+pub mod eigenmode;
+pub mod error;
+pub mod fixtures;
+pub mod free_flight;
+pub mod free_response;
+pub mod hertz;
+pub mod model;
+pub mod sample;
+pub mod separation;
+pub mod trigonometric;
+mod validation;
+
+pub use cantilever::Cantilever;
+pub use case::{Case, CaseFile};
+pub use drive::Drive;
+pub use eigenmode::Eigenmode;
+pub use error::AfmError;
+pub use fixtures::{
+    builtin_cantilever, builtin_case, builtin_sample, cantilever_names, case_names, find_case,
+    load_cantilever, load_case, load_sample, sample_names,
+};
+pub use free_flight::DrivenOscillator;
+pub use free_response::FreeResponse;
+pub use hertz::{effective_modulus_gpa, HertzContact};
+pub use model::TappingModel;
+pub use sample::Sample;
+pub use separation::Separation;

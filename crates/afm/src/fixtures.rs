@@ -1,0 +1,225 @@
+//! The built-in fixtures (embedded at compile time from `fixtures/` at the workspace root, so
+//! the binary works from any directory) and loading of user files by path.
+//!
+//! Every file is parsed with `deny_unknown_fields` and range-checked; errors name the file, the
+//! field and the allowed range.
+
+use std::path::{Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+
+use crate::case::CaseFile;
+use crate::{AfmError, Cantilever, Case, Sample};
+
+/// A built-in fixture: its name, the path it was embedded from, and its text.
+struct Embedded {
+    name: &'static str,
+    path: &'static str,
+    text: &'static str,
+}
+
+macro_rules! embedded {
+    ($kind:literal, $name:literal) => {
+        Embedded {
+            name: $name,
+            path: concat!("fixtures/", $kind, "/", $name, ".json"),
+            text: include_str!(concat!("../../../fixtures/", $kind, "/", $name, ".json")),
+        }
+    };
+}
+
+const CANTILEVERS: &[Embedded] = &[
+    embedded!("cantilevers", "biolever"),
+    embedded!("cantilevers", "maclever"),
+];
+
+const SAMPLES: &[Embedded] = &[
+    embedded!("samples", "mica"),
+    embedded!("samples", "soft"),
+    embedded!("samples", "purple-membrane"),
+];
+
+const CASES: &[Embedded] = &[
+    embedded!("cases", "biolever-mica"),
+    embedded!("cases", "biolever-soft"),
+    embedded!("cases", "maclever-mica"),
+    embedded!("cases", "maclever-soft"),
+    embedded!("cases", "maclever-mica-experiment"),
+    embedded!("cases", "maclever-membrane-experiment"),
+];
+
+fn names(table: &[Embedded]) -> Vec<&'static str> {
+    table.iter().map(|entry| entry.name).collect()
+}
+
+/// The names of the built-in cantilevers (`biolever`, `maclever`).
+pub fn cantilever_names() -> Vec<&'static str> {
+    names(CANTILEVERS)
+}
+
+/// The names of the built-in samples (`mica`, `soft`, `purple-membrane`).
+pub fn sample_names() -> Vec<&'static str> {
+    names(SAMPLES)
+}
+
+/// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
+/// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`).
+pub fn case_names() -> Vec<&'static str> {
+    names(CASES)
+}
+
+fn find<'a>(
+    table: &'a [Embedded],
+    kind: &'static str,
+    name: &str,
+) -> Result<&'a Embedded, AfmError> {
+    table
+        .iter()
+        .find(|entry| entry.name == name)
+        .ok_or_else(|| AfmError::UnknownFixture {
+            kind,
+            name: name.to_string(),
+            known: names(table).join(", "),
+        })
+}
+
+fn parse<T: DeserializeOwned>(file: &str, text: &str) -> Result<T, AfmError> {
+    serde_json::from_str(text).map_err(|source| AfmError::Json {
+        file: file.to_string(),
+        source,
+    })
+}
+
+fn read(path: &Path) -> Result<String, AfmError> {
+    std::fs::read_to_string(path).map_err(|source| AfmError::Io {
+        file: path.display().to_string(),
+        source,
+    })
+}
+
+/// Parse and validate cantilever JSON text; `file` names the source in errors.
+pub fn parse_cantilever(file: &str, text: &str) -> Result<Cantilever, AfmError> {
+    let cantilever: Cantilever = parse(file, text)?;
+    cantilever.validate(file)?;
+    Ok(cantilever)
+}
+
+/// Parse and validate sample JSON text; `file` names the source in errors.
+pub fn parse_sample(file: &str, text: &str) -> Result<Sample, AfmError> {
+    let sample: Sample = parse(file, text)?;
+    sample.validate(file)?;
+    Ok(sample)
+}
+
+/// Parse and validate case JSON text (without resolving its references); `file` names the
+/// source in errors.
+pub fn parse_case_file(file: &str, text: &str) -> Result<CaseFile, AfmError> {
+    let case: CaseFile = parse(file, text)?;
+    case.validate(file)?;
+    Ok(case)
+}
+
+/// The built-in cantilever `name`.
+pub fn builtin_cantilever(name: &str) -> Result<Cantilever, AfmError> {
+    let entry = find(CANTILEVERS, "cantilever", name)?;
+    parse_cantilever(entry.path, entry.text)
+}
+
+/// The built-in sample `name`.
+pub fn builtin_sample(name: &str) -> Result<Sample, AfmError> {
+    let entry = find(SAMPLES, "sample", name)?;
+    parse_sample(entry.path, entry.text)
+}
+
+/// The built-in case `name`, with its cantilever and sample resolved.
+pub fn builtin_case(name: &str) -> Result<Case, AfmError> {
+    let entry = find(CASES, "case", name)?;
+    let file = parse_case_file(entry.path, entry.text)?;
+    resolve_case(file, None)
+}
+
+/// Load and validate a cantilever file.
+pub fn load_cantilever(path: &Path) -> Result<Cantilever, AfmError> {
+    parse_cantilever(&path.display().to_string(), &read(path)?)
+}
+
+/// Load and validate a sample file.
+pub fn load_sample(path: &Path) -> Result<Sample, AfmError> {
+    parse_sample(&path.display().to_string(), &read(path)?)
+}
+
+/// Load and validate a case file; its `cantilever` and `sample` references are built-in names
+/// or paths ending in `.json` relative to the case file's directory.
+pub fn load_case(path: &Path) -> Result<Case, AfmError> {
+    let file = parse_case_file(&path.display().to_string(), &read(path)?)?;
+    resolve_case(file, Some(path.parent().unwrap_or_else(|| Path::new(""))))
+}
+
+/// A case named on a command line: a built-in case name, or else a path to a case file.
+pub fn find_case(name_or_path: &str) -> Result<Case, AfmError> {
+    if CASES.iter().any(|entry| entry.name == name_or_path) {
+        return builtin_case(name_or_path);
+    }
+    let path = Path::new(name_or_path);
+    if path.extension().is_some_and(|ext| ext == "json") || path.exists() {
+        load_case(path)
+    } else {
+        Err(AfmError::UnknownFixture {
+            kind: "case",
+            name: name_or_path.to_string(),
+            known: case_names().join(", "),
+        })
+    }
+}
+
+/// Resolve a reference: a built-in name, or (with a base directory) a `.json` path.
+fn resolve<T>(
+    reference: &str,
+    base: Option<&Path>,
+    table: &[Embedded],
+    kind: &'static str,
+    builtin: fn(&str) -> Result<T, AfmError>,
+    load: fn(&Path) -> Result<T, AfmError>,
+) -> Result<T, AfmError> {
+    if table.iter().any(|entry| entry.name == reference) {
+        return builtin(reference);
+    }
+    match base {
+        Some(base) if reference.ends_with(".json") => {
+            let path: PathBuf = base.join(reference);
+            load(&path)
+        }
+        _ => Err(AfmError::UnknownFixture {
+            kind,
+            name: reference.to_string(),
+            known: names(table).join(", "),
+        }),
+    }
+}
+
+fn resolve_case(file: CaseFile, base: Option<&Path>) -> Result<Case, AfmError> {
+    let cantilever = resolve(
+        &file.cantilever,
+        base,
+        CANTILEVERS,
+        "cantilever",
+        builtin_cantilever,
+        load_cantilever,
+    )?;
+    let sample = resolve(
+        &file.sample,
+        base,
+        SAMPLES,
+        "sample",
+        builtin_sample,
+        load_sample,
+    )?;
+    Ok(Case {
+        name: file.name,
+        description: file.description,
+        cantilever,
+        sample,
+        free_amplitude_nm: file.free_amplitude_nm,
+        drive_frequency_khz: file.drive_frequency_khz,
+    })
+}

@@ -1,0 +1,400 @@
+//! The tapping cantilever of Eq. 1 as a hybrid system: free flight (exact flow) and Hertz
+//! contact (integrated), separated by the surface `d = 0`.
+
+use std::f64::consts::PI;
+
+use hybrid::{HybridSystem, Mode, SwitchingPartials};
+use nalgebra::DMatrix;
+
+use crate::case::check_case_numbers;
+use crate::free_flight::DrivenOscillator;
+use crate::validation::invalid;
+use crate::{AfmError, Cantilever, Case, Drive, FreeResponse, HertzContact, Sample, Separation};
+
+/// The mode in which the tip is free (`d >= 0`): exact flow.
+pub const FREE_FLIGHT: Mode = 0;
+/// The mode in which the tip indents the sample (`d < 0`): Hertz force, integrated.
+pub const CONTACT: Mode = 1;
+/// The index of the contact switching surface `h_0 = d`.
+pub const GAP_SURFACE: usize = 0;
+
+/// The constants of one line of Eq. 1 in internal units.
+#[derive(Debug, Clone)]
+struct ModalConstants {
+    /// `w_i^2`, 1/us^2.
+    omega_squared: f64,
+    /// `w_i^2 / k_i`, (1/us^2)(nm/nN).
+    omega_squared_over_stiffness: f64,
+    /// `w_i / Q_i`, 1/us.
+    damping: f64,
+    /// `w_i^2 F_i / k_i`, nm/us^2.
+    drive_acceleration: f64,
+    /// `chi_i`.
+    optical_sensitivity: f64,
+    /// The free-flight flow of this mode.
+    oscillator: DrivenOscillator,
+}
+
+/// The N-mode tapping cantilever of Eq. 1 (MODEL.md section 1) as a [`HybridSystem`].
+///
+/// State `x = [q_1, q_1', ..., q_N, q_N']` (nm, nm/us), time in us, `t = 0` at a zero of the
+/// drive phase. One switching surface `h_0 = d = Z(t) + sum_i q_i` (the gap, nm); mode
+/// [`FREE_FLIGHT`] (`d >= 0`, exact flow) and [`CONTACT`] (`d < 0`, Hertz force
+/// `F_ts = c max(-d, 0)^{3/2}`, integrated). The system's parameter is the separation `Z`.
+#[derive(Debug, Clone)]
+pub struct TappingModel {
+    cantilever: Cantilever,
+    sample: Sample,
+    hertz: HertzContact,
+    drive: Drive,
+    free_amplitude_nm: f64,
+    free_response: FreeResponse,
+    grazing_separation_nm: f64,
+    separation: Separation,
+    modes: Vec<ModalConstants>,
+    exact_step_limit: f64,
+}
+
+impl TappingModel {
+    /// The model of `cantilever` tapping `sample`, driven at `drive_frequency_khz` (`None`:
+    /// the fundamental `f_1`) with `F_1` chosen so the free amplitude of `u` is
+    /// `free_amplitude_nm` (MODEL.md section 3), at separation `separation`.
+    ///
+    /// Validates every input (errors name the cantilever or sample and the field).
+    pub fn new(
+        cantilever: Cantilever,
+        sample: Sample,
+        free_amplitude_nm: f64,
+        drive_frequency_khz: Option<f64>,
+        separation: Separation,
+    ) -> Result<Self, AfmError> {
+        cantilever.validate(&format!("cantilever `{}`", cantilever.name))?;
+        sample.validate(&format!("sample `{}`", sample.name))?;
+        check_case_numbers("model parameters", free_amplitude_nm, drive_frequency_khz)?;
+        check_separation(&separation)?;
+        let frequency_khz =
+            drive_frequency_khz.unwrap_or_else(|| cantilever.fundamental_frequency_khz());
+        let drive = Drive::for_free_amplitude(&cantilever, free_amplitude_nm, frequency_khz)?;
+        let free_response = FreeResponse::new(&cantilever, &drive);
+        let grazing_separation_nm = free_response.grazing_separation_nm();
+        let modes: Vec<ModalConstants> = cantilever
+            .modes
+            .iter()
+            .map(|mode| {
+                let omega = mode.angular_frequency();
+                let static_deflection = mode.force_ratio * drive.force_nn / mode.stiffness_n_per_m;
+                ModalConstants {
+                    omega_squared: omega * omega,
+                    omega_squared_over_stiffness: omega * omega / mode.stiffness_n_per_m,
+                    damping: omega / mode.quality_factor,
+                    drive_acceleration: omega * omega * static_deflection,
+                    optical_sensitivity: mode.optical_sensitivity,
+                    oscillator: DrivenOscillator::new(
+                        omega,
+                        mode.quality_factor,
+                        static_deflection,
+                        drive.angular_frequency,
+                    ),
+                }
+            })
+            .collect();
+        // A quarter of the shortest period present: the undamped modal periods (each no longer
+        // than the damped one) and the drive period.
+        let shortest_period = cantilever
+            .modes
+            .iter()
+            .map(|mode| 2.0 * PI / mode.angular_frequency())
+            .fold(drive.period_us(), f64::min);
+        Ok(Self {
+            hertz: HertzContact::new(&cantilever, &sample),
+            cantilever,
+            sample,
+            drive,
+            free_amplitude_nm,
+            free_response,
+            grazing_separation_nm,
+            separation,
+            modes,
+            exact_step_limit: 0.25 * shortest_period,
+        })
+    }
+
+    /// The model of a resolved [`Case`] at separation `Z = Z_G1` (first contact); change it
+    /// with [`TappingModel::set_separation`].
+    pub fn from_case(case: &Case) -> Result<Self, AfmError> {
+        let mut model = Self::new(
+            case.cantilever.clone(),
+            case.sample.clone(),
+            case.free_amplitude_nm,
+            case.drive_frequency_khz,
+            Separation::Constant(0.0),
+        )?;
+        model.separation = Separation::Constant(model.grazing_separation_nm);
+        Ok(model)
+    }
+
+    /// The cantilever.
+    pub fn cantilever(&self) -> &Cantilever {
+        &self.cantilever
+    }
+
+    /// The sample.
+    pub fn sample(&self) -> &Sample {
+        &self.sample
+    }
+
+    /// The Hertz contact law (MODEL.md section 1).
+    pub fn hertz(&self) -> &HertzContact {
+        &self.hertz
+    }
+
+    /// The drive (frequency, `w`, `F_1`).
+    pub fn drive(&self) -> &Drive {
+        &self.drive
+    }
+
+    /// Number of eigenmodes N (the state has dimension 2N).
+    pub fn mode_count(&self) -> usize {
+        self.modes.len()
+    }
+
+    /// Drive angular frequency `w`, rad/us.
+    pub fn drive_angular_frequency(&self) -> f64 {
+        self.drive.angular_frequency
+    }
+
+    /// Drive frequency, kHz.
+    pub fn drive_frequency_khz(&self) -> f64 {
+        self.drive.frequency_khz
+    }
+
+    /// Drive period `T = 2 pi / w`, us.
+    pub fn period_us(&self) -> f64 {
+        self.drive.period_us()
+    }
+
+    /// The free amplitude `A0` of `u`, nm (MODEL.md section 3).
+    pub fn free_amplitude_nm(&self) -> f64 {
+        self.free_amplitude_nm
+    }
+
+    /// The drive force amplitude `F_1` of mode 1, nN.
+    pub fn drive_force_nn(&self) -> f64 {
+        self.drive.force_nn
+    }
+
+    /// The separation of first contact `Z_G1` (the free orbit's lowest gap is zero), nm.
+    pub fn grazing_separation_nm(&self) -> f64 {
+        self.grazing_separation_nm
+    }
+
+    /// The free steady orbit in closed form.
+    pub fn free_response(&self) -> &FreeResponse {
+        &self.free_response
+    }
+
+    /// The free steady orbit's phase of `u`, degrees (MODEL.md section 4).
+    pub fn free_phase_deg(&self) -> f64 {
+        self.free_response.phase_deg()
+    }
+
+    /// The free steady orbit's state at `t = 0` (length 2N; nm, nm/us).
+    pub fn free_state(&self) -> Vec<f64> {
+        let mut x = vec![0.0; self.dim()];
+        self.free_response.state_at(0.0, &mut x);
+        x
+    }
+
+    /// The separation law `Z(t)`.
+    pub fn separation(&self) -> Separation {
+        self.separation
+    }
+
+    /// Replace the separation law. Fails if it is not finite.
+    pub fn set_separation(&mut self, separation: Separation) -> Result<(), AfmError> {
+        check_separation(&separation)?;
+        self.separation = separation;
+        Ok(())
+    }
+
+    /// The tip-sample gap `d = Z(t) + sum_i q_i`, nm.
+    #[inline]
+    pub fn gap(&self, t: f64, x: &[f64]) -> f64 {
+        self.separation.at(t) + (0..self.modes.len()).map(|i| x[2 * i]).sum::<f64>()
+    }
+
+    /// The gap's rate `d' = Z'(t) + sum_i q_i'`, nm/us.
+    #[inline]
+    pub fn gap_rate(&self, x: &[f64]) -> f64 {
+        self.separation.rate() + (0..self.modes.len()).map(|i| x[2 * i + 1]).sum::<f64>()
+    }
+
+    /// The tip-sample force `F_ts(d)`, nN (repulsive positive).
+    #[inline]
+    pub fn tip_sample_force(&self, t: f64, x: &[f64]) -> f64 {
+        self.hertz.force(self.gap(t, x))
+    }
+
+    /// The photodiode signal `u = sum_i chi_i q_i`, nm.
+    #[inline]
+    pub fn photodiode(&self, x: &[f64]) -> f64 {
+        self.modes
+            .iter()
+            .enumerate()
+            .map(|(i, mode)| mode.optical_sensitivity * x[2 * i])
+            .sum()
+    }
+
+    fn in_contact(mode: Mode) -> bool {
+        mode & CONTACT != 0
+    }
+}
+
+fn check_separation(separation: &Separation) -> Result<(), AfmError> {
+    if separation.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(
+            "model parameters",
+            "separation",
+            separation.at(0.0),
+            "finite numbers (nm, nm/us)".to_string(),
+        ))
+    }
+}
+
+impl HybridSystem for TappingModel {
+    fn dim(&self) -> usize {
+        2 * self.modes.len()
+    }
+
+    fn surface_count(&self) -> usize {
+        1
+    }
+
+    /// Eq. 1 solved for the accelerations:
+    /// `q_i'' = w_i^2 [(F_i/k_i) cos(w t) + F_ts(d)/k_i - q_i] - (w_i/Q_i) q_i'`, with
+    /// `F_ts = 0` in free flight and the Hertz force (finite on both sides) in contact.
+    fn vector_field(&self, mode: Mode, t: f64, x: &[f64], dxdt: &mut [f64]) {
+        let drive = (self.drive.angular_frequency * t).cos();
+        let force = if Self::in_contact(mode) {
+            self.hertz.force(self.gap(t, x))
+        } else {
+            0.0
+        };
+        for (i, m) in self.modes.iter().enumerate() {
+            let q = x[2 * i];
+            let v = x[2 * i + 1];
+            dxdt[2 * i] = v;
+            dxdt[2 * i + 1] = m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
+                - m.omega_squared * q
+                - m.damping * v;
+        }
+    }
+
+    /// `df/dx`: the modal blocks `[[0, 1], [-w_i^2, -w_i/Q_i]]`, plus in contact
+    /// `d q_i'' / d q_j = (w_i^2 / k_i) F_ts'(d)` for every `i, j`.
+    fn jacobian(&self, mode: Mode, t: f64, x: &[f64], jacobian: &mut DMatrix<f64>) {
+        jacobian.fill(0.0);
+        let slope = if Self::in_contact(mode) {
+            self.hertz.force_derivative(self.gap(t, x))
+        } else {
+            0.0
+        };
+        for (i, m) in self.modes.iter().enumerate() {
+            jacobian[(2 * i, 2 * i + 1)] = 1.0;
+            jacobian[(2 * i + 1, 2 * i)] = -m.omega_squared;
+            jacobian[(2 * i + 1, 2 * i + 1)] = -m.damping;
+            if slope != 0.0 {
+                let coupling = m.omega_squared_over_stiffness * slope;
+                for j in 0..self.modes.len() {
+                    jacobian[(2 * i + 1, 2 * j)] += coupling;
+                }
+            }
+        }
+    }
+
+    /// `df/dZ`: `(w_i^2 / k_i) F_ts'(d)` on every acceleration component in contact, 0 in
+    /// free flight.
+    fn parameter_derivative(&self, mode: Mode, t: f64, x: &[f64], dfdp: &mut [f64]) {
+        dfdp.fill(0.0);
+        if Self::in_contact(mode) {
+            let slope = self.hertz.force_derivative(self.gap(t, x));
+            for (i, m) in self.modes.iter().enumerate() {
+                dfdp[2 * i + 1] = m.omega_squared_over_stiffness * slope;
+            }
+        }
+    }
+
+    /// `h_0 = d = Z(t) + sum_i q_i`, nm.
+    fn switching(&self, _k: usize, t: f64, x: &[f64]) -> f64 {
+        self.gap(t, x)
+    }
+
+    /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in both modes), nm/us.
+    fn switching_rate(&self, _k: usize, _mode: Mode, _t: f64, x: &[f64]) -> f64 {
+        self.gap_rate(x)
+    }
+
+    /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'`; `dh/dt|_x = Z'(t)`; `dh/dZ = 1`.
+    fn switching_gradient(
+        &self,
+        _k: usize,
+        _t: f64,
+        _x: &[f64],
+        gradient: &mut [f64],
+    ) -> SwitchingPartials {
+        for (i, g) in gradient.iter_mut().enumerate() {
+            *g = if i % 2 == 0 { 1.0 } else { 0.0 };
+        }
+        SwitchingPartials {
+            t: self.separation.rate(),
+            p: 1.0,
+        }
+    }
+
+    fn has_exact_flow(&self, mode: Mode) -> bool {
+        mode == FREE_FLIGHT
+    }
+
+    /// A quarter of the shortest of the drive period and the modal periods `2 pi / w_i`, us.
+    fn exact_step_limit(&self, mode: Mode) -> f64 {
+        if mode == FREE_FLIGHT {
+            self.exact_step_limit
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The free flight's closed-form flow (block diagonal, one [`DrivenOscillator`] per mode);
+    /// it does not depend on `Z`, so `dx/dZ = 0`.
+    fn exact_flow(
+        &self,
+        _mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        dt: f64,
+        x: &mut [f64],
+        mut transition: Option<&mut DMatrix<f64>>,
+        dxdp: Option<&mut [f64]>,
+    ) {
+        if let Some(matrix) = transition.as_deref_mut() {
+            matrix.fill(0.0);
+        }
+        for (i, m) in self.modes.iter().enumerate() {
+            let (state, phi) = m.oscillator.flow(t0, [x0[2 * i], x0[2 * i + 1]], dt);
+            x[2 * i] = state[0];
+            x[2 * i + 1] = state[1];
+            if let Some(matrix) = transition.as_deref_mut() {
+                for r in 0..2 {
+                    for c in 0..2 {
+                        matrix[(2 * i + r, 2 * i + c)] = phi[r][c];
+                    }
+                }
+            }
+        }
+        if let Some(dxdp) = dxdp {
+            dxdp.fill(0.0);
+        }
+    }
+}
