@@ -18,10 +18,13 @@
 //!   continuation tracks). A minimum that dips strictly below zero, however little, fires two
 //!   events (down, then up), both flagged `grazing` when `|dh/dt| < grazing_rate`; each event
 //!   advances time past its bracket, so neither repeats.
-//! * After a reset, the new mode bit of surface `k` is set iff `dh_k/dt < 0` just after the
-//!   reset (evaluated with the pre-event mode's field); other bits are unchanged. A reset that
-//!   leaves `dh/dt = 0` on the surface (a Zeno accumulation such as a bouncing ball coming to
-//!   rest) ends in [`HybridError::TooManyEvents`].
+//! * A reset chooses its bracket end from the sign of `dh_k/dt` just after the reset
+//!   (evaluated with the pre-event mode's field) at the far end: the near end if the state
+//!   bounces back, the far end if it goes through. The new mode bit of surface `k` is then the
+//!   side of `h_k` at the post-reset state (on the surface, the side `dh_k/dt` points to), so
+//!   the mode always matches the side the state is on and no later crossing can be missed;
+//!   other bits are unchanged. A Zeno accumulation (a bouncing ball coming to rest) ends in
+//!   [`HybridError::TooManyEvents`].
 
 use nalgebra::{DMatrix, DMatrixView};
 
@@ -705,9 +708,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let reset = system.has_reset(k, direction);
         let mut t_event = bracket.far;
         self.augmented_at(t_event);
-        let mut negative_after = !was_negative;
         if reset {
-            // Does the reset send the state back to the side it came from (a bounce)?
+            // Does the reset send the state back to the side it came from (a bounce)? Then
+            // return the bracket end on that side.
             self.x_after.copy_from_slice(&self.z[..n]);
             system.reset(
                 k,
@@ -717,7 +720,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 &mut self.reset_jacobian,
                 &mut self.reset_dxdp,
             );
-            negative_after = system.switching_rate(k, mode, t_event, &self.x_after) < 0.0;
+            let negative_after = system.switching_rate(k, mode, t_event, &self.x_after) < 0.0;
             let near_usable = bracket.far - bracket.near <= time_tolerance
                 || bracket.near_value <= self.settings.event_value_tolerance;
             if negative_after == was_negative && near_usable && bracket.near != t_event {
@@ -729,7 +732,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let rate = system.switching_rate(k, mode, t_event, &self.x);
         system.vector_field(mode, t_event, &self.x, &mut self.f_minus);
         self.field.evaluations += 1;
-        if reset {
+        let negative_after = if reset {
             system.reset(
                 k,
                 direction,
@@ -738,8 +741,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 &mut self.reset_jacobian,
                 &mut self.reset_dxdp,
             );
-            negative_after = system.switching_rate(k, mode, t_event, &self.z[..n]) < 0.0;
-        }
+            // The side of the post-reset state; on the surface, the side it moves to.
+            let h = system.switching(k, t_event, &self.z[..n]);
+            h < 0.0 || (h == 0.0 && system.switching_rate(k, mode, t_event, &self.z[..n]) < 0.0)
+        } else {
+            !was_negative
+        };
         if self.z[..n].iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t_event });
         }
