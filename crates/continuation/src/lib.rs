@@ -1,1 +1,35 @@
-//! placeholder
+//! Periodic orbits of parametrised (hybrid) systems: shooting, Floquet stability and
+//! pseudo-arclength continuation with labelled special points.
+//!
+//! The crate knows nothing about cantilevers. It works on a [`PeriodicProblem`], a period map
+//! `P(x; p)` with its monodromy `dP/dx`, its parameter derivative `dP/dp` and the structure of
+//! the orbit (the extrema of a contact switching function and the impacts per period,
+//! MODEL.md Sec. 5):
+//!
+//! * [`shoot`]: Newton's method on `P(x; p) - x = 0` with the exact monodromy;
+//! * [`floquet_multipliers`], [`is_stable`]: stability from the monodromy's eigenvalues;
+//! * [`Continuation`]: pseudo-arclength continuation in `(x, p)` through folds, an iterator of
+//!   [`BranchPoint`]s, which detects and locates [`SpecialPoint`]s: folds, period doubling,
+//!   Neimark-Sacker, grazing `G<n>` (a minimum of the gap through zero), merging and
+//!   splitting of impacts, and impact-count changes that are not grazing.
+#![warn(missing_docs)]
+
+pub mod branch;
+mod corrector;
+pub mod error;
+pub mod floquet;
+mod location;
+pub mod problem;
+pub mod settings;
+pub mod shooting;
+pub mod special_point;
+pub mod test_function;
+
+pub use branch::{Branch, BranchPoint, Continuation, StopReason};
+pub use error::ContinuationError;
+pub use floquet::{floquet_multipliers, is_stable, spectral_radius};
+pub use problem::{OrbitStructure, PeriodMap, PeriodicProblem};
+pub use settings::{ContinuationSettings, ParameterDirection};
+pub use shooting::{shoot, NewtonSettings, ShootingResult};
+pub use special_point::{SpecialPoint, SpecialPointKind};
+pub use test_function::{neimark_sacker_test, period_doubling_test, ExtremumKind, TestValues};

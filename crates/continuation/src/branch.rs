@@ -1,0 +1,563 @@
+//! Pseudo-arclength continuation of a branch of periodic orbits, driven as an iterator of
+//! [`BranchPoint`]s, with the detection and location of special points in every step.
+//!
+//! Each step predicts along the unit tangent, `u_pred = u_A + ds t_A`, and corrects on the
+//! hyperplane `t_A . (u - u_pred) = 0` (Keller's pseudo-arclength method), so the branch goes
+//! on through folds and its unstable parts are computed too. The step grows after easy steps
+//! and is cut when the corrector fails, when the tangent turns by more than
+//! `max_tangent_angle`, or when two structure events (MODEL.md Sec. 5) fall in one step and can
+//! be separated. Every test function that changes sign between two accepted points is located
+//! by root finding along that step ([`crate::location`]); the branch then carries on from the
+//! ordinary point that ends the step, so it crosses every grazing by itself.
+
+use nalgebra::{Complex, DVector};
+
+use crate::corrector::{correct, tangent};
+use crate::error::ContinuationError;
+use crate::floquet::{floquet_multipliers, is_stable};
+use crate::location::{Location, Sample, Segment};
+use crate::problem::{OrbitStructure, PeriodicProblem};
+use crate::settings::ContinuationSettings;
+use crate::shooting::{shoot, NewtonSettings};
+use crate::special_point::{SpecialPoint, SpecialPointKind};
+use crate::test_function::{
+    neimark_sacker_test, period_doubling_test, structure_changes, ExtremumKind, StructureTest,
+};
+
+/// One accepted point of a branch of periodic orbits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BranchPoint {
+    /// Position on the branch: 0 for the start, then 1, 2, ...
+    pub index: usize,
+    /// The fixed point `x` of the period map (state units).
+    pub state: DVector<f64>,
+    /// The parameter `p` (parameter units).
+    pub parameter: f64,
+    /// Unit tangent `(dx/ds, dp/ds)` (length `n + 1`) in the direction of continuation.
+    pub tangent: DVector<f64>,
+    /// Floquet multipliers (eigenvalues of the monodromy), by decreasing modulus.
+    pub multipliers: Vec<Complex<f64>>,
+    /// Whether every multiplier lies strictly inside the unit circle.
+    pub stable: bool,
+    /// Extrema and impacts of the contact switching function over the period.
+    pub structure: OrbitStructure,
+    /// Newton updates of the corrector (of the shooting, for the start).
+    pub iterations: usize,
+    /// `|P(x; p) - x|_2` (state units).
+    pub residual: f64,
+    /// Arclength step that reached this point (0 for the start).
+    pub step: f64,
+    /// Special points located in the step that ended at this point, in branch order.
+    pub special_points: Vec<SpecialPoint>,
+}
+
+/// Why a branch ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum StopReason {
+    /// `max_points` branch points were produced.
+    MaxPoints,
+    /// The parameter reached `parameter_min` or `parameter_max` (the last point lies on it).
+    ParameterBound,
+    /// The user's stop predicate returned `true` on the last point.
+    UserStop,
+    /// The corrector failed at the minimum step (for example at a non-smooth point it cannot
+    /// cross); see [`ContinuationError::StepTooSmall`].
+    StepTooSmall,
+    /// Another error ended the branch.
+    Error,
+}
+
+/// A computed branch: its points, its special points and why it ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// The accepted points, the start first.
+    pub points: Vec<BranchPoint>,
+    /// Every located special point, in branch order.
+    pub special_points: Vec<SpecialPoint>,
+    /// Why the branch ended.
+    pub stop: StopReason,
+    /// The error that ended it, for [`StopReason::StepTooSmall`] and [`StopReason::Error`].
+    pub error: Option<ContinuationError>,
+}
+
+/// A test function of a corrected orbit on a step.
+type SampleTest = fn(&Sample) -> f64;
+
+/// A user predicate that ends the branch after the point it returns `true` on.
+type StopPredicate<'a> = Box<dyn FnMut(&BranchPoint) -> bool + 'a>;
+
+/// Pseudo-arclength continuation of the fixed points of `P(x; p)`: an iterator of
+/// `Result<BranchPoint, ContinuationError>` that yields the start, then one accepted point per
+/// step, and ends after an error (yielded once) or a stop.
+pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
+    problem: &'a P,
+    settings: ContinuationSettings,
+    stop_predicate: Option<StopPredicate<'a>>,
+    current: Sample,
+    start: Option<BranchPoint>,
+    step: f64,
+    produced: usize,
+    special_points: Vec<SpecialPoint>,
+    stop: Option<StopReason>,
+}
+
+impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
+    /// Start a branch at the periodic orbit near `x0` at parameter `p0`: shoot there (with
+    /// four times the corrector's iterations), compute the tangent oriented in
+    /// `settings.direction`, and prepare the iteration.
+    ///
+    /// # Errors
+    /// Invalid settings, a wrong `x0`, a failed period map, a start that does not converge
+    /// ([`ContinuationError::StartNotConverged`]), or a singular tangent system (a start on a
+    /// fold or branch point).
+    pub fn new(
+        problem: &'a P,
+        x0: &[f64],
+        p0: f64,
+        settings: ContinuationSettings,
+    ) -> Result<Self, ContinuationError> {
+        settings.validate()?;
+        let shooting = NewtonSettings {
+            max_iterations: settings.corrector.max_iterations * 4,
+            ..settings.corrector.clone()
+        };
+        let start = shoot(problem, x0, p0, &shooting)?;
+        if !start.converged {
+            return Err(ContinuationError::StartNotConverged {
+                parameter: p0,
+                iterations: start.iterations,
+                residual: start.residual,
+            });
+        }
+        let n = problem.dim();
+        let mut u = DVector::zeros(n + 1);
+        u.rows_mut(0, n).copy_from(&start.state);
+        u[n] = p0;
+        let mut reference = DVector::zeros(n + 1);
+        reference[n] = settings.direction.sign();
+        let t = tangent(&start.period_map, &reference, p0)?;
+        let multipliers = floquet_multipliers(&start.period_map.monodromy);
+        let first = BranchPoint {
+            index: 0,
+            state: start.state.clone(),
+            parameter: p0,
+            tangent: t.clone(),
+            stable: is_stable(&multipliers),
+            multipliers: multipliers.clone(),
+            structure: start.period_map.structure.clone(),
+            iterations: start.iterations,
+            residual: start.residual,
+            step: 0.0,
+            special_points: Vec::new(),
+        };
+        let current = Sample {
+            sigma: 0.0,
+            u,
+            map: start.period_map,
+            tangent: t,
+            multipliers,
+        };
+        Ok(Self {
+            problem,
+            step: settings.initial_step,
+            settings,
+            stop_predicate: None,
+            current,
+            start: Some(first),
+            produced: 0,
+            special_points: Vec::new(),
+            stop: None,
+        })
+    }
+
+    /// End the branch after the first point on which `predicate` returns `true`.
+    pub fn stop_when(mut self, predicate: impl FnMut(&BranchPoint) -> bool + 'a) -> Self {
+        self.stop_predicate = Some(Box::new(predicate));
+        self
+    }
+
+    /// Every special point located so far, in branch order.
+    pub fn special_points(&self) -> &[SpecialPoint] {
+        &self.special_points
+    }
+
+    /// Why the branch ended (`None` while it goes on).
+    pub fn stop_reason(&self) -> Option<StopReason> {
+        self.stop
+    }
+
+    /// The arclength step the next continuation step will try.
+    pub fn current_step(&self) -> f64 {
+        self.step
+    }
+
+    /// Run the branch to its end and collect it. An error after the start ends the branch
+    /// and is kept in [`Branch::error`] with the points computed before it.
+    pub fn run(mut self) -> Branch {
+        let mut points = Vec::new();
+        let mut error = None;
+        for item in self.by_ref() {
+            match item {
+                Ok(point) => points.push(point),
+                Err(e) => error = Some(e),
+            }
+        }
+        Branch {
+            points,
+            special_points: self.special_points,
+            stop: self.stop.unwrap_or(StopReason::Error),
+            error,
+        }
+    }
+
+    /// Cut the step; `false` if it is already at the minimum.
+    fn cut(&mut self) -> bool {
+        if self.step <= self.settings.min_step {
+            return false;
+        }
+        self.step = (self.step * self.settings.step_cut).max(self.settings.min_step);
+        true
+    }
+
+    /// Count a produced point and apply the stop rules to it.
+    fn emit(&mut self, point: BranchPoint, at_bound: bool) -> BranchPoint {
+        self.produced += 1;
+        if at_bound {
+            self.stop = Some(StopReason::ParameterBound);
+        } else if self.produced >= self.settings.max_points {
+            self.stop = Some(StopReason::MaxPoints);
+        } else if let Some(predicate) = self.stop_predicate.as_mut() {
+            if predicate(&point) {
+                self.stop = Some(StopReason::UserStop);
+            }
+        }
+        point
+    }
+
+    /// Shoot at the parameter bound crossed by the step `A -> B`, from the state interpolated
+    /// linearly in `p`. `None` if it does not converge.
+    fn point_at_bound(
+        &self,
+        b: &Sample,
+        bound: f64,
+    ) -> Result<Option<(Sample, usize, f64)>, ContinuationError> {
+        let a = &self.current;
+        let n = self.problem.dim();
+        let (pa, pb) = (a.parameter(), b.parameter());
+        let w = if pb == pa {
+            1.0
+        } else {
+            ((bound - pa) / (pb - pa)).clamp(0.0, 1.0)
+        };
+        let guess = a.u.rows(0, n) + w * (b.u.rows(0, n) - a.u.rows(0, n));
+        let result = shoot(
+            self.problem,
+            guess.as_slice(),
+            bound,
+            &self.settings.corrector,
+        )?;
+        if !result.converged {
+            return Ok(None);
+        }
+        let mut u = DVector::zeros(n + 1);
+        u.rows_mut(0, n).copy_from(&result.state);
+        u[n] = bound;
+        Ok(Some((
+            Sample::new(1.0, u, result.period_map, &a.tangent),
+            result.iterations,
+            result.residual,
+        )))
+    }
+
+    /// One continuation step: the next accepted point, or an error.
+    fn advance(&mut self) -> Result<BranchPoint, ContinuationError> {
+        let n = self.problem.dim();
+        loop {
+            let ds = self.step;
+            let t_a = self.current.tangent.clone();
+            let predicted = &self.current.u + ds * &t_a;
+            let corrected = correct(
+                self.problem,
+                predicted.clone(),
+                &predicted,
+                &t_a,
+                &self.settings.corrector,
+            )?;
+            let (u, map) = match (corrected.converged, corrected.map) {
+                (true, Some(map)) => (corrected.u, map),
+                _ => {
+                    if self.cut() {
+                        continue;
+                    }
+                    self.stop = Some(StopReason::StepTooSmall);
+                    return Err(ContinuationError::StepTooSmall {
+                        parameter: self.current.parameter(),
+                        step: ds,
+                        residual: corrected.residual,
+                    });
+                }
+            };
+            let mut b = Sample::new(1.0, u, map, &t_a);
+            let mut iterations = corrected.iterations;
+            let mut residual = corrected.residual;
+            let turn = t_a.dot(&b.tangent).clamp(-1.0, 1.0).acos();
+            if !turn.is_finite() || turn > self.settings.max_tangent_angle {
+                if self.cut() {
+                    continue;
+                }
+                if !turn.is_finite() {
+                    self.stop = Some(StopReason::Error);
+                    return Err(ContinuationError::SingularMatrix {
+                        what: "bordered Jacobian (tangent)",
+                        parameter: b.parameter(),
+                    });
+                }
+            }
+            // Parameter bounds: end exactly on the bound.
+            let mut at_bound = false;
+            let pb = b.parameter();
+            let bound = if pb > self.settings.parameter_max {
+                Some(self.settings.parameter_max)
+            } else if pb < self.settings.parameter_min {
+                Some(self.settings.parameter_min)
+            } else {
+                None
+            };
+            if let Some(bound) = bound {
+                match self.point_at_bound(&b, bound)? {
+                    Some((sample, its, res)) => {
+                        b = sample;
+                        iterations = its;
+                        residual = res;
+                        at_bound = true;
+                    }
+                    None => {
+                        if self.cut() {
+                            continue;
+                        }
+                        self.stop = Some(StopReason::StepTooSmall);
+                        return Err(ContinuationError::StepTooSmall {
+                            parameter: self.current.parameter(),
+                            step: ds,
+                            residual: f64::INFINITY,
+                        });
+                    }
+                }
+            }
+            // Several separable structure events in one step: cut it.
+            let structure = structure_changes(&self.current.map.structure, &b.map.structure);
+            if structure.len() >= 2 && !at_bound {
+                let mut roots: Vec<f64> = structure.iter().map(|t| t.linear_root()).collect();
+                roots.sort_by(f64::total_cmp);
+                let separable = roots.windows(2).any(|w| w[1] - w[0] > 0.05);
+                if separable && self.cut() {
+                    continue;
+                }
+            }
+            let index = self.produced;
+            let mut a = self.current.clone();
+            a.sigma = 0.0;
+            let segment = Segment::new(
+                self.problem,
+                a,
+                b.clone(),
+                t_a.clone(),
+                self.settings.corrector.clone(),
+            );
+            let special = self.locate_all(&segment, &structure, index)?;
+            if iterations <= self.settings.easy_iterations {
+                self.step = (self.step * self.settings.step_growth).min(self.settings.max_step);
+            }
+            let point = BranchPoint {
+                index,
+                state: b.u.rows(0, n).into_owned(),
+                parameter: b.parameter(),
+                tangent: b.tangent.clone(),
+                multipliers: b.multipliers.clone(),
+                stable: is_stable(&b.multipliers),
+                structure: b.map.structure.clone(),
+                iterations,
+                residual,
+                step: ds,
+                special_points: special.clone(),
+            };
+            self.special_points.extend(special);
+            self.current = b;
+            return Ok(self.emit(point, at_bound));
+        }
+    }
+
+    /// Locate every sign change of a test function in the step held by `segment`.
+    fn locate_all(
+        &self,
+        segment: &Segment<'_, P>,
+        structure: &[StructureTest],
+        index: usize,
+    ) -> Result<Vec<SpecialPoint>, ContinuationError> {
+        let tolerance = self.settings.location_tolerance;
+        let max_iterations = self.settings.location_max_iterations;
+        let mut found: Vec<(f64, SpecialPoint)> = Vec::new();
+        let mut breaks: Vec<(usize, usize)> = Vec::new();
+        for test in structure {
+            let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
+            let location = segment.locate(0, 1, &value, tolerance, max_iterations)?;
+            let kind = match *test {
+                StructureTest::Extremum {
+                    kind: ExtremumKind::Minimum,
+                    ..
+                } => SpecialPointKind::Grazing,
+                StructureTest::Extremum {
+                    kind: ExtremumKind::Maximum,
+                    value_a,
+                    ..
+                } => {
+                    if value_a >= 0.0 {
+                        SpecialPointKind::Merge
+                    } else {
+                        SpecialPointKind::Split
+                    }
+                }
+                StructureTest::ImpactCount { n_a, n_b } => {
+                    if n_b < n_a {
+                        SpecialPointKind::ImpactVanish
+                    } else {
+                        SpecialPointKind::ImpactAppear
+                    }
+                }
+            };
+            breaks.push((location.low, location.high));
+            found.push(self.special_point(segment, kind, &location, location.converged, index));
+        }
+        // Smooth (tangent and multiplier) tests, located between the structure brackets.
+        let mut smooth: Vec<(SpecialPointKind, SampleTest)> =
+            vec![(SpecialPointKind::Fold, |s: &Sample| {
+                s.tangent[s.tangent.len() - 1]
+            })];
+        if self.settings.detect_bifurcations {
+            smooth.push((SpecialPointKind::PeriodDoubling, |s: &Sample| {
+                period_doubling_test(&s.multipliers)
+            }));
+            smooth.push((SpecialPointKind::NeimarkSacker, |s: &Sample| {
+                neimark_sacker_test(&s.multipliers)
+            }));
+        }
+        let sign = |g: f64| g < 0.0;
+        let a0 = segment.get(0);
+        let b1 = segment.get(1);
+        for (kind, test) in smooth {
+            let (ga, gb) = (test(&a0), test(&b1));
+            if !(ga.is_finite() && gb.is_finite()) || sign(ga) == sign(gb) {
+                continue;
+            }
+            // Intervals between the structure brackets, in sigma order.
+            let mut cuts: Vec<(f64, usize, usize)> = breaks
+                .iter()
+                .map(|&(l, h)| (segment.get(l).sigma, l, h))
+                .collect();
+            cuts.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let mut intervals = Vec::new();
+            let mut lo = 0;
+            for &(_, l, h) in &cuts {
+                intervals.push((lo, l));
+                lo = h;
+            }
+            intervals.push((lo, 1));
+            let continuous = intervals.iter().copied().find(|&(l, h)| {
+                let (gl, gh) = (test(&segment.get(l)), test(&segment.get(h)));
+                gl.is_finite() && gh.is_finite() && sign(gl) != sign(gh)
+            });
+            let (mut kind, location) = match continuous {
+                Some((l, h)) => {
+                    let location = segment.locate(l, h, &test, tolerance, max_iterations)?;
+                    (kind, location)
+                }
+                None => {
+                    // The sign change happens across a structure change (a jump).
+                    let Some(&(_, l, h)) = cuts.iter().find(|&&(_, l, h)| {
+                        sign(test(&segment.get(l))) != sign(test(&segment.get(h)))
+                    }) else {
+                        continue;
+                    };
+                    let location = Location {
+                        point: Some(segment.get(l)),
+                        low: l,
+                        high: h,
+                        converged: false,
+                        iterations: 0,
+                    };
+                    (kind, location)
+                }
+            };
+            if kind == SpecialPointKind::NeimarkSacker {
+                let on_circle = location.point.as_ref().is_some_and(|s| {
+                    s.multipliers
+                        .iter()
+                        .any(|m| m.im.abs() > 1e-8 * m.norm() && (m.norm() - 1.0).abs() < 1e-3)
+                });
+                if !on_circle {
+                    kind = SpecialPointKind::NeutralSaddle;
+                }
+            }
+            let converged = location.converged && continuous.is_some();
+            found.push(self.special_point(segment, kind, &location, converged, index));
+        }
+        found.sort_by(|x, y| x.0.total_cmp(&y.0));
+        Ok(found.into_iter().map(|(_, s)| s).collect())
+    }
+
+    /// Assemble a special point from a location.
+    fn special_point(
+        &self,
+        segment: &Segment<'_, P>,
+        kind: SpecialPointKind,
+        location: &Location,
+        converged: bool,
+        index: usize,
+    ) -> (f64, SpecialPoint) {
+        let low = segment.get(location.low);
+        let high = segment.get(location.high);
+        let (pl, ph) = (low.parameter(), high.parameter());
+        let point = location.point.clone().unwrap_or_else(|| low.clone());
+        let n = point.u.len() - 1;
+        let impacts_after = high.map.structure.impacts;
+        (
+            point.sigma,
+            SpecialPoint {
+                label: kind.label(impacts_after),
+                kind,
+                parameter: point.parameter(),
+                bracket: (pl.min(ph), pl.max(ph)),
+                precision: (pl - ph).abs(),
+                converged,
+                impacts_before: low.map.structure.impacts,
+                impacts_after,
+                state: point.u.rows(0, n).into_owned(),
+                multipliers: point.multipliers.clone(),
+                iterations: location.iterations,
+                branch_index: index,
+            },
+        )
+    }
+}
+
+impl<P: PeriodicProblem + ?Sized> Iterator for Continuation<'_, P> {
+    type Item = Result<BranchPoint, ContinuationError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if let Some(start) = self.start.take() {
+            return Some(Ok(self.emit(start, false)));
+        }
+        if self.stop.is_some() {
+            return None;
+        }
+        match self.advance() {
+            Ok(point) => Some(Ok(point)),
+            Err(e) => {
+                if self.stop.is_none() {
+                    self.stop = Some(StopReason::Error);
+                }
+                Some(Err(e))
+            }
+        }
+    }
+}

@@ -1,0 +1,82 @@
+//! Special points of a branch: where a test function changes sign, located by root finding
+//! along the branch, with the precision of the location (MODEL.md Sec. 5 for the labels).
+
+use nalgebra::{Complex, DVector};
+
+/// What kind of special point was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SpecialPointKind {
+    /// A turning point of the branch (the parameter component of the tangent vanishes).
+    Fold,
+    /// A real Floquet multiplier crosses `-1`.
+    PeriodDoubling,
+    /// A complex pair of multipliers crosses the unit circle.
+    NeimarkSacker,
+    /// Two real multipliers with product 1 (the Neimark-Sacker test vanishes without a
+    /// complex pair on the unit circle): not a bifurcation.
+    NeutralSaddle,
+    /// A local minimum of the contact switching function crosses zero: a grazing trajectory
+    /// (MODEL.md Sec. 5), labelled `G<n>` with `n` the impacts per period after it.
+    Grazing,
+    /// A local maximum of the switching function between two contacts dips below zero: the
+    /// two impacts merge into one.
+    Merge,
+    /// A local maximum of the switching function rises above zero: one impact splits in two.
+    Split,
+    /// The impact count decreases with no extremum crossing zero.
+    ImpactVanish,
+    /// The impact count increases with no extremum crossing zero.
+    ImpactAppear,
+}
+
+impl SpecialPointKind {
+    /// The label of a point of this kind with `impacts_after` impacts per period after it:
+    /// `G<n>`, `fold`, `period-doubling`, `neimark-sacker`, `neutral-saddle`, `merge`,
+    /// `split`, `impact-vanish`, `impact-appear`.
+    pub fn label(self, impacts_after: usize) -> String {
+        match self {
+            SpecialPointKind::Fold => "fold".into(),
+            SpecialPointKind::PeriodDoubling => "period-doubling".into(),
+            SpecialPointKind::NeimarkSacker => "neimark-sacker".into(),
+            SpecialPointKind::NeutralSaddle => "neutral-saddle".into(),
+            SpecialPointKind::Grazing => format!("G{impacts_after}"),
+            SpecialPointKind::Merge => "merge".into(),
+            SpecialPointKind::Split => "split".into(),
+            SpecialPointKind::ImpactVanish => "impact-vanish".into(),
+            SpecialPointKind::ImpactAppear => "impact-appear".into(),
+        }
+    }
+}
+
+/// A located special point of a branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpecialPoint {
+    /// `G1`, `G2`, ..., `fold`, `period-doubling`, `neimark-sacker`, `neutral-saddle`,
+    /// `merge`, `split`, `impact-vanish`, `impact-appear` ([`SpecialPointKind::label`]).
+    pub label: String,
+    /// The kind of point.
+    pub kind: SpecialPointKind,
+    /// The parameter at the located point (parameter units; for the AFM, `Z` in nm).
+    pub parameter: f64,
+    /// The final parameter bracket `(low, high)` of the sign change (parameter units).
+    pub bracket: (f64, f64),
+    /// `high - low` of the bracket: the achieved precision (parameter units).
+    pub precision: f64,
+    /// Whether the bracket reached the location tolerance with a continuous sign change.
+    /// False when the root finder ran out of iterations, a trial point failed, or the test
+    /// function jumped across a structure change (a discontinuous crossing, reported at the
+    /// structure change's bracket).
+    pub converged: bool,
+    /// Impacts per period on the side of the bracket the branch comes from.
+    pub impacts_before: usize,
+    /// Impacts per period on the side of the bracket the branch goes to.
+    pub impacts_after: usize,
+    /// The state `x` of the orbit at the located point (state units).
+    pub state: DVector<f64>,
+    /// The Floquet multipliers at the located point.
+    pub multipliers: Vec<Complex<f64>>,
+    /// Root-finding iterations (corrected trial points) spent on the location.
+    pub iterations: usize,
+    /// Index of the branch point that ends the step in which the point was found.
+    pub branch_index: usize,
+}

@@ -1,0 +1,211 @@
+//! Continuous test functions along a branch, whose sign changes signal special points.
+//!
+//! * fold: the parameter component `t_p` of the unit tangent (zero at a turning point);
+//! * period doubling: `Re prod_i (1 + mu_i)` = `det(M + I)` (zero when a real multiplier is
+//!   `-1`);
+//! * Neimark-Sacker: `Re prod_{i<j} (mu_i mu_j - 1)` = `det(M (.) M - I)` on the bialternate
+//!   product (zero when a complex pair crosses the unit circle, `mu conj(mu) = 1`; also at a
+//!   neutral saddle, `mu_i mu_j = 1` real, which is labelled apart);
+//! * structure (MODEL.md Sec. 5): the value of each local minimum of the contact switching
+//!   function (zero at grazing), of each local maximum (zero when two contacts merge), and the
+//!   impact count per period. Extrema of two orbits are matched by their time in the period.
+//!
+//! (Kuznetsov, *Elements of Applied Bifurcation Theory*, Sec. 10.2, for the bialternate test.)
+
+use nalgebra::{Complex, DVector};
+
+use crate::problem::OrbitStructure;
+
+/// The multiplier- and tangent-based test functions of one branch point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TestValues {
+    /// Fold test: the parameter component of the unit tangent.
+    pub fold: f64,
+    /// Period-doubling test `Re prod (1 + mu_i)`.
+    pub period_doubling: f64,
+    /// Neimark-Sacker test `Re prod_{i<j} (mu_i mu_j - 1)` (1 for `n = 1`).
+    pub neimark_sacker: f64,
+}
+
+impl TestValues {
+    /// The test values of a point with unit tangent `tangent` (length `n + 1`, parameter
+    /// last) and Floquet multipliers `multipliers`.
+    pub fn new(tangent: &DVector<f64>, multipliers: &[Complex<f64>]) -> Self {
+        Self {
+            fold: tangent[tangent.len() - 1],
+            period_doubling: period_doubling_test(multipliers),
+            neimark_sacker: neimark_sacker_test(multipliers),
+        }
+    }
+}
+
+/// `Re prod_i (1 + mu_i)`: changes sign when a real multiplier crosses `-1`.
+pub fn period_doubling_test(multipliers: &[Complex<f64>]) -> f64 {
+    multipliers
+        .iter()
+        .fold(Complex::new(1.0, 0.0), |acc, m| acc * (m + 1.0))
+        .re
+}
+
+/// `Re prod_{i<j} (mu_i mu_j - 1)`: changes sign when a complex pair of multipliers crosses
+/// the unit circle (or at a neutral saddle).
+pub fn neimark_sacker_test(multipliers: &[Complex<f64>]) -> f64 {
+    let mut acc = Complex::new(1.0, 0.0);
+    for (i, a) in multipliers.iter().enumerate() {
+        for b in &multipliers[i + 1..] {
+            acc *= a * b - 1.0;
+        }
+    }
+    acc.re
+}
+
+/// Which kind of extremum of the switching function a structure test follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ExtremumKind {
+    /// A local minimum of `h` (a near impact, an impact, or grazing at value 0).
+    Minimum,
+    /// A local maximum of `h` (between two contacts when negative).
+    Maximum,
+}
+
+/// A structure test between two branch points: an extremum followed from one to the other
+/// (its value changes sign), or the impact count (which changes without any extremum
+/// changing sign).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum StructureTest {
+    /// An extremum at time `t_a` in the first orbit and `t_b` in the second.
+    Extremum {
+        kind: ExtremumKind,
+        t_a: f64,
+        t_b: f64,
+        value_a: f64,
+        value_b: f64,
+        duration: f64,
+    },
+    /// The impact count goes from `n_a` to `n_b`.
+    ImpactCount { n_a: usize, n_b: usize },
+}
+
+/// The periodic time difference `b - a` wrapped to `[-duration/2, duration/2]`.
+fn wrapped(a: f64, b: f64, duration: f64) -> f64 {
+    if !(duration.is_finite() && duration > 0.0) {
+        return b - a;
+    }
+    let d = (b - a).rem_euclid(duration);
+    if d > 0.5 * duration {
+        d - duration
+    } else {
+        d
+    }
+}
+
+/// Mutually nearest pairs (by periodic time) of two lists of `(time, value)`.
+fn matched(a: &[(f64, f64)], b: &[(f64, f64)], duration: f64) -> Vec<(usize, usize)> {
+    let nearest = |t: f64, list: &[(f64, f64)]| -> Option<usize> {
+        list.iter()
+            .enumerate()
+            .min_by(|x, y| {
+                wrapped(t, x.1 .0, duration)
+                    .abs()
+                    .total_cmp(&wrapped(t, y.1 .0, duration).abs())
+            })
+            .map(|(i, _)| i)
+    };
+    let mut pairs = Vec::new();
+    for (i, &(t, _)) in a.iter().enumerate() {
+        if let Some(j) = nearest(t, b) {
+            if nearest(b[j].0, a) == Some(i) {
+                pairs.push((i, j));
+            }
+        }
+    }
+    pairs
+}
+
+/// The structure tests whose value changes sign between orbits `a` and `b`: every matched
+/// minimum or maximum whose value changes sign, or, when there is none, the impact count if
+/// it changed.
+pub(crate) fn structure_changes(a: &OrbitStructure, b: &OrbitStructure) -> Vec<StructureTest> {
+    let duration = if a.duration > 0.0 {
+        a.duration
+    } else {
+        b.duration
+    };
+    let mut tests = Vec::new();
+    for (kind, la, lb) in [
+        (ExtremumKind::Minimum, &a.minima, &b.minima),
+        (ExtremumKind::Maximum, &a.maxima, &b.maxima),
+    ] {
+        for (i, j) in matched(la, lb, duration) {
+            let (t_a, value_a) = la[i];
+            let (t_b, value_b) = lb[j];
+            if (value_a < 0.0) != (value_b < 0.0) {
+                tests.push(StructureTest::Extremum {
+                    kind,
+                    t_a,
+                    t_b,
+                    value_a,
+                    value_b,
+                    duration,
+                });
+            }
+        }
+    }
+    if tests.is_empty() && a.impacts != b.impacts {
+        tests.push(StructureTest::ImpactCount {
+            n_a: a.impacts,
+            n_b: b.impacts,
+        });
+    }
+    tests
+}
+
+impl StructureTest {
+    /// The value of this test on an orbit at fraction `sigma` of the segment from the first
+    /// orbit to the second: the extremum of the right kind nearest in time to the
+    /// interpolated time (NaN if there is none), or `impacts - (n_a + n_b)/2`.
+    pub(crate) fn value(&self, sigma: f64, structure: &OrbitStructure) -> f64 {
+        match *self {
+            StructureTest::Extremum {
+                kind,
+                t_a,
+                t_b,
+                duration,
+                ..
+            } => {
+                let t = t_a + sigma * wrapped(t_a, t_b, duration);
+                let list = match kind {
+                    ExtremumKind::Minimum => &structure.minima,
+                    ExtremumKind::Maximum => &structure.maxima,
+                };
+                list.iter()
+                    .min_by(|x, y| {
+                        wrapped(t, x.0, duration)
+                            .abs()
+                            .total_cmp(&wrapped(t, y.0, duration).abs())
+                    })
+                    .map_or(f64::NAN, |e| e.1)
+            }
+            StructureTest::ImpactCount { n_a, n_b } => {
+                structure.impacts as f64 - 0.5 * (n_a + n_b) as f64
+            }
+        }
+    }
+
+    /// The fraction of the segment where the test crosses zero by linear interpolation of
+    /// its end values (used to tell apart several events in one step).
+    pub(crate) fn linear_root(&self) -> f64 {
+        match *self {
+            StructureTest::Extremum {
+                value_a, value_b, ..
+            } => {
+                if value_a == value_b {
+                    0.5
+                } else {
+                    (value_a / (value_a - value_b)).clamp(0.0, 1.0)
+                }
+            }
+            StructureTest::ImpactCount { .. } => 0.5,
+        }
+    }
+}
