@@ -35,6 +35,13 @@ pub struct Settings {
     /// A crossing with `|dh/dt| <` this value (switching-function units per time unit) is
     /// flagged `grazing`. Allowed: `>= 0`, finite. Default `1e-6`.
     pub grazing_rate: f64,
+    /// Include the transition matrix and parameter sensitivity in the local error norm (they
+    /// are integrated in the same Runge-Kutta system either way). Default `false`: only the
+    /// state is controlled, which is cheapest and enough for smooth fields; where the Jacobian
+    /// is not smooth (Hertz contact, `J ~ sqrt(-h)` at contact onset) the sensitivities are
+    /// then only good to ~1e-6 relative at `relative_tolerance = 1e-13`, and `true` restores
+    /// their accuracy at the cost of more steps.
+    pub sensitivity_error_control: bool,
 }
 
 impl Default for Settings {
@@ -50,6 +57,7 @@ impl Default for Settings {
             event_value_tolerance: 1e-14,
             samples_per_step: 8,
             grazing_rate: 1e-6,
+            sensitivity_error_control: false,
         }
     }
 }

@@ -176,7 +176,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             transition: DMatrix::identity(n, n),
             zero_parameter: vec![0.0; n],
             field: VariationalField::new(n, sensitivity),
-            rk: Dop853::new(dim, n),
+            rk: Dop853::new(
+                dim,
+                if settings.sensitivity_error_control {
+                    dim
+                } else {
+                    n
+                },
+            ),
             proposed_step: settings.initial_step,
             first_same_as_last: false,
             kind: StepKind::None,
