@@ -98,8 +98,9 @@ impl Convergency<f64> for EigenvalueConvergence {
 /// `w_n = b_n^2 sqrt(EI / (rho A L^4))`.
 ///
 /// The arguments are not range-checked here ([`crate::Beam`] does that); the result is checked:
-/// the returned `b` has a residual `|g(b)|` at the rounding level of `g`, which bounds its error
-/// by about `16 eps (2 + mu b) / |g'(b)|`, a few ulps of `b`.
+/// after Brent's method and a secant polish, `b` is within about one ulp of the exact root
+/// (its residual `|g(b)|` is at most `16 eps (2 + mu b) (1 + b)`, the rounding level of `g`
+/// plus its slope times the spacing of doubles near `b`).
 ///
 /// # Errors
 /// [`BeamError::EigenvalueNotFound`] if the root finder fails or returns a point whose residual
@@ -116,8 +117,9 @@ pub fn eigenvalue(index: usize, tip_mass_ratio: f64) -> Result<f64, BeamError> {
     if index == 0 {
         return Err(not_found("mode indices count from 1".to_string()));
     }
-    // Rounding level of g near b: its terms are O(1) and O(mu b).
-    let residual = 16.0 * f64::EPSILON * (2.0 + tip_mass_ratio * upper);
+    // Attainable residual: g's terms and its slope are O(1 + mu b), so rounding of g gives
+    // ~ eps (2 + mu b) and the spacing of doubles near b (eps b) gives ~ eps b (2 + mu b).
+    let residual = 4.0 * f64::EPSILON * (2.0 + tip_mass_ratio * upper) * (1.0 + upper);
     let mut convergence = EigenvalueConvergence {
         residual,
         relative_step: 4.0 * f64::EPSILON,
@@ -126,15 +128,46 @@ pub fn eigenvalue(index: usize, tip_mass_ratio: f64) -> Result<f64, BeamError> {
     let g = |b: f64| characteristic_function(b, tip_mass_ratio);
     let root = find_root_brent(lower, upper, g, &mut convergence)
         .map_err(|error| not_found(format!("Brent's method: {error}")))?;
-    // The crate's Brent may stop on the bracket width and return the previous iterate: accept
-    // the point only if it is a root to rounding level (a looser factor for that case).
+    // The crate's Brent may stop on the bracket width and return the previous iterate, a few
+    // ulps off. Higher modes normalised to unit tip deflection amplify an error in b by about
+    // |phi'(1)| ~ mu b^2 (their tip barely moves), so polish to the nearest representable root.
+    let root = polish(root, lower, upper, g);
+    // Accept the point only if it is a root to rounding level.
     let check = g(root);
-    let accepted = root > lower && root < upper && check.abs() <= 64.0 * residual;
+    let accepted = root > lower && root < upper && check.abs() <= 4.0 * residual;
     if !accepted {
         return Err(not_found(format!(
             "returned b = {root} with residual {check:e} (tolerance {:e})",
-            64.0 * residual
+            4.0 * residual
         )));
     }
     Ok(root)
+}
+
+/// Refines a bracketed root `b` of `g` by up to four secant steps through `b -+ h`
+/// (`h = 64` ulps of `b`: large enough for the difference quotient to rise above the rounding
+/// noise of `g`, small enough to be exact for a function that is linear on that scale),
+/// keeping a step only while it reduces `|g|` and stays inside `[lower, upper]`.
+fn polish(root: f64, lower: f64, upper: f64, g: impl Fn(f64) -> f64) -> f64 {
+    let mut best = root;
+    let mut best_value = g(best).abs();
+    for _ in 0..4 {
+        if best_value == 0.0 {
+            break;
+        }
+        let h = 64.0 * f64::EPSILON * best.abs().max(1.0);
+        let slope = (g(best + h) - g(best - h)) / (2.0 * h);
+        let candidate = best - g(best) / slope;
+        if !(candidate > lower && candidate < upper) {
+            break;
+        }
+        let value = g(candidate).abs();
+        if value < best_value {
+            best = candidate;
+            best_value = value;
+        } else {
+            break;
+        }
+    }
+    best
 }

@@ -13,13 +13,13 @@
 //! - the generalised forces of a uniformly distributed drive (`int phi_n`, magnetic excitation)
 //!   and of a tip force (`phi_n(L) = 1`).
 //!
-//! [`modal_table`] returns all of them as ratios to mode 1. It reproduces the paper's numbers
+//! [`modal_table()`] returns all of them as ratios to mode 1. It reproduces the paper's numbers
 //! (MODEL.md section 7): `k_2/k_1 = 39.27` at `mu = 0` and `73.83` at `mu = 0.1`;
 //! `chi_2 = 3.473` at `mu = 0` and `5.256` at `mu = 0.16`; `F_2/F_1 = -0.5542` at `mu = 0` and
 //! `-1.544` at `mu = 0.16`.
 #![warn(missing_docs)]
 
-pub mod beam;
+pub mod cantilever;
 pub mod characteristic;
 pub mod error;
 pub mod inner_product;
@@ -27,7 +27,7 @@ pub mod modal_table;
 pub mod mode_shape;
 pub mod quadrature;
 
-pub use beam::{Beam, MAX_MODES, MAX_TIP_MASS_RATIO};
+pub use cantilever::{Beam, MAX_MODES, MAX_TIP_MASS_RATIO};
 pub use characteristic::{characteristic_function, eigenvalue, eigenvalue_bracket};
 pub use error::BeamError;
 pub use inner_product::{distributed_force_by_quadrature, mass_product, stiffness_product};

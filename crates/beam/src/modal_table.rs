@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use crate::beam::Beam;
+use crate::cantilever::Beam;
 use crate::error::BeamError;
 
 /// Modal properties of mode `index` relative to mode 1, for modes normalised to unit tip
@@ -30,7 +30,7 @@ pub struct ModalProperties {
 }
 
 impl Beam {
-    /// The first `modes` rows of [`ModalProperties`] for this beam (see [`modal_table`]).
+    /// The first `modes` rows of [`ModalProperties`] for this beam (see [`modal_table()`]).
     ///
     /// # Errors
     /// [`BeamError::ModeOutOfRange`] unless `1 <= modes <= MAX_MODES`;
