@@ -27,8 +27,9 @@
 //! ```
 //!
 //! For `mu = 0` this is the free cantilever's `1 + cos b cosh b = 0`; for small `b`,
-//! `f = 2 - (2 mu / 3) b^4 + O(b^4)`, so a heavy tip mass gives `b_1^4 -> 3 / mu`, the massless
-//! spring `k = 3 EI / L^3` carrying `m_tip`.
+//! `f = 2 - (1/6 + 2 mu / 3) b^4 + O(b^8)`, so a heavy tip mass gives `b_1^4 -> 3 / mu`, the
+//! massless spring `k = 3 EI / L^3` carrying `m_tip` (Rayleigh's refinement, with the static
+//! shape, is `b_1^4 <= 3 / (mu + 33/140)`).
 //!
 //! # Numerics
 //!

@@ -58,15 +58,13 @@
 //! and integrating `phi'''' = b^4 phi` once, `int_0^1 phi dxi = -mu - phi'''(0) / b^4
 //! = -mu + 2 sigma / (b U(1))`. The test suite checks each against Gauss-Legendre quadrature.
 
-use serde::Serialize;
-
 /// One mode of the cantilever with a point tip mass, normalised to unit tip deflection
 /// (`phi(1) = 1`), with its derivatives and modal integrals (module documentation).
 ///
 /// Positions are `xi = x / L` in `[0, 1]`; derivatives are with respect to `xi` (multiply the
 /// `k`-th by `L^{-k}` for derivatives in `x`). Outside `[0, 1]` the methods return the
 /// analytic continuation of the shape, which has no physical meaning.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ModeShape {
     /// 1-based mode number `n`.
     index: usize,
