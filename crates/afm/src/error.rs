@@ -61,4 +61,7 @@ pub enum AfmError {
         /// The magnitude of the transfer function `sum_i chi_i r_i H_i(w)` in nm/nN.
         gain: f64,
     },
+    /// The hybrid solver failed while computing an orbit or its observables.
+    #[error("solver failure: {0}")]
+    Solver(#[from] hybrid::HybridError),
 }

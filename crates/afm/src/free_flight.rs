@@ -81,6 +81,13 @@ impl DrivenOscillator {
     #[inline]
     pub fn steady_state(&self, t: f64) -> [f64; 2] {
         let (sin, cos) = (self.drive_angular_frequency * t).sin_cos();
+        self.steady_state_at_phase(sin, cos)
+    }
+
+    /// The steady solution `[q_p, q_p']` at a time whose drive phase has sine `sin` and cosine
+    /// `cos` (`sin(w t)`, `cos(w t)`: shared between modes driven at the same frequency).
+    #[inline]
+    pub fn steady_state_at_phase(&self, sin: f64, cos: f64) -> [f64; 2] {
         let [a, b] = self.steady;
         [
             a * cos + b * sin,
@@ -137,8 +144,23 @@ impl DrivenOscillator {
     /// transition matrix `d x(t0 + dt) / d x(t0)`.
     #[inline]
     pub fn flow(&self, t0: f64, x0: [f64; 2], dt: f64) -> ([f64; 2], [[f64; 2]; 2]) {
-        let start = self.steady_state(t0);
-        let end = self.steady_state(t0 + dt);
+        let start = (self.drive_angular_frequency * t0).sin_cos();
+        let end = (self.drive_angular_frequency * (t0 + dt)).sin_cos();
+        self.flow_between_phases(start, end, x0, dt)
+    }
+
+    /// As [`DrivenOscillator::flow`], with the drive phases `(sin, cos)` of `w t0` and
+    /// `w (t0 + dt)` supplied by the caller (computed once for all modes).
+    #[inline]
+    pub fn flow_between_phases(
+        &self,
+        start_phase: (f64, f64),
+        end_phase: (f64, f64),
+        x0: [f64; 2],
+        dt: f64,
+    ) -> ([f64; 2], [[f64; 2]; 2]) {
+        let start = self.steady_state_at_phase(start_phase.0, start_phase.1);
+        let end = self.steady_state_at_phase(end_phase.0, end_phase.1);
         let phi = self.homogeneous_transition(dt);
         let y = [x0[0] - start[0], x0[1] - start[1]];
         (

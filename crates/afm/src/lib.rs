@@ -27,6 +27,7 @@ pub mod free_flight;
 pub mod free_response;
 pub mod hertz;
 pub mod model;
+pub mod observables;
 pub mod sample;
 pub mod separation;
 pub mod trigonometric;
@@ -45,5 +46,9 @@ pub use free_flight::DrivenOscillator;
 pub use free_response::FreeResponse;
 pub use hertz::{effective_modulus_gpa, HertzContact};
 pub use model::TappingModel;
+pub use observables::{
+    observe_period, orbit_observables, GapMinimum, Harmonic, Impact, OrbitObservables,
+    PeriodObserver,
+};
 pub use sample::Sample;
 pub use separation::Separation;

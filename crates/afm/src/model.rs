@@ -381,8 +381,15 @@ impl HybridSystem for TappingModel {
         if let Some(matrix) = transition.as_deref_mut() {
             matrix.fill(0.0);
         }
+        let start_phase = (self.drive.angular_frequency * t0).sin_cos();
+        let end_phase = (self.drive.angular_frequency * (t0 + dt)).sin_cos();
         for (i, m) in self.modes.iter().enumerate() {
-            let (state, phi) = m.oscillator.flow(t0, [x0[2 * i], x0[2 * i + 1]], dt);
+            let (state, phi) = m.oscillator.flow_between_phases(
+                start_phase,
+                end_phase,
+                [x0[2 * i], x0[2 * i + 1]],
+                dt,
+            );
             x[2 * i] = state[0];
             x[2 * i + 1] = state[1];
             if let Some(matrix) = transition.as_deref_mut() {

@@ -1,0 +1,368 @@
+//! Observables of a trajectory over one drive period (MODEL.md sections 4 and 5): the first
+//! (and higher) harmonics of `u`, the impacts with their onset velocities and peak forces, every
+//! local minimum of the gap, and the force integrals.
+//!
+//! The Fourier coefficients and force integrals are integrated by 8-point Gauss-Legendre
+//! quadrature over every solver step (exact to rounding in free flight, where the solver
+//! interpolates with the exact flow; to dense-output accuracy in contact). Impacts come from the
+//! solver's events, gap minima from its extrema, so none is missed between samples.
+
+use hybrid::{
+    flow_map_observed, Direction, ExtremumKind, FlowMap, HybridSystem, Sensitivity, Settings,
+    Solver, StepOutcome,
+};
+
+use crate::model::{CONTACT, GAP_SURFACE};
+use crate::validation::invalid;
+use crate::{AfmError, TappingModel};
+
+/// Gauss-Legendre nodes on [-1, 1] (positive half) for 8 points.
+const GAUSS_NODES: [f64; 4] = [
+    0.183_434_642_495_649_8,
+    0.525_532_409_916_329,
+    0.796_666_477_413_626_7,
+    0.960_289_856_497_536_3,
+];
+/// The matching Gauss-Legendre weights.
+const GAUSS_WEIGHTS: [f64; 4] = [
+    0.362_683_783_378_362,
+    0.313_706_645_877_887_3,
+    0.222_381_034_453_374_5,
+    0.101_228_536_290_376_3,
+];
+
+/// Minima of the gap closer together than this fraction of a period are one minimum (the same
+/// extremum reported by two adjacent steps).
+const DUPLICATE_FRACTION: f64 = 1e-9;
+
+/// One impact: a maximal interval with `d < 0` (MODEL.md section 5).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Impact {
+    /// Onset time, in periods from the window start (in `[0, 1)`).
+    pub start_periods: f64,
+    /// Release time, in periods from the window start; greater than 1 for an impact that wraps
+    /// around the period boundary (in progress at the start and at the end of the window of a
+    /// periodic orbit: one impact).
+    pub end_periods: f64,
+    /// The gap's rate `d'` at onset (negative: approach speed), nm/us; NaN when the onset is not
+    /// in the window (the tip is in contact at the start and free at the end, or in contact
+    /// throughout).
+    pub velocity_nm_per_us: f64,
+    /// The largest Hertz force during the impact, nN.
+    pub peak_force_nn: f64,
+}
+
+/// A local minimum of the gap `d(t)` (MODEL.md section 5): an impact's deepest point when
+/// negative, a near impact when positive; zero at grazing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GapMinimum {
+    /// Time, in periods from the window start (in `[0, 1)`).
+    pub t_periods: f64,
+    /// The gap there, nm.
+    pub gap_nm: f64,
+}
+
+/// One harmonic `k` of the photodiode signal: `u ~ sum_k A_k cos(k w t - Phi_k)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Harmonic {
+    /// `A_k = hypot(a_k, b_k)`, nm, with `a_k = (2/T) int u cos(k w t) dt` and `b_k` with sin.
+    pub amplitude_nm: f64,
+    /// `Phi_k = atan2(b_k, a_k)`, degrees (a lag).
+    pub phase_deg: f64,
+}
+
+/// The observables of a trajectory over one drive period `[t0, t0 + T]` (MODEL.md section 4).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrbitObservables {
+    /// First-harmonic amplitude `A` of `u`, nm.
+    pub amplitude_nm: f64,
+    /// `A / A0`.
+    pub amplitude_ratio: f64,
+    /// Phase lag `Phi` of the first harmonic of `u`, degrees.
+    pub phase_deg: f64,
+    /// Harmonics `k = 1..=K` of `u` (`harmonics[0]` repeats `A`, `Phi`).
+    pub harmonics: Vec<Harmonic>,
+    /// The impacts in order of onset (a wrapped impact last); `impacts.len()` is `n`.
+    pub impacts: Vec<Impact>,
+    /// Every local minimum of the gap in the window, in time order.
+    pub gap_minima: Vec<GapMinimum>,
+    /// The largest tip-sample force, nN (0 without contact).
+    pub peak_force_nn: f64,
+    /// The mean tip-sample force `(1/T) int F_ts dt`, nN.
+    pub mean_force_nn: f64,
+    /// The time in contact (`d < 0`), in periods.
+    pub contact_time_periods: f64,
+    /// The impulse per period `int F_ts dt`, nN us.
+    pub impulse_nn_us: f64,
+}
+
+/// An observer of the solver's steps that accumulates the observables of the window
+/// `[t0, t0 + T]`: pass [`PeriodObserver::observe`] to `hybrid::flow_map_observed` (or call it
+/// after every `Solver::step` of a sweep), then call [`PeriodObserver::finish`].
+///
+/// Steps (or parts of steps) outside the window are ignored; it allocates only when it records
+/// an event or a gap minimum.
+#[derive(Debug, Clone)]
+pub struct PeriodObserver {
+    start: f64,
+    end: f64,
+    period: f64,
+    angular_frequency: f64,
+    free_amplitude: f64,
+    starts_in_contact: bool,
+    gap_at_start: f64,
+    gap_at_end: f64,
+    /// `[int u cos(k w t), int u sin(k w t)]`, k = 1..=K.
+    fourier: Vec<[f64; 2]>,
+    impulse: f64,
+    /// `(t, direction, rate)` of every contact event in the window.
+    events: Vec<(f64, Direction, f64)>,
+    minima: Vec<(f64, f64)>,
+    state: Vec<f64>,
+}
+
+impl PeriodObserver {
+    /// An observer of the period `[t0, t0 + T]` of `model` started from state `x0` at `t0`,
+    /// recording harmonics `1..=harmonic_count` of `u` (at least 1).
+    pub fn new(model: &TappingModel, t0: f64, x0: &[f64], harmonic_count: usize) -> Self {
+        let period = model.period_us();
+        Self {
+            start: t0,
+            end: t0 + period,
+            period,
+            angular_frequency: model.drive_angular_frequency(),
+            free_amplitude: model.free_amplitude_nm(),
+            starts_in_contact: model.mode_of(t0, x0) & CONTACT != 0,
+            gap_at_start: model.gap(t0, x0),
+            gap_at_end: f64::NAN,
+            fourier: vec![[0.0, 0.0]; harmonic_count.max(1)],
+            impulse: 0.0,
+            events: Vec::new(),
+            minima: Vec::new(),
+            state: vec![0.0; model.dim()],
+        }
+    }
+
+    /// Accumulate the last step of `solver` (its part inside the window): Gauss-Legendre
+    /// quadrature of `u cos(k w t)`, `u sin(k w t)` and `F_ts` on `Solver::interpolate`, the
+    /// step's gap minima and its contact event.
+    pub fn observe(&mut self, solver: &Solver<TappingModel>, outcome: &StepOutcome) {
+        let model = solver.system();
+        let (step_start, step_end) = solver.last_step();
+        let a = step_start.max(self.start);
+        let b = step_end.min(self.end);
+        if b > a {
+            let middle = 0.5 * (a + b);
+            let half = 0.5 * (b - a);
+            for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
+                for t in [middle - half * node, middle + half * node] {
+                    self.accumulate(solver, model, t, weight * half);
+                }
+            }
+        }
+        for extremum in solver.step_extrema() {
+            if extremum.surface == GAP_SURFACE
+                && extremum.kind == ExtremumKind::Minimum
+                && extremum.t >= self.start
+                && extremum.t < self.end
+            {
+                self.minima.push((extremum.t, extremum.value));
+            }
+        }
+        if let StepOutcome::Event(event) = outcome {
+            if event.surface == GAP_SURFACE && event.t >= self.start && event.t <= self.end {
+                self.events.push((event.t, event.direction, event.rate));
+            }
+        }
+        if step_end >= self.end && step_start < self.end {
+            if step_end == self.end {
+                self.gap_at_end = model.gap(step_end, solver.state());
+            } else {
+                solver.interpolate(self.end, &mut self.state);
+                self.gap_at_end = model.gap(self.end, &self.state);
+            }
+        }
+    }
+
+    fn accumulate(
+        &mut self,
+        solver: &Solver<TappingModel>,
+        model: &TappingModel,
+        t: f64,
+        weight: f64,
+    ) {
+        solver.interpolate(t, &mut self.state);
+        let u = model.photodiode(&self.state);
+        self.impulse += weight * model.hertz().force(model.gap(t, &self.state));
+        let (sin, cos) = (self.angular_frequency * t).sin_cos();
+        let (mut sin_k, mut cos_k) = (sin, cos);
+        for coefficient in self.fourier.iter_mut() {
+            coefficient[0] += weight * u * cos_k;
+            coefficient[1] += weight * u * sin_k;
+            (sin_k, cos_k) = (sin_k * cos + cos_k * sin, cos_k * cos - sin_k * sin);
+        }
+    }
+
+    /// The observables of the window (call after the solver has reached `t0 + T`).
+    pub fn finish(&self, model: &TappingModel) -> OrbitObservables {
+        let scale = 2.0 / self.period;
+        let harmonics: Vec<Harmonic> = self
+            .fourier
+            .iter()
+            .map(|&[a, b]| Harmonic {
+                amplitude_nm: scale * a.hypot(b),
+                phase_deg: b.atan2(a).to_degrees(),
+            })
+            .collect();
+        let gap_minima = self.gap_minima();
+        let impacts = self.impacts(model, &gap_minima);
+        let peak_force_nn = impacts
+            .iter()
+            .map(|impact| impact.peak_force_nn)
+            .fold(0.0, f64::max);
+        let contact_time_periods = impacts
+            .iter()
+            .map(|impact| impact.end_periods - impact.start_periods)
+            .sum();
+        OrbitObservables {
+            amplitude_nm: harmonics[0].amplitude_nm,
+            amplitude_ratio: harmonics[0].amplitude_nm / self.free_amplitude,
+            phase_deg: harmonics[0].phase_deg,
+            harmonics,
+            impacts,
+            gap_minima,
+            peak_force_nn,
+            mean_force_nn: self.impulse / self.period,
+            contact_time_periods,
+            impulse_nn_us: self.impulse,
+        }
+    }
+
+    fn periods(&self, t: f64) -> f64 {
+        (t - self.start) / self.period
+    }
+
+    fn gap_minima(&self) -> Vec<GapMinimum> {
+        let mut minima: Vec<(f64, f64)> = self.minima.clone();
+        minima.sort_by(|x, y| x.0.total_cmp(&y.0));
+        minima.dedup_by(|later, earlier| (later.0 - earlier.0) < DUPLICATE_FRACTION * self.period);
+        minima
+            .iter()
+            .map(|&(t, gap)| GapMinimum {
+                t_periods: self.periods(t),
+                gap_nm: gap,
+            })
+            .collect()
+    }
+
+    /// Impacts from the events; an impact in progress at both ends of the window is one impact
+    /// (the window of a periodic orbit), reported last with `end_periods > 1`.
+    fn impacts(&self, model: &TappingModel, minima: &[GapMinimum]) -> Vec<Impact> {
+        // (start, end, velocity) in periods; a start of 0 with NaN velocity is a head fragment.
+        let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
+        let mut open: Option<(f64, f64)> = self.starts_in_contact.then_some((0.0, f64::NAN));
+        for &(t, direction, rate) in &self.events {
+            match direction {
+                Direction::Down => open = Some((self.periods(t), rate)),
+                Direction::Up => {
+                    if let Some((start, velocity)) = open.take() {
+                        intervals.push((start, self.periods(t), velocity));
+                    }
+                }
+            }
+        }
+        let tail = open;
+        let head_fragment = self.starts_in_contact && !intervals.is_empty();
+        let hertz = model.hertz();
+        let peak_in = |from: f64, to: f64| {
+            minima
+                .iter()
+                .filter(|minimum| minimum.t_periods >= from && minimum.t_periods <= to)
+                .map(|minimum| hertz.force(minimum.gap_nm))
+                .fold(0.0, f64::max)
+        };
+        let boundary_start = hertz.force(self.gap_at_start);
+        let boundary_end = hertz.force(self.gap_at_end);
+        let mut impacts = Vec::with_capacity(intervals.len() + 1);
+        let mut head: Option<(f64, f64)> = None; // (end, peak) of the head fragment
+        for (index, &(start, end, velocity)) in intervals.iter().enumerate() {
+            let mut peak = peak_in(start, end);
+            if index == 0 && head_fragment {
+                peak = peak.max(boundary_start);
+                if tail.is_some() {
+                    head = Some((end, peak));
+                    continue;
+                }
+            }
+            impacts.push(Impact {
+                start_periods: start,
+                end_periods: end,
+                velocity_nm_per_us: velocity,
+                peak_force_nn: peak,
+            });
+        }
+        if let Some((start, velocity)) = tail {
+            let mut peak = peak_in(start, 1.0).max(boundary_end);
+            let mut end = 1.0;
+            if let Some((head_end, head_peak)) = head {
+                end = 1.0 + head_end;
+                peak = peak.max(head_peak);
+            } else if self.starts_in_contact && intervals.is_empty() {
+                // In contact throughout the window.
+                peak = peak.max(boundary_start);
+            }
+            impacts.push(Impact {
+                start_periods: start,
+                end_periods: end,
+                velocity_nm_per_us: velocity,
+                peak_force_nn: peak,
+            });
+        }
+        impacts
+    }
+}
+
+/// Integrate `model` over one period from `(t0, x0)` and return the flow map (state, monodromy
+/// and `dx/dZ` as `sensitivity` asks, events, extrema) with the period's observables, harmonics
+/// `1..=harmonic_count` of `u` included.
+pub fn observe_period(
+    model: &TappingModel,
+    t0: f64,
+    x0: &[f64],
+    sensitivity: Sensitivity,
+    settings: &Settings,
+    harmonic_count: usize,
+) -> Result<(FlowMap, OrbitObservables), AfmError> {
+    if x0.len() != model.dim() {
+        return Err(invalid(
+            "orbit observables",
+            "x0.len()",
+            x0.len() as f64,
+            format!("the model's dimension 2N = {}", model.dim()),
+        ));
+    }
+    let mut observer = PeriodObserver::new(model, t0, x0, harmonic_count);
+    let flow = flow_map_observed(
+        model,
+        t0,
+        x0,
+        model.period_us(),
+        sensitivity,
+        settings,
+        &mut |solver: &Solver<TappingModel>, outcome: &StepOutcome| {
+            observer.observe(solver, outcome)
+        },
+    )?;
+    let observables = observer.finish(model);
+    Ok((flow, observables))
+}
+
+/// The observables of one period of `model` from state `x0` at `t = 0` (MODEL.md section 4).
+pub fn orbit_observables(
+    model: &TappingModel,
+    x0: &[f64],
+    settings: &Settings,
+) -> Result<OrbitObservables, AfmError> {
+    observe_period(model, 0.0, x0, Sensitivity::None, settings, 1)
+        .map(|(_, observables)| observables)
+}
