@@ -519,6 +519,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         .min(max_step);
         let mut rejected = false;
         let mut non_finite = false;
+        let mut landing_tried = false;
+        let mut previous: Option<(f64, f64)> = None;
         let (hs, lands, error) = loop {
             let attempts = self.statistics.steps + self.statistics.rejected_steps;
             if attempts >= self.settings.max_steps {
@@ -548,13 +550,52 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
             self.statistics.rejected_steps += 1;
             rejected = true;
-            if error.is_finite() {
-                non_finite = false;
-                h = Dop853::next_step(hs, error, false);
-            } else {
+            if !error.is_finite() {
                 non_finite = true;
                 h = 0.1 * hs;
+                previous = None;
+                continue;
             }
+            non_finite = false;
+            // A trial that ends across a switching surface was probably rejected for the kink
+            // of the field there: retry once landing just past the estimated crossing, so the
+            // step holds the crossing with a negligible non-smooth part (instead of a geometric
+            // sequence of steps shrinking towards the surface).
+            if !landing_tried {
+                if let Some(theta) = crossing_fraction(
+                    system,
+                    mode,
+                    self.surfaces,
+                    self.n,
+                    t0,
+                    &self.z,
+                    t0 + hs,
+                    &self.z_new,
+                ) {
+                    landing_tried = true;
+                    let landing = hs * (theta + LANDING_OVERSHOOT).min(1.0);
+                    if landing < hs {
+                        h = landing;
+                        previous = None;
+                        continue;
+                    }
+                }
+            }
+            // Successive rejections: estimate the error's actual order in h from the last two
+            // attempts (near a singularity of the field it is far below 8) and aim for an
+            // error of 0.5 with it.
+            h = match previous {
+                Some((h_prev, e_prev)) if h_prev > hs && e_prev > error => {
+                    let order = (e_prev / error).ln() / (h_prev / hs).ln();
+                    if (0.5..=9.0).contains(&order) {
+                        hs * (0.5 / error).powf(1.0 / order).clamp(0.01, 0.9)
+                    } else {
+                        Dop853::next_step(hs, error, false)
+                    }
+                }
+                _ => Dop853::next_step(hs, error, false),
+            };
+            previous = Some((hs, error));
         };
         let mut next = Dop853::next_step(hs, error, rejected).min(max_step);
         if lands && !rejected {
@@ -828,6 +869,54 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 .copy_from_slice(&self.z[n..n + n * n]);
         }
     }
+}
+
+/// Fraction of a step past the estimated crossing at which a retried step lands.
+const LANDING_OVERSHOOT: f64 = 1e-6;
+
+/// If the trial step from `(t0, z0)` to `(t1, z1)` ends across a switching surface (on the
+/// other side of the one the mode says), the fraction `theta` of the step at which the cubic
+/// Hermite interpolant of `h_k` (values and rates at both ends) first crosses zero.
+#[allow(clippy::too_many_arguments)]
+fn crossing_fraction<S: HybridSystem + ?Sized>(
+    system: &S,
+    mode: Mode,
+    surfaces: usize,
+    n: usize,
+    t0: f64,
+    z0: &[f64],
+    t1: f64,
+    z1: &[f64],
+) -> Option<f64> {
+    let dt = t1 - t0;
+    let mut earliest: Option<f64> = None;
+    for k in 0..surfaces {
+        let sigma = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
+        let g1 = sigma * system.switching(k, t1, &z1[..n]);
+        if g1.is_nan() || g1 >= 0.0 {
+            continue;
+        }
+        let g0 = (sigma * system.switching(k, t0, &z0[..n])).abs();
+        let r0 = sigma * system.switching_rate(k, mode, t0, &z0[..n]) * dt;
+        let r1 = sigma * system.switching_rate(k, mode, t1, &z1[..n]) * dt;
+        if !(g0.is_finite() && r0.is_finite() && r1.is_finite()) {
+            continue;
+        }
+        let mut hermite = |s: f64| {
+            let s2 = s * s;
+            let s3 = s2 * s;
+            g0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+                + r0 * (s3 - 2.0 * s2 + s)
+                + g1 * (-2.0 * s3 + 3.0 * s2)
+                + r1 * (s3 - s2)
+        };
+        let bracket = locate_sign_change(0.0, g0, 1.0, g1, &mut hermite, 1e-9, 0.0);
+        let theta = bracket.far;
+        if earliest.is_none_or(|e| theta < e) {
+            earliest = Some(theta);
+        }
+    }
+    earliest
 }
 
 /// The state at `t` in the current (not yet accepted) step: dense output or exact flow.

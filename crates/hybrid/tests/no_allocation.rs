@@ -1,0 +1,82 @@
+//! `Solver::step` allocates nothing on the heap except `Event::state`: counted with a global
+//! allocator wrapper over a run with many steps and events (RK and exact flow, with and
+//! without sensitivities).
+
+mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use common::{HertzOscillator, ImpactOscillator, Rotation};
+use hybrid::{HybridSystem, Sensitivity, Settings, Solver, StepOutcome};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations during the steps of a run, minus one per event (its `state` vector).
+fn allocations_beyond_events<S: HybridSystem>(system: &S, x0: &[f64], s: Sensitivity) -> usize {
+    let mut solver = Solver::new(system, 0.0, x0, s, Settings::default()).expect("valid");
+    let mut events = 0;
+    let mut steps = 0;
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    loop {
+        match solver.step(30.0).expect("integration succeeds") {
+            StepOutcome::Event(_) => events += 1,
+            StepOutcome::Internal => {}
+            StepOutcome::EndTime => break,
+        }
+        steps += 1;
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert!(
+        events > 3 && steps > 50,
+        "a run with events: {events}, {steps}"
+    );
+    after - before - events
+}
+
+// One test function only: the counter is global and tests in one binary run in parallel.
+#[test]
+fn steps_do_not_allocate() {
+    for s in [
+        Sensitivity::None,
+        Sensitivity::Transition,
+        Sensitivity::TransitionAndParameter,
+    ] {
+        assert_eq!(
+            allocations_beyond_events(&HertzOscillator::reference(), &[0.0, 0.0], s),
+            0
+        );
+        assert_eq!(
+            allocations_beyond_events(&ImpactOscillator::reference(), &[0.0, 0.0], s),
+            0
+        );
+        let rotation = Rotation {
+            c: 0.3,
+            t_c: 0.0,
+            exact_flow_limit: Some(0.5),
+        };
+        assert_eq!(
+            allocations_beyond_events(&rotation, &rotation.initial_state(), s),
+            0
+        );
+    }
+}
