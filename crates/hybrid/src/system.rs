@@ -10,7 +10,10 @@
 //! * flips the mode bit and carries on with the same state (a *crossing*; this is how a
 //!   continuous contact force such as Hertz contact is expressed), or
 //! * applies the system's *reset map* `x+ = R(t, x-)` (a hard impact with restitution) and
-//!   chooses the new mode from the sign of `dh/dt` after the reset.
+//!   chooses the new mode from the sign of `dh/dt` after the reset: a reset that sends the
+//!   state back (a bounce) is applied at the bracket end on the old side, so the mode bit is
+//!   unchanged; otherwise the bit flips. Precisely, the new bit is the side of `h` at the
+//!   post-reset state (on the surface: the side `dh/dt` points to); see [`crate::solver`].
 //!
 //! A mode may also provide an *exact flow*: when the dynamics in that region are linear with
 //! harmonic forcing (the free flight of a cantilever), the solver propagates the state and its
