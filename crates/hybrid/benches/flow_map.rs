@@ -11,6 +11,9 @@ use std::time::Instant;
 use common::{ForcedOscillator, HertzOscillator};
 use hybrid::{flow_map, HybridSystem, Sensitivity, Settings};
 
+/// A benchmark case: runs with the given sensitivity, returns (median us, statistics).
+type Case<'a> = &'a dyn Fn(Sensitivity) -> (f64, hybrid::Statistics);
+
 fn median_micros<S: HybridSystem>(
     system: &S,
     x0: &[f64],
@@ -46,7 +49,7 @@ fn main() {
     };
     let hertz = HertzOscillator::reference();
     let hertz_period = 2.0 * std::f64::consts::PI / hertz.drive;
-    let cases: [(&str, &dyn Fn(Sensitivity) -> (f64, hybrid::Statistics)); 3] = [
+    let cases: [(&str, Case); 3] = [
         ("linear oscillator, DOP853, 1 period", &|s| {
             median_micros(&oscillator, &[0.4, -0.3], period, s, &settings)
         }),

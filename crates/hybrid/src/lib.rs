@@ -8,7 +8,7 @@
 //!
 //! * [`Solver::step`] is the primitive: one DOP853 step (Hairer's Dormand-Prince 8(5,3) with
 //!   7th-order dense output) or one exact-flow step, truncated at the earliest event.
-//! * [`flow_map`] integrates over an interval on top of it.
+//! * [`flow_map()`] integrates over an interval on top of it.
 //!
 //! The rules that make events unique and the exact-grazing convention are documented in
 //! [`solver`].
