@@ -64,4 +64,7 @@ pub enum AfmError {
     /// The hybrid solver failed while computing an orbit or its observables.
     #[error("solver failure: {0}")]
     Solver(#[from] hybrid::HybridError),
+    /// Shooting or continuation of a periodic orbit failed.
+    #[error("periodic orbit: {0}")]
+    Continuation(#[from] continuation::ContinuationError),
 }

@@ -26,10 +26,12 @@ pub mod fixtures;
 pub mod free_flight;
 pub mod free_response;
 pub mod hertz;
+pub mod impact_numbers;
 pub mod model;
 pub mod observables;
 pub mod sample;
 pub mod separation;
+pub mod steady_orbit;
 pub mod trigonometric;
 mod validation;
 
@@ -45,6 +47,7 @@ pub use fixtures::{
 pub use free_flight::DrivenOscillator;
 pub use free_response::FreeResponse;
 pub use hertz::{effective_modulus_gpa, HertzContact};
+pub use impact_numbers::MultipleImpactNumbers;
 pub use model::TappingModel;
 pub use observables::{
     observe_period, orbit_observables, GapMinimum, Harmonic, Impact, OrbitObservables,
@@ -52,3 +55,4 @@ pub use observables::{
 };
 pub use sample::Sample;
 pub use separation::Separation;
+pub use steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};

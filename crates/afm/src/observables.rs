@@ -12,6 +12,8 @@ use hybrid::{
     Solver, StepOutcome,
 };
 
+use serde::Serialize;
+
 use crate::model::{CONTACT, GAP_SURFACE};
 use crate::validation::invalid;
 use crate::{AfmError, TappingModel};
@@ -36,7 +38,7 @@ const GAUSS_WEIGHTS: [f64; 4] = [
 const DUPLICATE_FRACTION: f64 = 1e-9;
 
 /// One impact: a maximal interval with `d < 0` (MODEL.md section 5).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Impact {
     /// Onset time, in periods from the window start (in `[0, 1)`).
     pub start_periods: f64,
@@ -54,7 +56,7 @@ pub struct Impact {
 
 /// A local minimum of the gap `d(t)` (MODEL.md section 5): an impact's deepest point when
 /// negative, a near impact when positive; zero at grazing.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GapMinimum {
     /// Time, in periods from the window start (in `[0, 1)`).
     pub t_periods: f64,
@@ -63,7 +65,7 @@ pub struct GapMinimum {
 }
 
 /// One harmonic `k` of the photodiode signal: `u ~ sum_k A_k cos(k w t - Phi_k)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Harmonic {
     /// `A_k = hypot(a_k, b_k)`, nm, with `a_k = (2/T) int u cos(k w t) dt` and `b_k` with sin.
     pub amplitude_nm: f64,
@@ -72,7 +74,7 @@ pub struct Harmonic {
 }
 
 /// The observables of a trajectory over one drive period `[t0, t0 + T]` (MODEL.md section 4).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OrbitObservables {
     /// First-harmonic amplitude `A` of `u`, nm.
     pub amplitude_nm: f64,

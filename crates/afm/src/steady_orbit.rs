@@ -1,0 +1,285 @@
+//! The steady periodic orbit of the tapping cantilever at a fixed separation `Z`: transient
+//! periods from a sensible start, then Newton (shooting) on the stroboscopic map
+//! `x -> x(T)` with the exact monodromy matrix from the hybrid solver, and the orbit's
+//! observables (MODEL.md sections 4 and 5).
+//!
+//! An orbit that is not period-1 (period doubling, a period-k window) is found by iterating the
+//! map until a state recurs after `k` periods, then shooting on the `k`-th iterate; an orbit that
+//! settles on none within the budget is reported as not converged, never dressed up as one.
+
+use continuation::{
+    floquet_multipliers, is_stable, shoot, HybridPeriodicProblem, NewtonSettings, Parametrised,
+};
+use hybrid::{flow_map, Sensitivity, Settings};
+use nalgebra::Complex;
+use serde::Serialize;
+
+use crate::error::AfmError;
+use crate::model::TappingModel;
+use crate::observables::{observe_period, OrbitObservables};
+use crate::separation::Separation;
+
+/// `TappingModel` as a parametrised periodic system for shooting and continuation: the
+/// parameter is the separation `Z` (nm), the period is the drive period `T` (us), and the
+/// contact surface is the gap `d = Z + sum_i q_i` (surface 0).
+impl Parametrised for TappingModel {
+    fn parameter(&self) -> f64 {
+        self.separation().at(0.0)
+    }
+
+    fn set_parameter(&mut self, p: f64) {
+        // A finite p always gives a valid constant separation; a non-finite one is rejected by
+        // the solver's non-finite state check on the first step.
+        let _ = self.set_separation(Separation::Constant(p));
+    }
+
+    fn period(&self) -> f64 {
+        self.period_us()
+    }
+}
+
+/// How the steady orbit is searched for. Every field is checked by
+/// [`SteadyOrbitSettings::validate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SteadyOrbitSettings {
+    /// Settings of the hybrid solver (tolerances 1e-12 by default, so that the period map is
+    /// accurate well below the Newton tolerance).
+    pub integration: Settings,
+    /// Newton on the stroboscopic map; the tolerance is on the state residual
+    /// `|P(x) - x|` in nm and nm/us (default 1e-10, the brief's target).
+    pub newton: NewtonSettings,
+    /// Periods integrated from a cold start before Newton (default 20; the slowest free decay,
+    /// `exp(-w_1 t / (2 Q_1))`, loses a factor `exp(-pi / Q_1)` per period, about 1e-36 over 20
+    /// periods for the paper's cantilevers). Range 0..=100000.
+    pub transient_periods: usize,
+    /// Periods iterated to find a recurrence when the period-1 orbit is not the attractor
+    /// (default 400). Range 1..=1000000.
+    pub recurrence_periods: usize,
+    /// The largest multiplicity `k` (orbit period `k T`) searched for (default 8). Range 1..=64.
+    pub max_multiplicity: usize,
+}
+
+impl Default for SteadyOrbitSettings {
+    fn default() -> Self {
+        Self {
+            integration: Settings::default(),
+            newton: NewtonSettings::default(),
+            transient_periods: 20,
+            recurrence_periods: 400,
+            max_multiplicity: 8,
+        }
+    }
+}
+
+impl SteadyOrbitSettings {
+    /// Check every field against its documented range.
+    pub fn validate(&self) -> Result<(), AfmError> {
+        self.integration.validate()?;
+        self.newton.validate()?;
+        let checks = [
+            ("transient_periods", self.transient_periods, 0, 100_000),
+            ("recurrence_periods", self.recurrence_periods, 1, 1_000_000),
+            ("max_multiplicity", self.max_multiplicity, 1, 64),
+        ];
+        for (field, value, low, high) in checks {
+            if !(low..=high).contains(&value) {
+                return Err(AfmError::InvalidField {
+                    file: String::from("steady-orbit settings"),
+                    field: field.to_string(),
+                    value: value.to_string(),
+                    allowed: format!("an integer in {low}..={high}"),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A steady periodic orbit at one separation, with how it was found and what it looks like.
+#[derive(Debug, Clone, Serialize)]
+pub struct SteadyOrbit {
+    /// The separation `Z`, nm.
+    pub z_nm: f64,
+    /// The orbit's period in drive periods (`k` for an orbit of period `k T`).
+    pub multiplicity: usize,
+    /// Whether Newton reached the tolerance on the `k`-th iterate of the stroboscopic map.
+    pub converged: bool,
+    /// Newton iterations of the last (successful or final) shooting.
+    pub iterations: usize,
+    /// The final residual `|P^k(x) - x|`, nm and nm/us mixed (the state's units).
+    pub residual: f64,
+    /// The state at `t = 0` (drive phase zero): `[q_1, q_1', ..., q_N, q_N']`, nm and nm/us.
+    pub state: Vec<f64>,
+    /// Floquet multipliers: eigenvalues of the monodromy matrix of `P^k`.
+    #[serde(serialize_with = "serialize_multipliers")]
+    pub multipliers: Vec<Complex<f64>>,
+    /// Whether every multiplier lies inside the unit circle (the orbit attracts).
+    pub stable: bool,
+    /// The observables of each of the `k` drive periods of the orbit, in order.
+    pub periods: Vec<OrbitObservables>,
+}
+
+impl SteadyOrbit {
+    /// The observables of the orbit's first drive period.
+    pub fn observables(&self) -> &OrbitObservables {
+        &self.periods[0]
+    }
+
+    /// The lock-in reading over the whole orbit (`k` periods): the first-harmonic Fourier
+    /// coefficients `a`, `b` of `u` averaged over the periods, returned as
+    /// `(A / A0, Phi in degrees)` (MODEL.md section 4).
+    pub fn lockin(&self, free_amplitude_nm: f64) -> (f64, f64) {
+        let (mut a, mut b) = (0.0, 0.0);
+        for period in &self.periods {
+            let phase = period.phase_deg.to_radians();
+            a += period.amplitude_nm * phase.cos();
+            b += period.amplitude_nm * phase.sin();
+        }
+        let k = self.periods.len() as f64;
+        (
+            (a / k).hypot(b / k) / free_amplitude_nm,
+            (b / k).atan2(a / k).to_degrees(),
+        )
+    }
+
+    /// Impacts per drive period: the total over the orbit's `k` periods divided by `k`.
+    pub fn impacts_per_period(&self) -> f64 {
+        let total: usize = self.periods.iter().map(|p| p.impacts.len()).sum();
+        total as f64 / self.periods.len() as f64
+    }
+}
+
+fn serialize_multipliers<S: serde::Serializer>(
+    multipliers: &[Complex<f64>],
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeSeq;
+    let mut seq = serializer.serialize_seq(Some(multipliers.len()))?;
+    for m in multipliers {
+        seq.serialize_element(&[m.re, m.im])?;
+    }
+    seq.end()
+}
+
+/// The steady orbit of `model` at separation `z_nm`.
+///
+/// With `start = Some(x)` (the orbit at a neighbouring `Z`), Newton starts from `x` directly;
+/// with `None` (a cold start), from the free steady state after `transient_periods` periods.
+/// If Newton does not converge, or converges to an orbit that repels (so that it is not what a
+/// cantilever would settle on), the map is iterated until a state recurs after `k <=
+/// max_multiplicity` periods and Newton is applied to the `k`-th iterate.
+pub fn steady_orbit(
+    model: &TappingModel,
+    z_nm: f64,
+    start: Option<&[f64]>,
+    settings: &SteadyOrbitSettings,
+) -> Result<SteadyOrbit, AfmError> {
+    settings.validate()?;
+    if !z_nm.is_finite() {
+        return Err(AfmError::InvalidField {
+            file: String::from("steady orbit"),
+            field: String::from("z_nm"),
+            value: z_nm.to_string(),
+            allowed: String::from("a finite separation in nm"),
+        });
+    }
+    let mut model = model.clone();
+    model.set_separation(Separation::Constant(z_nm))?;
+    let period = model.period_us();
+
+    let initial = match start {
+        Some(x) => x.to_vec(),
+        None => iterate(&model, &model.free_state(), settings.transient_periods, &settings.integration)?,
+    };
+
+    let period_one = HybridPeriodicProblem::new(model.clone(), 1, settings.integration.clone())?;
+    let first = shoot(&period_one, &initial, z_nm, &settings.newton)?;
+    let first_multipliers = floquet_multipliers(&first.period_map.monodromy);
+    if first.converged && is_stable(&first_multipliers) {
+        return finish(&model, 1, first.state.as_slice(), first.iterations, first.residual, first_multipliers, settings);
+    }
+
+    // Period-1 Newton failed or found a repelling orbit: look for the attractor by iteration.
+    let mut states = Vec::with_capacity(settings.recurrence_periods + 1);
+    let mut x = iterate(&model, &initial, settings.transient_periods, &settings.integration)?;
+    states.push(x.clone());
+    let scale = model.free_amplitude_nm();
+    let mut best: Option<(usize, Vec<f64>, usize, f64, Vec<Complex<f64>>)> = None;
+    for _ in 0..settings.recurrence_periods {
+        x = flow_map(&model, 0.0, &x, period, Sensitivity::None, &settings.integration)?.state;
+        states.push(x.clone());
+        let last = states.len() - 1;
+        for k in 1..=settings.max_multiplicity.min(last) {
+            let distance = distance(&states[last], &states[last - k]);
+            if distance > 1e-4 * scale {
+                continue;
+            }
+            let problem = HybridPeriodicProblem::new(model.clone(), k, settings.integration.clone())?;
+            let shot = shoot(&problem, &states[last], z_nm, &settings.newton)?;
+            let multipliers = floquet_multipliers(&shot.period_map.monodromy);
+            if shot.converged {
+                return finish(&model, k, shot.state.as_slice(), shot.iterations, shot.residual, multipliers, settings);
+            }
+            if best.as_ref().is_none_or(|b| shot.residual < b.3) {
+                best = Some((k, shot.state.as_slice().to_vec(), shot.iterations, shot.residual, multipliers));
+            }
+        }
+    }
+    // No recurrence converged: report honestly, with the best attempt (or the period-1 one).
+    let (k, state, iterations, residual, multipliers) = match best {
+        Some(best) if best.3 < first.residual => best,
+        _ => (1, first.state.as_slice().to_vec(), first.iterations, first.residual, first_multipliers),
+    };
+    let mut orbit = finish(&model, k, &state, iterations, residual, multipliers, settings)?;
+    orbit.converged = false;
+    Ok(orbit)
+}
+
+/// Iterate the stroboscopic map `periods` times from `x0` (state only).
+fn iterate(
+    model: &TappingModel,
+    x0: &[f64],
+    periods: usize,
+    settings: &Settings,
+) -> Result<Vec<f64>, AfmError> {
+    let mut x = x0.to_vec();
+    for _ in 0..periods {
+        x = flow_map(model, 0.0, &x, model.period_us(), Sensitivity::None, settings)?.state;
+    }
+    Ok(x)
+}
+
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt()
+}
+
+/// Assemble the orbit: the observables of each of its `k` periods from the converged state.
+fn finish(
+    model: &TappingModel,
+    multiplicity: usize,
+    state: &[f64],
+    iterations: usize,
+    residual: f64,
+    multipliers: Vec<Complex<f64>>,
+    settings: &SteadyOrbitSettings,
+) -> Result<SteadyOrbit, AfmError> {
+    let mut periods = Vec::with_capacity(multiplicity);
+    let mut x = state.to_vec();
+    for _ in 0..multiplicity {
+        let (flow, observables) =
+            observe_period(model, 0.0, &x, Sensitivity::None, &settings.integration, 1)?;
+        periods.push(observables);
+        x = flow.state;
+    }
+    Ok(SteadyOrbit {
+        z_nm: model.parameter(),
+        multiplicity,
+        converged: residual <= settings.newton.tolerance,
+        iterations,
+        residual,
+        state: state.to_vec(),
+        stable: is_stable(&multipliers),
+        multipliers,
+        periods,
+    })
+}
