@@ -210,6 +210,49 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         })
     }
 
+    /// Restart from `(t0, x0)` reusing every buffer (no allocation): the mode from
+    /// [`HybridSystem::mode_of`], identity transition, zero parameter sensitivity, zeroed
+    /// statistics and the configured initial step, so the run is identical to one from a new
+    /// solver. Useful for repeated flow maps (Newton iterations on a periodic orbit).
+    ///
+    /// # Errors
+    /// [`HybridError::DimensionMismatch`], [`HybridError::NonFiniteState`].
+    pub fn restart(&mut self, t0: f64, x0: &[f64]) -> Result<(), HybridError> {
+        let n = self.n;
+        if x0.len() != n {
+            return Err(HybridError::DimensionMismatch {
+                expected: n,
+                found: x0.len(),
+            });
+        }
+        if !t0.is_finite() || x0.iter().any(|v| !v.is_finite()) {
+            return Err(HybridError::NonFiniteState { t: t0 });
+        }
+        self.z.fill(0.0);
+        self.z[..n].copy_from_slice(x0);
+        if self.sensitivity.transition() {
+            for i in 0..n {
+                self.z[n + i * n + i] = 1.0;
+            }
+        }
+        self.z_start.copy_from_slice(&self.z);
+        self.z_new.copy_from_slice(&self.z);
+        self.t = t0;
+        self.mode = self.system.mode_of(t0, x0);
+        self.transition.fill_with_identity();
+        self.proposed_step = self.settings.initial_step;
+        self.first_same_as_last = false;
+        self.kind = StepKind::None;
+        self.step_start = t0;
+        self.step_end = t0;
+        self.full_dense = false;
+        self.samples.start_valid = false;
+        self.extrema.clear();
+        self.field.evaluations = 0;
+        self.statistics = Statistics::default();
+        Ok(())
+    }
+
     /// Current time (system time units).
     pub fn t(&self) -> f64 {
         self.t

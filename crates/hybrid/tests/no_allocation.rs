@@ -31,9 +31,24 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// Allocations during the steps of a run, minus one per event (its `state` vector).
+/// Allocations during the steps of a run, minus one per event (its `state` vector). The run
+/// is made twice, the second time after `Solver::restart` (which must not allocate either),
+/// and both runs must give the same final state and statistics.
 fn allocations_beyond_events<S: HybridSystem>(system: &S, x0: &[f64], s: Sensitivity) -> usize {
     let mut solver = Solver::new(system, 0.0, x0, s, Settings::default()).expect("valid");
+    let first = run_counting(&mut solver);
+    let final_state = solver.state().to_vec();
+    let statistics = *solver.statistics();
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    solver.restart(0.0, x0).expect("valid");
+    let restart = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    let second = run_counting(&mut solver);
+    assert_eq!(solver.state(), &final_state[..]);
+    assert_eq!(*solver.statistics(), statistics);
+    first + restart + second
+}
+
+fn run_counting<S: HybridSystem>(solver: &mut Solver<S>) -> usize {
     let mut events = 0;
     let mut steps = 0;
     let before = ALLOCATIONS.load(Ordering::SeqCst);
