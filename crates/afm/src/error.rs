@@ -64,6 +64,14 @@ pub enum AfmError {
     /// The hybrid solver failed while computing an orbit or its observables.
     #[error("solver failure: {0}")]
     Solver(#[from] hybrid::HybridError),
+    /// A search along a branch ended without reaching its target.
+    #[error("{what} not reached: {reason}")]
+    NotReached {
+        /// What was searched for, e.g. `A/A0 = 0.5`.
+        what: String,
+        /// Why the search stopped.
+        reason: String,
+    },
     /// Shooting or continuation of a periodic orbit failed.
     #[error("periodic orbit: {0}")]
     Continuation(#[from] continuation::ContinuationError),

@@ -17,6 +17,7 @@
 //! phase (`cos(w t) = 1`).
 #![warn(missing_docs)]
 
+pub mod amplitude_ratio;
 pub mod cantilever;
 pub mod case;
 pub mod drive;
@@ -32,9 +33,11 @@ pub mod observables;
 pub mod sample;
 pub mod separation;
 pub mod steady_orbit;
+pub mod trajectory;
 pub mod trigonometric;
 mod validation;
 
+pub use amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
 pub use cantilever::Cantilever;
 pub use case::{Case, CaseFile};
 pub use drive::Drive;
@@ -56,3 +59,4 @@ pub use observables::{
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};
+pub use trajectory::{sample_trajectory, TrajectorySample};

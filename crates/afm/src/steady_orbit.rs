@@ -189,24 +189,50 @@ pub fn steady_orbit(
 
     let initial = match start {
         Some(x) => x.to_vec(),
-        None => iterate(&model, &model.free_state(), settings.transient_periods, &settings.integration)?,
+        None => iterate(
+            &model,
+            &model.free_state(),
+            settings.transient_periods,
+            &settings.integration,
+        )?,
     };
 
     let period_one = HybridPeriodicProblem::new(model.clone(), 1, settings.integration.clone())?;
     let first = shoot(&period_one, &initial, z_nm, &settings.newton)?;
     let first_multipliers = floquet_multipliers(&first.period_map.monodromy);
     if first.converged && is_stable(&first_multipliers) {
-        return finish(&model, 1, first.state.as_slice(), first.iterations, first.residual, first_multipliers, settings);
+        return finish(
+            &model,
+            1,
+            first.state.as_slice(),
+            first.iterations,
+            first.residual,
+            first_multipliers,
+            settings,
+        );
     }
 
     // Period-1 Newton failed or found a repelling orbit: look for the attractor by iteration.
     let mut states = Vec::with_capacity(settings.recurrence_periods + 1);
-    let mut x = iterate(&model, &initial, settings.transient_periods, &settings.integration)?;
+    let mut x = iterate(
+        &model,
+        &initial,
+        settings.transient_periods,
+        &settings.integration,
+    )?;
     states.push(x.clone());
     let scale = model.free_amplitude_nm();
     let mut best: Option<(usize, Vec<f64>, usize, f64, Vec<Complex<f64>>)> = None;
     for _ in 0..settings.recurrence_periods {
-        x = flow_map(&model, 0.0, &x, period, Sensitivity::None, &settings.integration)?.state;
+        x = flow_map(
+            &model,
+            0.0,
+            &x,
+            period,
+            Sensitivity::None,
+            &settings.integration,
+        )?
+        .state;
         states.push(x.clone());
         let last = states.len() - 1;
         for k in 1..=settings.max_multiplicity.min(last) {
@@ -214,23 +240,52 @@ pub fn steady_orbit(
             if distance > 1e-4 * scale {
                 continue;
             }
-            let problem = HybridPeriodicProblem::new(model.clone(), k, settings.integration.clone())?;
+            let problem =
+                HybridPeriodicProblem::new(model.clone(), k, settings.integration.clone())?;
             let shot = shoot(&problem, &states[last], z_nm, &settings.newton)?;
             let multipliers = floquet_multipliers(&shot.period_map.monodromy);
             if shot.converged {
-                return finish(&model, k, shot.state.as_slice(), shot.iterations, shot.residual, multipliers, settings);
+                return finish(
+                    &model,
+                    k,
+                    shot.state.as_slice(),
+                    shot.iterations,
+                    shot.residual,
+                    multipliers,
+                    settings,
+                );
             }
             if best.as_ref().is_none_or(|b| shot.residual < b.3) {
-                best = Some((k, shot.state.as_slice().to_vec(), shot.iterations, shot.residual, multipliers));
+                best = Some((
+                    k,
+                    shot.state.as_slice().to_vec(),
+                    shot.iterations,
+                    shot.residual,
+                    multipliers,
+                ));
             }
         }
     }
     // No recurrence converged: report honestly, with the best attempt (or the period-1 one).
     let (k, state, iterations, residual, multipliers) = match best {
         Some(best) if best.3 < first.residual => best,
-        _ => (1, first.state.as_slice().to_vec(), first.iterations, first.residual, first_multipliers),
+        _ => (
+            1,
+            first.state.as_slice().to_vec(),
+            first.iterations,
+            first.residual,
+            first_multipliers,
+        ),
     };
-    let mut orbit = finish(&model, k, &state, iterations, residual, multipliers, settings)?;
+    let mut orbit = finish(
+        &model,
+        k,
+        &state,
+        iterations,
+        residual,
+        multipliers,
+        settings,
+    )?;
     orbit.converged = false;
     Ok(orbit)
 }
@@ -244,13 +299,25 @@ fn iterate(
 ) -> Result<Vec<f64>, AfmError> {
     let mut x = x0.to_vec();
     for _ in 0..periods {
-        x = flow_map(model, 0.0, &x, model.period_us(), Sensitivity::None, settings)?.state;
+        x = flow_map(
+            model,
+            0.0,
+            &x,
+            model.period_us(),
+            Sensitivity::None,
+            settings,
+        )?
+        .state;
     }
     Ok(x)
 }
 
 fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt()
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt()
 }
 
 /// Assemble the orbit: the observables of each of its `k` periods from the converged state.

@@ -2,5 +2,8 @@
 //! lives in the library crates (`hybrid`, `continuation`, `afm`, `beam`).
 #![warn(missing_docs)]
 
+pub mod model_args;
 pub mod output;
 pub mod plot;
+pub mod simulate;
+pub mod trajectory_plot;

@@ -1,1 +1,37 @@
-fn main() {}
+//! `drumroll`: non-smooth dynamics of AFM cantilevers tapping a sample (Melcher, Xu, Raman,
+//! APL 93, 093111 (2008)). Thin: parses arguments and hands each subcommand to its module.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Non-smooth dynamics of AFM cantilevers tapping a sample: steady orbits, impacts, grazing
+/// bifurcations (Melcher, Xu, Raman, Appl. Phys. Lett. 93, 093111 (2008)).
+#[derive(Debug, Parser)]
+#[command(name = "drumroll", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// The steady periodic orbit at one separation Z (or one amplitude ratio A/A0).
+    Simulate(drumroll::simulate::SimulateArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Simulate(args) => drumroll::simulate::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("drumroll: error: {error}");
+            for cause in error.chain().skip(1) {
+                eprintln!("  caused by: {cause}");
+            }
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,180 @@
+//! `drumroll simulate`: the steady periodic orbit at one separation `Z`, or at the `Z` where the
+//! approach curve reaches an amplitude ratio, with its impacts, gap minima and forces.
+
+use afm::{
+    find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, SteadyOrbit, SteadyOrbitSettings,
+    TappingModel,
+};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde_json::json;
+use std::path::PathBuf;
+
+use crate::model_args::{output_path, ModelArgs};
+use crate::output::write_atomically;
+use crate::plot::render_svg;
+use crate::trajectory_plot::trajectory_panels;
+
+/// Options of `drumroll simulate`.
+#[derive(Debug, Clone, Args)]
+pub struct SimulateArgs {
+    /// The cantilever, sample and drive.
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Separation Z between the cantilever base and the sample, nm (Z > 0 above the sample).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        conflicts_with = "amplitude_ratio",
+        required_unless_present = "amplitude_ratio"
+    )]
+    pub z: Option<f64>,
+    /// Instead of --z: approach from above first contact (Z decreasing, each orbit started from
+    /// the previous one) and stop at the Z where A/A0 equals this ratio (0 < R < 1).
+    #[arg(long)]
+    pub amplitude_ratio: Option<f64>,
+    /// Print one JSON object instead of the readable summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) into this SVG file.
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Run `drumroll simulate`.
+pub fn run(args: &SimulateArgs) -> Result<()> {
+    let (case, model) = args.model.model()?;
+    let plot_path = args
+        .plot
+        .as_ref()
+        .map(|p| output_path(p, "svg", "--plot"))
+        .transpose()?;
+    let settings = SteadyOrbitSettings::default();
+    let orbit = match (args.z, args.amplitude_ratio) {
+        (Some(z), None) => {
+            if !z.is_finite() {
+                bail!("--z {z}: the separation must be a finite number of nm");
+            }
+            steady_orbit(&model, z, None, &settings)
+                .with_context(|| format!("no steady orbit at Z = {z} nm"))?
+        }
+        (None, Some(ratio)) => {
+            let search = AmplitudeRatioSearch::new(ratio).context("invalid --amplitude-ratio")?;
+            find_amplitude_ratio(&model, &search, &settings)
+                .with_context(|| format!("cannot reach A/A0 = {ratio} on the approach"))?
+        }
+        _ => bail!("give exactly one of --z and --amplitude-ratio"),
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&orbit_json(&case.name, &model, &orbit))?
+        );
+    } else {
+        print!("{}", summary(&case.name, &model, &orbit));
+    }
+    if let Some(path) = plot_path {
+        let panels = trajectory_panels(&model, &orbit, 2)?;
+        let svg = render_svg(&panels, 2, 1, (800, 320))?;
+        write_atomically(&path, svg.as_bytes())?;
+        if !args.json {
+            println!("figure: {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// The JSON object of one steady orbit (units in the key names).
+pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serde_json::Value {
+    let observables = orbit.observables();
+    let (amplitude_ratio, phase_deg) = orbit.lockin(model.free_amplitude_nm());
+    json!({
+        "case": case,
+        "z_nm": orbit.z_nm,
+        "first_contact_z_nm": model.grazing_separation_nm(),
+        "free_amplitude_nm": model.free_amplitude_nm(),
+        "drive_frequency_khz": model.drive_frequency_khz(),
+        "period_us": model.period_us(),
+        "amplitude_ratio": amplitude_ratio,
+        "phase_deg": phase_deg,
+        "free_phase_deg": model.free_phase_deg(),
+        "impacts_per_period": orbit.impacts_per_period(),
+        "multiplicity": orbit.multiplicity,
+        "converged": orbit.converged,
+        "newton_iterations": orbit.iterations,
+        "residual": orbit.residual,
+        "stable": orbit.stable,
+        "floquet_multipliers": orbit.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "gap_minima": observables.gap_minima,
+        "impacts": observables.impacts,
+        "peak_force_nn": observables.peak_force_nn,
+        "mean_force_nn": observables.mean_force_nn,
+        "contact_time_periods": observables.contact_time_periods,
+        "impulse_nn_us": observables.impulse_nn_us,
+        "state": orbit.state,
+        "periods": orbit.periods,
+    })
+}
+
+/// The readable summary of one steady orbit.
+pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String {
+    use std::fmt::Write;
+    let observables = orbit.observables();
+    let (ratio, phase) = orbit.lockin(model.free_amplitude_nm());
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "case {case}: A0 = {} nm, drive {:.4} kHz, first contact at Z_G1 = {:.9} nm",
+        model.free_amplitude_nm(),
+        model.drive_frequency_khz(),
+        model.grazing_separation_nm()
+    );
+    let status = if orbit.converged {
+        format!(
+            "converged in {} Newton iterations, residual {:.1e}",
+            orbit.iterations, orbit.residual
+        )
+    } else {
+        format!("NOT CONVERGED after {} Newton iterations, residual {:.1e}: the values below are the best attempt", orbit.iterations, orbit.residual)
+    };
+    let _ = writeln!(s, "steady orbit at Z = {:.9} nm: {status}", orbit.z_nm);
+    if orbit.multiplicity > 1 {
+        let _ = writeln!(
+            s,
+            "the orbit is NOT period-1: its period is {} drive periods",
+            orbit.multiplicity
+        );
+    }
+    let radius = continuation::spectral_radius(&orbit.multipliers);
+    let _ = writeln!(
+        s,
+        "stability: {} (largest |Floquet multiplier| = {radius:.6})",
+        if orbit.stable { "stable" } else { "unstable" }
+    );
+    let _ = writeln!(
+        s,
+        "A/A0 = {ratio:.6}   phase = {phase:.4} deg (free: {:.4} deg)",
+        model.free_phase_deg()
+    );
+    let _ = writeln!(s, "impacts per period: {}", orbit.impacts_per_period());
+    for (i, impact) in observables.impacts.iter().enumerate() {
+        let _ = writeln!(s, "  impact {}: t = {:.6} .. {:.6} periods, onset velocity {:.6} nm/us, peak force {:.6} nN",
+            i + 1, impact.start_periods, impact.end_periods, impact.velocity_nm_per_us, impact.peak_force_nn);
+    }
+    let _ = writeln!(s, "gap minima (t in periods, gap in nm):");
+    for minimum in &observables.gap_minima {
+        let kind = if minimum.gap_nm < 0.0 {
+            "impact"
+        } else {
+            "near impact"
+        };
+        let _ = writeln!(
+            s,
+            "  t = {:.6}  d = {:+.6e}  ({kind})",
+            minimum.t_periods, minimum.gap_nm
+        );
+    }
+    let _ = writeln!(s, "peak force {:.6} nN, mean force {:.6e} nN, contact time {:.6} periods, impulse {:.6} nN us",
+        observables.peak_force_nn, observables.mean_force_nn, observables.contact_time_periods, observables.impulse_nn_us);
+    s
+}
