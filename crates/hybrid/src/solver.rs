@@ -378,10 +378,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         if !t_end.is_finite() || t_end < self.t {
             return Err(HybridError::InvalidEndTime { t: self.t, t_end });
         }
+        self.extrema.clear();
         if t_end == self.t {
             return Ok(StepOutcome::EndTime);
         }
-        self.extrema.clear();
         let t0 = self.t;
         let mode = self.mode;
         self.z_start.copy_from_slice(&self.z);

@@ -323,3 +323,39 @@ fn exact_grazing_never_loops() {
         );
     }
 }
+
+/// `step(t_end)` with `t_end == t` takes no step: it returns `EndTime` and reports no extrema
+/// (so a driver collecting `step_extrema` after every call never counts one twice).
+#[test]
+fn step_to_current_time_reports_nothing() {
+    // h = -0.3 - cos t: up at acos(-0.3) = 1.88, maximum at pi, down at 4.41. Exact steps of
+    // 3 make the step that ends at the down event contain the maximum.
+    let system = Rotation {
+        c: -0.3,
+        t_c: 0.0,
+        exact_flow_limit: Some(3.0),
+    };
+    let mut solver = Solver::new(
+        &system,
+        0.0,
+        &system.initial_state(),
+        Sensitivity::None,
+        Settings::default(),
+    )
+    .expect("valid");
+    let event_time = loop {
+        let outcome = solver.step(10.0).expect("integration succeeds");
+        if let StepOutcome::Event(event) = outcome {
+            if event.direction == Direction::Down {
+                break event.t;
+            }
+        }
+    };
+    assert_eq!(
+        solver.step_extrema().len(),
+        1,
+        "the event step holds the maximum"
+    );
+    assert_eq!(solver.step(event_time), Ok(StepOutcome::EndTime));
+    assert!(solver.step_extrema().is_empty());
+}
