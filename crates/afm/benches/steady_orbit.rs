@@ -1,0 +1,86 @@
+//! Benchmark of the steady orbit at the paper's Fig. 1 points (Biolever on mica, A0 = 10 nm,
+//! A/A0 = 0.95, 0.90, 0.50): the time to converge it from the orbit at a neighbouring point of
+//! the approach branch (Z + 0.01 nm), and from a cold start (the free orbit plus transients),
+//! and the right-hand-side evaluations per period.
+//!
+//! Run with `cargo bench -p afm --bench steady_orbit`. Timings are medians over repetitions in
+//! one process, so the ratios between rows are meaningful on a noisy machine.
+
+use afm::{
+    builtin_case, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, Separation,
+    SteadyOrbitSettings, TappingModel,
+};
+use hybrid::{flow_map, Sensitivity};
+use std::time::Instant;
+
+/// Median wall time of `repetitions` calls of `f`, microseconds.
+fn median_us<F: FnMut()>(repetitions: usize, mut f: F) -> f64 {
+    let mut times: Vec<f64> = (0..repetitions)
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[repetitions / 2]
+}
+
+fn main() {
+    let case = builtin_case("biolever-mica").expect("built-in case");
+    let model = TappingModel::from_case(&case).expect("model");
+    let settings = SteadyOrbitSettings::default();
+    println!("steady orbit, Biolever on mica, A0 = 10 nm (median of repetitions)");
+    println!(
+        "{:>6} {:>12} {:>8} {:>12} {:>10} {:>14} {:>14} {:>12}",
+        "A/A0",
+        "Z (nm)",
+        "impacts",
+        "neighbour us",
+        "cold us",
+        "Newton iters",
+        "RHS evals/T",
+        "steps/T"
+    );
+    for ratio in [0.95, 0.90, 0.50] {
+        let search = AmplitudeRatioSearch::new(ratio).expect("ratio");
+        let target = find_amplitude_ratio(&model, &search, &settings).expect("reached");
+        let z = target.z_nm;
+        // The neighbouring point on the approach branch, 0.01 nm above.
+        let neighbour =
+            steady_orbit(&model, z + 0.01, Some(&target.state), &settings).expect("neighbour");
+        let warm = steady_orbit(&model, z, Some(&neighbour.state), &settings).expect("warm");
+        assert!(warm.converged, "warm start converges");
+        let neighbour_us = median_us(201, || {
+            let orbit = steady_orbit(&model, z, Some(&neighbour.state), &settings).expect("warm");
+            std::hint::black_box(orbit);
+        });
+        let cold_us = median_us(51, || {
+            let orbit = steady_orbit(&model, z, None, &settings).expect("cold");
+            std::hint::black_box(orbit);
+        });
+        let mut at_z = model.clone();
+        at_z.set_separation(Separation::Constant(z))
+            .expect("finite");
+        let period = flow_map(
+            &at_z,
+            0.0,
+            &target.state,
+            at_z.period_us(),
+            Sensitivity::TransitionAndParameter,
+            &settings.integration,
+        )
+        .expect("period map");
+        println!(
+            "{:>6.2} {:>12.6} {:>8} {:>12.1} {:>10.1} {:>14} {:>14} {:>12}",
+            ratio,
+            z,
+            target.observables().impacts.len(),
+            neighbour_us,
+            cold_us,
+            warm.iterations,
+            period.statistics.rhs_evaluations,
+            period.statistics.steps + period.statistics.exact_steps,
+        );
+    }
+}
