@@ -22,10 +22,10 @@ pub struct ModelArgs {
     pub sample: Option<String>,
     /// Free amplitude A0 of the photodiode signal u, nm (MODEL.md section 3). With `--case`
     /// it overrides the case's value.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub a0: Option<f64>,
     /// Drive frequency, kHz (default: the case's, else the fundamental f_1).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub drive_frequency: Option<f64>,
 }
 

@@ -31,7 +31,7 @@ pub struct SimulateArgs {
     pub z: Option<f64>,
     /// Instead of --z: approach from above first contact (Z decreasing, each orbit started from
     /// the previous one) and stop at the Z where A/A0 equals this ratio (0 < R < 1).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub amplitude_ratio: Option<f64>,
     /// Print one JSON object instead of the readable summary.
     #[arg(long)]
