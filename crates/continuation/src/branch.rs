@@ -80,6 +80,30 @@ pub struct Branch {
     pub error: Option<ContinuationError>,
 }
 
+/// Whether the structure changes between two orbits include a corner of the branch at a
+/// grazing: an extremum whose value at the first orbit is below `1e-3` of its value at the
+/// second (the first orbit sits at the grazing the continuation ran into).
+fn at_grazing_corner(tests: &[StructureTest]) -> bool {
+    tests.iter().any(|t| match *t {
+        StructureTest::Extremum {
+            value_a, value_b, ..
+        } => value_a.abs() <= 1e-3 * value_b.abs(),
+        StructureTest::ImpactCount { .. } => false,
+    })
+}
+
+/// An orbit found past a corner of the branch by [`Continuation::corner_jump`].
+struct Jump {
+    sample: Sample,
+    iterations: usize,
+    residual: f64,
+    /// Unit secant from the current point to the new one.
+    secant: DVector<f64>,
+}
+
+/// Consecutive corrector failures at one point after which a corner jump is tried.
+const CORNER_FAILURES: usize = 6;
+
 /// A test function of a corrected orbit on a step.
 type SampleTest = fn(&Sample) -> f64;
 
@@ -269,9 +293,123 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         )))
     }
 
+    /// Jump over a corner of the branch at a structure change (the square-root singularity
+    /// of a hard impact at grazing, where the branch turns too sharply for the corrector):
+    /// shoot at fixed parameters `p_A + dp` beyond the current point, `dp` growing from
+    /// `1e-4` to `100` times the initial step, from the state extrapolated along the tangent.
+    /// The first converged orbit whose structure differs from the current one is returned,
+    /// with its tangent oriented along the secant (also returned).
+    fn corner_jump(&self) -> Result<Option<Jump>, ContinuationError> {
+        let a = &self.current;
+        let n = self.problem.dim();
+        let tp = a.tangent[n];
+        let direction = if tp < 0.0 { -1.0 } else { 1.0 };
+        let shooting = NewtonSettings {
+            max_iterations: self.settings.corrector.max_iterations * 4,
+            ..self.settings.corrector.clone()
+        };
+        for j in 0..=6 {
+            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+            let p = a.parameter() + direction * dp;
+            if p > self.settings.parameter_max || p < self.settings.parameter_min {
+                break;
+            }
+            let slope = if tp.abs() > 1e-12 { 1.0 / tp } else { 0.0 };
+            let guess = a.u.rows(0, n) + (direction * dp * slope) * a.tangent.rows(0, n);
+            let result = match shoot(self.problem, guess.as_slice(), p, &shooting) {
+                Ok(result) => result,
+                Err(ContinuationError::DimensionMismatch { .. }) => {
+                    return Err(ContinuationError::DimensionMismatch {
+                        what: "period map",
+                        expected: n,
+                        found: 0,
+                    })
+                }
+                Err(_) => continue,
+            };
+            if !result.converged
+                || !at_grazing_corner(&structure_changes(
+                    &a.map.structure,
+                    &result.period_map.structure,
+                ))
+            {
+                continue;
+            }
+            let mut u = DVector::zeros(n + 1);
+            u.rows_mut(0, n).copy_from(&result.state);
+            u[n] = p;
+            let secant = (&u - &a.u).normalize();
+            let sample = Sample::new(1.0, u, result.period_map, &secant);
+            if sample.tangent.iter().any(|v| !v.is_finite()) {
+                continue;
+            }
+            return Ok(Some(Jump {
+                sample,
+                iterations: result.iterations,
+                residual: result.residual,
+                secant,
+            }));
+        }
+        Ok(None)
+    }
+
+    /// At the end of a branch that cannot go on (the corrector fails at the minimum step and
+    /// no corner jump finds an orbit past it), locate the structure change the branch runs
+    /// into, if any: a trajectory started from the state extrapolated along the tangent,
+    /// `dp = 1e-4 .. 100` initial steps ahead, that has a different structure marks the far
+    /// side; the change is then located in the natural parameter between the last orbit and
+    /// that parameter, trials with no orbit counting as the far side. `impacts_after` is the
+    /// impact count of that extrapolated trajectory (no orbit exists there).
+    fn terminal_location(&self) -> Result<Vec<SpecialPoint>, ContinuationError> {
+        let a = &self.current;
+        let n = self.problem.dim();
+        let tp = a.tangent[n];
+        if !(tp.abs() > 1e-12 && tp.is_finite()) {
+            return Ok(Vec::new());
+        }
+        let direction = tp.signum();
+        for j in 0..=6 {
+            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+            let p = a.parameter() + direction * dp;
+            if p > self.settings.parameter_max || p < self.settings.parameter_min {
+                break;
+            }
+            let guess = a.u.rows(0, n) + (direction * dp / tp) * a.tangent.rows(0, n);
+            let Ok(map) = self.problem.period_map(guess.as_slice(), p) else {
+                continue;
+            };
+            let structure: Vec<StructureTest> = structure_changes(&a.map.structure, &map.structure)
+                .into_iter()
+                .filter(|t| at_grazing_corner(std::slice::from_ref(t)))
+                .collect();
+            if structure.is_empty() {
+                continue;
+            }
+            let mut u = DVector::zeros(n + 1);
+            u.rows_mut(0, n).copy_from(&guess);
+            u[n] = p;
+            let far = Sample::new(1.0, u, map, &a.tangent);
+            let mut start = a.clone();
+            start.sigma = 0.0;
+            let segment = Segment::new(
+                self.problem,
+                start,
+                far,
+                a.tangent.clone(),
+                self.settings.corrector.clone(),
+                true,
+            );
+            let index = self.produced.saturating_sub(1);
+            return self.locate_all(&segment, &structure, index, true, false);
+        }
+        Ok(Vec::new())
+    }
+
     /// One continuation step: the next accepted point, or an error.
     fn advance(&mut self) -> Result<BranchPoint, ContinuationError> {
         let n = self.problem.dim();
+        let mut failures = 0;
+        let mut jump_tried = false;
         loop {
             let ds = self.step;
             let t_a = self.current.tangent.clone();
@@ -283,25 +421,51 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 &t_a,
                 &self.settings.corrector,
             )?;
-            let (u, map) = match (corrected.converged, corrected.map) {
-                (true, Some(map)) => (corrected.u, map),
-                _ => {
-                    if self.cut() {
-                        continue;
+            let mut reference = t_a.clone();
+            // A corrector that wandered further than the step itself has probably left the
+            // branch: treat it as a failure.
+            let wandered = (&corrected.u - &predicted).norm() > ds;
+            let (mut b, mut iterations, mut residual) =
+                match (corrected.converged && !wandered, corrected.map) {
+                    (true, Some(map)) => (
+                        Sample::new(1.0, corrected.u, map, &t_a),
+                        corrected.iterations,
+                        corrected.residual,
+                    ),
+                    _ => {
+                        failures += 1;
+                        let stuck =
+                            failures >= CORNER_FAILURES || self.step <= self.settings.min_step;
+                        let jump = if stuck && !jump_tried {
+                            jump_tried = true;
+                            self.corner_jump()?
+                        } else {
+                            None
+                        };
+                        match jump {
+                            Some(jump) => {
+                                reference = jump.secant;
+                                (jump.sample, jump.iterations, jump.residual)
+                            }
+                            None => {
+                                if self.cut() {
+                                    continue;
+                                }
+                                let terminal = self.terminal_location()?;
+                                self.special_points.extend(terminal);
+                                self.stop = Some(StopReason::StepTooSmall);
+                                return Err(ContinuationError::StepTooSmall {
+                                    parameter: self.current.parameter(),
+                                    step: ds,
+                                    residual: corrected.residual,
+                                });
+                            }
+                        }
                     }
-                    self.stop = Some(StopReason::StepTooSmall);
-                    return Err(ContinuationError::StepTooSmall {
-                        parameter: self.current.parameter(),
-                        step: ds,
-                        residual: corrected.residual,
-                    });
-                }
-            };
-            let mut b = Sample::new(1.0, u, map, &t_a);
-            let mut iterations = corrected.iterations;
-            let mut residual = corrected.residual;
+                };
+            let jumped = reference != t_a;
             let turn = t_a.dot(&b.tangent).clamp(-1.0, 1.0).acos();
-            if !turn.is_finite() || turn > self.settings.max_tangent_angle {
+            if !jumped && (!turn.is_finite() || turn > self.settings.max_tangent_angle) {
                 if self.cut() {
                     continue;
                 }
@@ -361,11 +525,16 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 self.problem,
                 a,
                 b.clone(),
-                t_a.clone(),
+                reference,
                 self.settings.corrector.clone(),
+                jumped,
             );
-            let special = self.locate_all(&segment, &structure, index)?;
-            if iterations <= self.settings.easy_iterations {
+            let special = self.locate_all(&segment, &structure, index, jumped, true)?;
+            if jumped {
+                // Past a corner the branch's own scale is the jump.
+                let jump = (&b.u - &self.current.u).norm();
+                self.step = self.step.max(jump.min(self.settings.max_step));
+            } else if iterations <= self.settings.easy_iterations {
                 self.step = (self.step * self.settings.step_growth).min(self.settings.max_step);
             }
             let point = BranchPoint {
@@ -393,6 +562,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         segment: &Segment<'_, P>,
         structure: &[StructureTest],
         index: usize,
+        jumped: bool,
+        smooth_tests: bool,
     ) -> Result<Vec<SpecialPoint>, ContinuationError> {
         let tolerance = self.settings.location_tolerance;
         let max_iterations = self.settings.location_max_iterations;
@@ -400,7 +571,13 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         let mut breaks: Vec<(usize, usize)> = Vec::new();
         for test in structure {
             let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
-            let location = segment.locate(0, 1, &value, tolerance, max_iterations)?;
+            // Across a corner, a failed trial lies past the structure change (B side).
+            let failure = if jumped {
+                value(&segment.get(1))
+            } else {
+                f64::NAN
+            };
+            let location = segment.locate(0, 1, &value, failure, tolerance, max_iterations)?;
             let kind = match *test {
                 StructureTest::Extremum {
                     kind: ExtremumKind::Minimum,
@@ -425,15 +602,17 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                     }
                 }
             };
-            breaks.push((location.low, location.high));
+            breaks.push((location.low.unwrap_or(0), location.high.unwrap_or(1)));
             found.push(self.special_point(segment, kind, &location, location.converged, index));
         }
         // Smooth (tangent and multiplier) tests, located between the structure brackets.
-        let mut smooth: Vec<(SpecialPointKind, SampleTest)> =
-            vec![(SpecialPointKind::Fold, |s: &Sample| {
+        let mut smooth: Vec<(SpecialPointKind, SampleTest)> = Vec::new();
+        if smooth_tests {
+            smooth.push((SpecialPointKind::Fold, |s: &Sample| {
                 s.tangent[s.tangent.len() - 1]
-            })];
-        if self.settings.detect_bifurcations {
+            }));
+        }
+        if smooth_tests && self.settings.detect_bifurcations {
             smooth.push((SpecialPointKind::PeriodDoubling, |s: &Sample| {
                 period_doubling_test(&s.multipliers)
             }));
@@ -468,7 +647,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             });
             let (mut kind, location) = match continuous {
                 Some((l, h)) => {
-                    let location = segment.locate(l, h, &test, tolerance, max_iterations)?;
+                    let location =
+                        segment.locate(l, h, &test, f64::NAN, tolerance, max_iterations)?;
                     (kind, location)
                 }
                 None => {
@@ -480,8 +660,9 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                     };
                     let location = Location {
                         point: Some(segment.get(l)),
-                        low: l,
-                        high: h,
+                        low: Some(l),
+                        high: Some(h),
+                        parameters: (segment.get(l).parameter(), segment.get(h).parameter()),
                         converged: false,
                         iterations: 0,
                     };
@@ -514,9 +695,9 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         converged: bool,
         index: usize,
     ) -> (f64, SpecialPoint) {
-        let low = segment.get(location.low);
-        let high = segment.get(location.high);
-        let (pl, ph) = (low.parameter(), high.parameter());
+        let low = segment.get(location.low.unwrap_or(0));
+        let high = segment.get(location.high.unwrap_or(1));
+        let (pl, ph) = location.parameters;
         let point = location.point.clone().unwrap_or_else(|| low.clone());
         let n = point.u.len() - 1;
         let impacts_after = high.map.structure.impacts;

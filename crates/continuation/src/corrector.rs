@@ -77,6 +77,7 @@ fn recoverable(error: &ContinuationError) -> bool {
     matches!(
         error,
         ContinuationError::PeriodMapFailed { .. }
+            | ContinuationError::Hybrid { .. }
             | ContinuationError::NonFinite { .. }
             | ContinuationError::SingularMatrix { .. }
     )

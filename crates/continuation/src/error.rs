@@ -41,6 +41,16 @@ pub enum ContinuationError {
         /// The underlying error, as text.
         message: String,
     },
+    /// The hybrid solver failed to integrate the period map.
+    #[error(
+        "hybrid integration of the period map failed at parameter p = {parameter:e}: {source}"
+    )]
+    Hybrid {
+        /// The parameter value of the evaluation.
+        parameter: f64,
+        /// The solver's error.
+        source: hybrid::HybridError,
+    },
     /// Newton's method at the start of a branch did not reach the tolerance.
     #[error(
         "starting orbit not converged at p = {parameter:e}: residual {residual:e} after {iterations} Newton iterations"

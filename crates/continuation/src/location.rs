@@ -6,6 +6,14 @@
 //! the pseudo-arclength corrector. A test function of that orbit is root-found in `sigma` with
 //! the Illinois method of the `roots` crate until the *parameter* bracket is below the
 //! location tolerance.
+//!
+//! A step that jumped over a corner of the branch (a hard-impact grazing, see
+//! [`crate::Continuation`]) is located in the *natural* parameter instead: `p` runs linearly
+//! from `p_A` to `p_B` and each trial orbit is shot at fixed `p` from the state extrapolated
+//! along the tangent at `A` (then at `B`). There a trial that converges on neither side is
+//! counted as lying on the far (`B`) side of a structure change: near the grazing of a hard
+//! impact the orbit past it is too singular for Newton's method, while the orbit before it is
+//! smooth and its extrapolated guess is excellent.
 
 use std::cell::{Cell, RefCell};
 
@@ -16,6 +24,7 @@ use crate::corrector::{correct, tangent};
 use crate::error::ContinuationError;
 use crate::floquet::floquet_multipliers;
 use crate::problem::{PeriodMap, PeriodicProblem};
+use crate::shooting::shoot;
 use crate::shooting::NewtonSettings;
 
 /// A corrected orbit on the segment, with what the test functions need.
@@ -66,14 +75,17 @@ impl Sample {
 pub(crate) struct Location {
     /// The sample at the located point (`None` if its correction failed).
     pub point: Option<Sample>,
-    /// Index (into the segment's samples) of the bracket end nearer `sigma = 0`.
-    pub low: usize,
-    /// Index of the bracket end nearer `sigma = 1`.
-    pub high: usize,
-    /// Whether the parameter bracket reached the tolerance with finite values of opposite
-    /// signs (or an exact zero).
+    /// Index (into the segment's samples) of the bracket end nearer `sigma = 0`; `None` if
+    /// that end is a failed trial (natural mode), which stands for the far side.
+    pub low: Option<usize>,
+    /// Index of the bracket end nearer `sigma = 1` (`None`: a failed trial).
+    pub high: Option<usize>,
+    /// Parameters at the bracket ends (low, high).
+    pub parameters: (f64, f64),
+    /// Whether the parameter bracket reached the tolerance with values of opposite signs (or
+    /// an exact zero).
     pub converged: bool,
-    /// New corrected trial points spent.
+    /// New trial points spent.
     pub iterations: usize,
 }
 
@@ -85,7 +97,9 @@ pub(crate) struct Segment<'a, P: PeriodicProblem + ?Sized> {
     tau: DVector<f64>,
     reference: DVector<f64>,
     settings: NewtonSettings,
+    natural: bool,
     samples: RefCell<Vec<Sample>>,
+    trials: Cell<usize>,
 }
 
 /// Stop rule for the Illinois iteration: parameter bracket below the tolerance.
@@ -115,13 +129,15 @@ impl<P: PeriodicProblem + ?Sized> Convergency<f64> for ParameterBracket<'_, '_, 
 
 impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     /// The segment between samples `a` (`sigma = 0`) and `b` (`sigma = 1`); trial points are
-    /// corrected with `settings` and their tangents oriented along `reference`.
+    /// corrected with `settings` and their tangents oriented along `reference`. With
+    /// `natural`, trials are shot at fixed parameters (see the module documentation).
     pub(crate) fn new(
         problem: &'a P,
         a: Sample,
         b: Sample,
         reference: DVector<f64>,
         settings: NewtonSettings,
+        natural: bool,
     ) -> Self {
         let delta = &b.u - &a.u;
         let length = delta.norm();
@@ -137,12 +153,19 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             tau,
             reference,
             settings,
+            natural,
             samples: RefCell::new(vec![a, b]),
+            trials: Cell::new(0),
         }
     }
 
-    /// Parameter of the cached sample at exactly `sigma` (NaN if none).
+    /// Parameter at `sigma`: linear in natural mode, else that of the cached sample at
+    /// exactly `sigma` (NaN if none).
     fn parameter_at(&self, sigma: f64) -> f64 {
+        let n = self.u_a.len() - 1;
+        if self.natural {
+            return self.u_a[n] + sigma * self.delta[n];
+        }
         self.samples
             .borrow()
             .iter()
@@ -155,14 +178,38 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
         self.samples.borrow()[index].clone()
     }
 
+    /// Index of the cached sample at exactly `sigma`.
+    fn index_of(&self, sigma: f64) -> Option<usize> {
+        self.samples.borrow().iter().position(|s| s.sigma == sigma)
+    }
+
     /// Index of the sample at `sigma`, correcting a new orbit if it is not cached
-    /// (`Ok(None)` if the corrector fails there).
+    /// (`Ok(None)` if the correction fails there).
     pub(crate) fn sample(&self, sigma: f64) -> Result<Option<usize>, ContinuationError> {
+        if let Some(i) = self.index_of(sigma) {
+            return Ok(Some(i));
+        }
+        self.trials.set(self.trials.get() + 1);
+        let found = if self.natural {
+            self.shoot_at(sigma)?
+        } else {
+            self.correct_at(sigma)?
+        };
+        Ok(found.map(|(u, map)| {
+            let sample = Sample::new(sigma, u, map, &self.reference);
+            let mut samples = self.samples.borrow_mut();
+            samples.push(sample);
+            samples.len() - 1
+        }))
+    }
+
+    /// Pseudo-arclength correction on the hyperplane through the secant point at `sigma`.
+    fn correct_at(
+        &self,
+        sigma: f64,
+    ) -> Result<Option<(DVector<f64>, PeriodMap)>, ContinuationError> {
         let (guess, anchor) = {
             let samples = self.samples.borrow();
-            if let Some(i) = samples.iter().position(|s| s.sigma == sigma) {
-                return Ok(Some(i));
-            }
             // Interpolate between the nearest cached samples on either side.
             let below = samples
                 .iter()
@@ -183,39 +230,75 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             (guess, anchor)
         };
         let corrected = correct(self.problem, guess, &anchor, &self.tau, &self.settings)?;
-        if !corrected.converged {
-            return Ok(None);
-        }
-        let Some(map) = corrected.map else {
-            return Ok(None);
+        Ok(match (corrected.converged, corrected.map) {
+            (true, Some(map)) => Some((corrected.u, map)),
+            _ => None,
+        })
+    }
+
+    /// Shooting at the fixed parameter of `sigma`, from the states extrapolated along the
+    /// tangents at `A`, then at `B`.
+    fn shoot_at(&self, sigma: f64) -> Result<Option<(DVector<f64>, PeriodMap)>, ContinuationError> {
+        let n = self.u_a.len() - 1;
+        let p = self.parameter_at(sigma);
+        let ends = [self.get(0), self.get(1)];
+        let settings = NewtonSettings {
+            max_iterations: self.settings.max_iterations * 4,
+            ..self.settings.clone()
         };
-        let sample = Sample::new(sigma, corrected.u, map, &self.reference);
-        let mut samples = self.samples.borrow_mut();
-        samples.push(sample);
-        Ok(Some(samples.len() - 1))
+        for end in &ends {
+            let tp = end.tangent[n];
+            let slope = if tp.abs() > 1e-12 && tp.is_finite() {
+                (p - end.parameter()) / tp
+            } else {
+                0.0
+            };
+            let guess = end.u.rows(0, n) + slope * end.tangent.rows(0, n);
+            let result = match shoot(self.problem, guess.as_slice(), p, &settings) {
+                Ok(result) => result,
+                Err(ContinuationError::DimensionMismatch {
+                    what,
+                    expected,
+                    found,
+                }) => {
+                    return Err(ContinuationError::DimensionMismatch {
+                        what,
+                        expected,
+                        found,
+                    })
+                }
+                Err(_) => continue,
+            };
+            if result.converged {
+                let mut u = DVector::zeros(n + 1);
+                u.rows_mut(0, n).copy_from(&result.state);
+                u[n] = p;
+                return Ok(Some((u, result.period_map)));
+            }
+        }
+        Ok(None)
     }
 
     /// Locate a sign change of `test` between the cached samples `low` and `high`
-    /// (`sigma_low < sigma_high`) to a parameter bracket of `tolerance`.
+    /// (`sigma_low < sigma_high`) to a parameter bracket of `tolerance`. A trial that fails
+    /// counts as `failure_value` (NaN: unknown, which ends the search).
     pub(crate) fn locate(
         &self,
         low: usize,
         high: usize,
         test: &dyn Fn(&Sample) -> f64,
+        failure_value: f64,
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<Location, ContinuationError> {
-        let (s_low, s_high) = {
-            let samples = self.samples.borrow();
-            (samples[low].sigma, samples[high].sigma)
-        };
-        let before = self.samples.borrow().len();
+        let (s_low, s_high) = (self.get(low).sigma, self.get(high).sigma);
+        let before = self.trials.get();
         let bracket = Cell::new((s_low, s_high));
         let error: RefCell<Option<ContinuationError>> = RefCell::new(None);
-        let f = |sigma: f64| -> f64 {
+        let value = |sigma: f64| -> f64 {
             match self.sample(sigma) {
                 Ok(Some(i)) => test(&self.samples.borrow()[i]),
-                Ok(None) => f64::NAN,
+                Ok(None) => failure_value,
                 Err(e) => {
                     error.borrow_mut().get_or_insert(e);
                     f64::NAN
@@ -228,7 +311,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             max_iterations,
             bracket: &bracket,
         };
-        let root = find_root_regula_falsi(s_low, s_high, f, &mut convergency);
+        let root = find_root_regula_falsi(s_low, s_high, value, &mut convergency);
         if let Some(e) = error.into_inner() {
             return Err(e);
         }
@@ -239,10 +322,9 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
                 0.5 * (l + h)
             }
         };
-        let point = self.sample(sigma)?.map(|i| self.get(i));
-        let value = point.as_ref().map_or(f64::NAN, test);
+        let mut point = self.sample(sigma)?.map(|i| self.get(i));
         let (mut bl, mut bh) = bracket.get();
-        if value == 0.0 {
+        if point.as_ref().is_some_and(|s| test(s) == 0.0) {
             // An exact zero: bracket it by two orbits a quarter of the tolerance (in p) on
             // either side, so that both sides (and their impact counts) are known.
             let slope =
@@ -254,39 +336,33 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             };
             let lo = (sigma - delta).max(bl);
             let hi = (sigma + delta).min(bh);
-            let lo_ok = lo < sigma && self.sample(lo)?.is_some();
-            let hi_ok = hi > sigma && self.sample(hi)?.is_some();
-            bl = if lo_ok { lo } else { bl };
-            bh = if hi_ok { hi } else { bh };
+            if lo < sigma && self.sample(lo)?.is_some() {
+                bl = lo;
+            }
+            // In natural mode a failed trial stands for the far side.
+            let inferred = self.natural && failure_value.is_finite();
+            if hi > sigma && (self.sample(hi)?.is_some() || inferred) {
+                bh = hi;
+            }
         }
-        let index_of = |s: f64| {
-            self.samples
-                .borrow()
-                .iter()
-                .position(|x| x.sigma == s)
-                .unwrap_or(low)
-        };
-        let (il, ih) = (index_of(bl), index_of(bh));
-        let (gl, gh, pl, ph) = {
-            let samples = self.samples.borrow();
-            (
-                test(&samples[il]),
-                test(&samples[ih]),
-                samples[il].parameter(),
-                samples[ih].parameter(),
-            )
-        };
+        let (il, ih) = (self.index_of(bl), self.index_of(bh));
+        let value_at = |index: Option<usize>| index.map_or(failure_value, |i| test(&self.get(i)));
+        let (gl, gh) = (value_at(il), value_at(ih));
+        let (pl, ph) = (self.parameter_at(bl), self.parameter_at(bh));
         let opposite = (gl == 0.0 || gh == 0.0 || (gl < 0.0) != (gh < 0.0))
             && gl.is_finite()
             && gh.is_finite();
+        if point.is_none() {
+            point = il.or(ih).map(|i| self.get(i));
+        }
         let converged = opposite && (pl - ph).abs() <= tolerance && point.is_some();
-        let iterations = self.samples.borrow().len() - before;
         Ok(Location {
             point,
             low: il,
             high: ih,
+            parameters: (pl, ph),
             converged,
-            iterations,
+            iterations: self.trials.get() - before,
         })
     }
 }

@@ -1,0 +1,215 @@
+//! The periodic-orbit problem of a parametrised hybrid system: its period map is the hybrid
+//! solver's flow map over a whole number of forcing periods from `t0 = 0`, with the monodromy
+//! and `dx/dp` carried through every event by saltation matrices (hybrid-api.md).
+//!
+//! The orbit structure is read from the flow map: the local minima and maxima of the contact
+//! switching function that the solver locates inside its steps, and the `Down` events on it
+//! (impacts, MODEL.md Sec. 5). At a hard impact (a reset map) `h` has a corner at zero instead
+//! of a smooth minimum; there the structure records the *virtual minimum* of the free flight
+//! continued through the surface, `h_min = -v^2 / (2 a)` with `v = dh/dt` before the impact
+//! and `a = d^2h/dt^2` (the parabola of the flight near the contact), so that the grazing test
+//! function is continuous through the grazing of a hard impact as well: `v^2` grows linearly
+//! with the distance past grazing (Nordmark's square-root law for `v`).
+
+use std::cell::RefCell;
+
+use hybrid::{flow_map, Direction, ExtremumKind, FlowMap, HybridSystem, Sensitivity, Settings};
+use nalgebra::{DMatrix, DVector};
+
+use crate::error::ContinuationError;
+use crate::problem::{OrbitStructure, PeriodMap, PeriodicProblem};
+
+/// A hybrid system with one scalar parameter and a periodic forcing, as continuation needs it.
+pub trait Parametrised: HybridSystem + Clone {
+    /// The current parameter value (for the AFM model, the separation `Z` in nm).
+    fn parameter(&self) -> f64;
+    /// Set the parameter (the derivatives `parameter_derivative`, `switching_gradient().p`
+    /// and `reset`'s `dxdp` of [`HybridSystem`] are with respect to it).
+    fn set_parameter(&mut self, p: f64);
+    /// The forcing period `T` (system time units).
+    fn period(&self) -> f64;
+    /// The index of the switching function whose impacts and extrema define the orbit
+    /// structure (the contact surface). Default 0.
+    fn contact_surface(&self) -> usize {
+        0
+    }
+}
+
+/// The period map `x -> x(periods * T)` from `t0 = 0` of a [`Parametrised`] hybrid system.
+pub struct HybridPeriodicProblem<S: Parametrised> {
+    system: RefCell<S>,
+    periods: usize,
+    settings: Settings,
+    buffers: RefCell<Buffers>,
+}
+
+/// Scratch vectors for the virtual-minimum estimate.
+struct Buffers {
+    field: Vec<f64>,
+    shifted: Vec<f64>,
+}
+
+impl<S: Parametrised> HybridPeriodicProblem<S> {
+    /// The problem of the orbits of period `periods * system.period()` (`periods >= 1`),
+    /// integrated with `settings`.
+    ///
+    /// # Errors
+    /// [`ContinuationError::InvalidSettings`] for `periods == 0`, a non-positive or
+    /// non-finite period, or a contact surface beyond the system's surfaces;
+    /// [`ContinuationError::Hybrid`] for invalid solver settings.
+    pub fn new(system: S, periods: usize, settings: Settings) -> Result<Self, ContinuationError> {
+        if periods == 0 {
+            return Err(ContinuationError::InvalidSettings {
+                field: "periods",
+                value: 0.0,
+                allowed: ">= 1",
+            });
+        }
+        let period = system.period();
+        if !(period.is_finite() && period > 0.0) {
+            return Err(ContinuationError::InvalidSettings {
+                field: "period",
+                value: period,
+                allowed: "> 0, finite",
+            });
+        }
+        if system.contact_surface() >= system.surface_count() {
+            return Err(ContinuationError::InvalidSettings {
+                field: "contact_surface",
+                value: system.contact_surface() as f64,
+                allowed: "< surface_count",
+            });
+        }
+        settings
+            .validate()
+            .map_err(|source| ContinuationError::Hybrid {
+                parameter: system.parameter(),
+                source,
+            })?;
+        let n = system.dim();
+        Ok(Self {
+            system: RefCell::new(system),
+            periods,
+            settings,
+            buffers: RefCell::new(Buffers {
+                field: vec![0.0; n],
+                shifted: vec![0.0; n],
+            }),
+        })
+    }
+
+    /// A copy of the system with its parameter set to `p` (to integrate observables on a
+    /// branch point, for example with `hybrid::flow_map_observed`).
+    pub fn system_at(&self, p: f64) -> S {
+        let mut system = self.system.borrow().clone();
+        system.set_parameter(p);
+        system
+    }
+
+    /// Number of forcing periods in one period map.
+    pub fn periods(&self) -> usize {
+        self.periods
+    }
+
+    /// Duration of one period map, `periods * T` (system time units).
+    pub fn duration(&self) -> f64 {
+        self.periods as f64 * self.system.borrow().period()
+    }
+
+    /// The solver settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// The flow map over one period map at `(x, p)` with the requested sensitivities.
+    ///
+    /// # Errors
+    /// [`ContinuationError::Hybrid`] if the integration fails.
+    pub fn flow(
+        &self,
+        x: &[f64],
+        p: f64,
+        sensitivity: Sensitivity,
+    ) -> Result<FlowMap, ContinuationError> {
+        self.system.borrow_mut().set_parameter(p);
+        let system = self.system.borrow();
+        let duration = self.periods as f64 * system.period();
+        flow_map(&*system, 0.0, x, duration, sensitivity, &self.settings).map_err(|source| {
+            ContinuationError::Hybrid {
+                parameter: p,
+                source,
+            }
+        })
+    }
+
+    /// `-v^2 / (2 a)` for a hard impact at time `t` with pre-impact rate `v` and post-impact
+    /// state `x`: `a = d^2h/dt^2` by a forward difference of `dh/dt` along the flow
+    /// (continuous through the reset up to `O(v)`, which vanishes at grazing).
+    fn virtual_minimum(&self, system: &S, k: usize, t: f64, v: f64, x: &[f64]) -> f64 {
+        let mut buffers = self.buffers.borrow_mut();
+        let Buffers { field, shifted } = &mut *buffers;
+        let mode = system.mode_of(t, x);
+        system.vector_field(mode, t, x, field);
+        let scale = system.period();
+        let delta = 1e-7 * scale;
+        for ((s, xi), fi) in shifted.iter_mut().zip(x).zip(field.iter()) {
+            *s = xi + delta * fi;
+        }
+        let r0 = system.switching_rate(k, mode, t, x);
+        let r1 = system.switching_rate(k, mode, t + delta, shifted);
+        let a = (r1 - r0) / delta;
+        -v * v / (2.0 * a.abs().max(f64::MIN_POSITIVE))
+    }
+}
+
+impl<S: Parametrised> PeriodicProblem for HybridPeriodicProblem<S> {
+    fn dim(&self) -> usize {
+        self.system.borrow().dim()
+    }
+
+    fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError> {
+        let n = self.dim();
+        if x.len() != n {
+            return Err(ContinuationError::DimensionMismatch {
+                what: "state of the period map",
+                expected: n,
+                found: x.len(),
+            });
+        }
+        let flow = self.flow(x, p, Sensitivity::TransitionAndParameter)?;
+        let system = self.system.borrow();
+        let k = system.contact_surface();
+        let duration = self.periods as f64 * system.period();
+        let mut structure = OrbitStructure {
+            minima: Vec::new(),
+            maxima: Vec::new(),
+            impacts: 0,
+            duration,
+        };
+        for extremum in flow.extrema.iter().filter(|e| e.surface == k) {
+            let entry = (extremum.t, extremum.value);
+            match extremum.kind {
+                ExtremumKind::Minimum => structure.minima.push(entry),
+                ExtremumKind::Maximum => structure.maxima.push(entry),
+            }
+        }
+        for event in flow
+            .events
+            .iter()
+            .filter(|e| e.surface == k && e.direction == Direction::Down)
+        {
+            structure.impacts += 1;
+            if event.reset {
+                let value = self.virtual_minimum(&system, k, event.t, event.rate, &event.state);
+                structure.minima.push((event.t, value));
+            }
+        }
+        structure.minima.sort_by(|a, b| a.0.total_cmp(&b.0));
+        Ok(PeriodMap {
+            image: DVector::from_vec(flow.state),
+            monodromy: DMatrix::from(flow.transition),
+            parameter_derivative: DVector::from_vec(flow.parameter_sensitivity),
+            structure,
+        })
+    }
+}

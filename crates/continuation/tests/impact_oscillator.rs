@@ -1,0 +1,154 @@
+//! The hard impact oscillator through the hybrid solver: shooting against the closed-form
+//! free steady state and against a long time-domain run, and the continuation in the drive
+//! amplitude against the closed-form grazing amplitude `A_g = d sqrt((k - w^2)^2 + (c w)^2)`.
+
+#[path = "../examples/impact_oscillator/oscillator.rs"]
+#[allow(dead_code)]
+mod oscillator;
+
+use continuation::{
+    floquet_multipliers, shoot, HybridPeriodicProblem, NewtonSettings, PeriodicProblem,
+    SpecialPointKind,
+};
+use hybrid::{flow_map, Sensitivity, Settings};
+use nalgebra::Complex;
+use oscillator::{continue_in_amplitude, first_grazing, ImpactOscillator};
+
+fn oscillator(w: f64, amplitude: f64) -> ImpactOscillator {
+    ImpactOscillator {
+        k: 1.0,
+        c: 0.1,
+        w,
+        d: 1.0,
+        e: 0.8,
+        amplitude,
+    }
+}
+
+/// Below grazing the orbit is the linear steady state. Newton on an affine map converges in
+/// one update; the state matches the closed form to 1e-9 (integration tolerance 1e-12
+/// relative on states of order 1, amplified by `|(M - I)^-1| < 1 / (1 - 0.54)`, with margin);
+/// the multipliers are `exp(lambda T)`, `lambda = -c/2 +- i sqrt(k - c^2/4)`, to 1e-6 (the
+/// solver controls the error of the state, not of the variational equations).
+#[test]
+fn shooting_matches_the_free_steady_state() {
+    for w in [0.5, 0.8, 1.2, 2.0] {
+        let osc = oscillator(w, 0.5 * oscillator(w, 0.0).grazing_amplitude_closed_form());
+        let problem = HybridPeriodicProblem::new(osc, 1, Settings::default()).expect("problem");
+        let result = shoot(
+            &problem,
+            &[0.0, 0.0],
+            osc.amplitude,
+            &NewtonSettings::default(),
+        )
+        .expect("shooting");
+        assert!(result.converged, "w = {w}: {result:?}");
+        assert!(
+            result.iterations <= 2,
+            "w = {w}: {} iterations",
+            result.iterations
+        );
+        let exact = osc.free_steady_state();
+        for i in 0..2 {
+            assert!(
+                (result.state[i] - exact[i]).abs() < 1e-9,
+                "w = {w}: {:?} vs {exact:?}",
+                result.state
+            );
+        }
+        assert_eq!(result.period_map.structure.impacts, 0);
+        let t = 2.0 * std::f64::consts::PI / w;
+        let lambda = Complex::new(-0.05, (1.0f64 - 0.0025).sqrt());
+        let exact_mu = (lambda * t).exp();
+        let mu = floquet_multipliers(&result.period_map.monodromy);
+        for m in &mu {
+            let error = (m - exact_mu).norm().min((m - exact_mu.conj()).norm());
+            assert!(error < 1e-6, "w = {w}: {m} vs {exact_mu}");
+        }
+    }
+}
+
+/// Past grazing at `w = 2` the period-one orbit impacts once per period and is stable
+/// (multipliers about 0.68 +- 0.05i). A time-domain run of 300 periods from the free steady
+/// state (no Newton, no sensitivities) must end on the shot orbit: contraction 0.69^300 is
+/// negligible, so the difference is the integration error, below 1e-8.
+#[test]
+fn impacting_orbit_agrees_with_a_long_time_domain_run() {
+    let w = 2.0;
+    let osc = oscillator(w, 1.1 * oscillator(w, 0.0).grazing_amplitude_closed_form());
+    let problem = HybridPeriodicProblem::new(osc, 1, Settings::default()).expect("problem");
+    let guess = osc.free_steady_state();
+    let shot = shoot(
+        &problem,
+        &guess,
+        osc.amplitude,
+        &NewtonSettings {
+            max_iterations: 30,
+            ..NewtonSettings::default()
+        },
+    )
+    .expect("shooting");
+    assert!(shot.converged, "{shot:?}");
+    assert_eq!(shot.period_map.structure.impacts, 1);
+    let mu = floquet_multipliers(&shot.period_map.monodromy);
+    assert!(mu.iter().all(|m| m.norm() < 0.75), "{mu:?}");
+    let t = 2.0 * std::f64::consts::PI / w;
+    let run = flow_map(
+        &osc,
+        0.0,
+        &guess,
+        300.0 * t,
+        Sensitivity::None,
+        &Settings::default(),
+    )
+    .expect("time-domain run");
+    for i in 0..2 {
+        assert!(
+            (run.state[i] - shot.state[i]).abs() < 1e-8,
+            "{:?} vs {:?}",
+            run.state,
+            shot.state
+        );
+    }
+    assert_eq!(problem.dim(), 2);
+}
+
+/// The continuation in `A` finds the first contact G1 at the closed-form grazing amplitude:
+/// within the location tolerance 1e-9 (the free orbit's minimum of `h` is integrated to
+/// ~1e-12, which moves the root by ~1e-12 / |dh_min/dA| <= 1e-11), and the closed form lies
+/// in the reported bracket up to that margin.
+#[test]
+fn grazing_amplitude_matches_the_closed_form() {
+    for w in [0.5, 0.8, 1.0, 1.2, 2.0] {
+        let osc = oscillator(w, 0.0);
+        let exact = osc.grazing_amplitude_closed_form();
+        let branch =
+            continue_in_amplitude(&osc, 2.0 * (1.0 + w * w + 0.1 * w), 400).expect("branch starts");
+        let a_g = first_grazing(&branch).unwrap_or_else(|| {
+            panic!(
+                "w = {w}: no G1; stop {:?} {:?}, special points {:?}",
+                branch.stop, branch.error, branch.special_points
+            )
+        });
+        let g1 = branch
+            .special_points
+            .iter()
+            .find(|s| s.kind == SpecialPointKind::Grazing)
+            .expect("G1");
+        assert_eq!(g1.label, "G1");
+        assert_eq!((g1.impacts_before, g1.impacts_after), (0, 1));
+        assert!(g1.converged && g1.precision <= 1e-9, "w = {w}: {g1:?}");
+        assert!(
+            (a_g - exact).abs() <= 1e-9,
+            "w = {w}: A_g = {a_g} vs {exact} (error {:e})",
+            a_g - exact
+        );
+        assert!(g1.bracket.0 - 1e-11 <= exact && exact <= g1.bracket.1 + 1e-11);
+        // Before G1 every orbit is free (no impact), after it the orbits impact.
+        for point in &branch.points {
+            if point.parameter < g1.bracket.0 && point.index <= g1.branch_index {
+                assert_eq!(point.structure.impacts, 0, "w = {w}: {}", point.parameter);
+            }
+        }
+    }
+}
