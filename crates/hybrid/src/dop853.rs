@@ -21,20 +21,31 @@ const MIN_FACTOR: f64 = 0.333;
 const MAX_FACTOR: f64 = 6.0;
 
 /// Workspace and results of DOP853 steps on an augmented state of length `dim`.
+///
+/// Stage derivatives are stored component-major (`stages[c * 16 + j]` is component `c` of
+/// stage `j`), so that every Runge-Kutta sum over stages is a short contiguous dot product.
 pub(crate) struct Dop853 {
     /// Length `N` of the augmented state.
     dim: usize,
     /// Number `n` of leading components under error control.
     controlled: usize,
-    /// Stage derivatives, `STAGES_EXTENDED` rows of length `dim`; row 0 holds `f(t, z)`, row 12
-    /// `f(t + h, z_new)` after [`Dop853::finish`].
+    /// Stage derivatives, component-major; stage 0 holds `f(t, z)`, stage 12 `f(t + h, z_new)`
+    /// after [`Dop853::derivative_at_end`].
     stages: Vec<f64>,
     /// Scratch stage argument.
     argument: Vec<f64>,
+    /// Scratch derivative written by the right-hand side.
+    derivative: Vec<f64>,
     /// Dense-output coefficients, 7 rows of length `dim`.
     dense: Vec<f64>,
     /// Step size of the last attempted step.
     pub h: f64,
+}
+
+/// `sum_j a_j k_j` over the leading entries.
+#[inline]
+fn dot(a: &[f64], k: &[f64]) -> f64 {
+    a.iter().zip(k).map(|(a, k)| a * k).sum()
 }
 
 impl Dop853 {
@@ -44,34 +55,47 @@ impl Dop853 {
             controlled,
             stages: vec![0.0; STAGES_EXTENDED * dim],
             argument: vec![0.0; dim],
+            derivative: vec![0.0; dim],
             dense: vec![0.0; 7 * dim],
             h: 0.0,
         }
     }
 
-    /// Stage row `i` (write).
-    pub fn stage_mut(&mut self, i: usize) -> &mut [f64] {
-        &mut self.stages[i * self.dim..(i + 1) * self.dim]
+    /// The stage derivatives of component `c` (16 values).
+    #[inline]
+    fn component(&self, c: usize) -> &[f64] {
+        &self.stages[c * STAGES_EXTENDED..(c + 1) * STAGES_EXTENDED]
+    }
+
+    /// Evaluate `rhs` at `(t, argument)` and store the result as stage `i` (components `0..m`).
+    fn evaluate_stage(&mut self, rhs: &mut Rhs<'_>, i: usize, t: f64, m: usize) {
+        rhs(t, &self.argument, &mut self.derivative);
+        for (c, &value) in self.derivative[..m].iter().enumerate() {
+            self.stages[c * STAGES_EXTENDED + i] = value;
+        }
+    }
+
+    /// Stage 0: `f(t, z)` (needed before [`Dop853::attempt`] unless reused from stage 12).
+    pub fn evaluate_first_stage(&mut self, rhs: &mut Rhs<'_>, t: f64, z: &[f64]) {
+        self.argument.copy_from_slice(z);
+        let dim = self.dim;
+        self.evaluate_stage(rhs, 0, t, dim);
     }
 
     /// Copy stage 12 (the derivative at the end of the last accepted step) to stage 0: the
     /// first-same-as-last property.
     pub fn reuse_last_derivative(&mut self) {
-        let (first, rest) = self.stages.split_at_mut(self.dim);
-        first.copy_from_slice(&rest[11 * self.dim..12 * self.dim]);
+        for row in self.stages.chunks_exact_mut(STAGES_EXTENDED) {
+            row[0] = row[12];
+        }
     }
 
     /// Form `argument = z + h sum_{j < i} a_ij k_j` on components `0..m`.
     fn stage_argument(&mut self, i: usize, z: &[f64], h: f64, m: usize) {
-        let dim = self.dim;
-        self.argument[..m].copy_from_slice(&z[..m]);
-        for (j, &a) in A[i][..i].iter().enumerate() {
-            if a != 0.0 {
-                let k = &self.stages[j * dim..j * dim + m];
-                for (y, &kj) in self.argument[..m].iter_mut().zip(k) {
-                    *y += h * a * kj;
-                }
-            }
+        let a = &A[i][..i];
+        for c in 0..m {
+            let k = &self.stages[c * STAGES_EXTENDED..c * STAGES_EXTENDED + i];
+            self.argument[c] = z[c] + h * dot(a, k);
         }
     }
 
@@ -94,18 +118,12 @@ impl Dop853 {
         self.h = h;
         for i in 1..STAGES {
             self.stage_argument(i, z, h, dim);
-            let (_, rest) = self.stages.split_at_mut(i * dim);
-            rhs(t + C[i] * h, &self.argument, &mut rest[..dim]);
+            self.evaluate_stage(rhs, i, t + C[i] * h, dim);
         }
         // z_new = z + h sum b_j k_j (b = row 12 of A).
-        z_new.copy_from_slice(z);
-        for (j, &b) in A[12][..STAGES].iter().enumerate() {
-            if b != 0.0 {
-                let k = &self.stages[j * dim..(j + 1) * dim];
-                for (y, &kj) in z_new.iter_mut().zip(k) {
-                    *y += h * b * kj;
-                }
-            }
+        let b = &A[12][..STAGES];
+        for c in 0..dim {
+            z_new[c] = z[c] + h * dot(b, &self.component(c)[..STAGES]);
         }
         // Error estimate on the controlled components (Hairer's err / err2 combination).
         let n = self.controlled;
@@ -113,13 +131,9 @@ impl Dop853 {
         let mut err3 = 0.0;
         for c in 0..n {
             let scale = atol + rtol * z[c].abs().max(z_new[c].abs());
-            let mut e5 = 0.0;
-            let mut e3 = 0.0;
-            for j in 0..STAGES {
-                let k = self.stages[j * dim + c];
-                e5 += E5[j] * k;
-                e3 += (A[12][j] - BHH[j]) * k;
-            }
+            let k = &self.component(c)[..STAGES];
+            let e5 = dot(&E5, k);
+            let e3 = dot(b, k) - dot(&BHH, k);
             err5 += (e5 / scale) * (e5 / scale);
             err3 += (e3 / scale) * (e3 / scale);
         }
@@ -146,9 +160,9 @@ impl Dop853 {
     /// Complete an accepted step to `z_new`: stage 12, the augmented derivative at the new point
     /// (reused as stage 0 of the next step, and needed by the dense output).
     pub fn derivative_at_end(&mut self, rhs: &mut Rhs<'_>, t: f64, z_new: &[f64]) {
+        self.argument.copy_from_slice(z_new);
         let dim = self.dim;
-        let row = &mut self.stages[12 * dim..13 * dim];
-        rhs(t + self.h, z_new, row);
+        self.evaluate_stage(rhs, 12, t + self.h, dim);
     }
 
     /// Dense-output stages 13..=15 and coefficients for components `0..m` (the state with
@@ -167,24 +181,18 @@ impl Dop853 {
             // The remaining components of the argument are left as they are: for m < dim the
             // caller's field reads only the state part.
             self.stage_argument(i, z, h, m);
-            let (_, rest) = self.stages.split_at_mut(i * dim);
-            rhs(t + C[i] * h, &self.argument, &mut rest[..dim]);
+            self.evaluate_stage(rhs, i, t + C[i] * h, m);
         }
         for c in 0..m {
+            let k = &self.stages[c * STAGES_EXTENDED..(c + 1) * STAGES_EXTENDED];
             let delta = z_new[c] - z[c];
-            let f0 = self.stages[c];
-            let f1 = self.stages[12 * dim + c];
+            let f0 = k[0];
+            let f1 = k[12];
             self.dense[c] = delta;
             self.dense[dim + c] = h * f0 - delta;
             self.dense[2 * dim + c] = 2.0 * delta - h * (f1 + f0);
             for (row, d) in D.iter().enumerate() {
-                let mut sum = 0.0;
-                for (j, &dj) in d.iter().enumerate() {
-                    if dj != 0.0 {
-                        sum += dj * self.stages[j * dim + c];
-                    }
-                }
-                self.dense[(3 + row) * dim + c] = h * sum;
+                self.dense[(3 + row) * dim + c] = h * dot(d, k);
             }
         }
     }
@@ -204,7 +212,8 @@ impl Dop853 {
     }
 
     /// Hairer's starting step (`hinit`, order 8): balances `0.01 / max(|f'|, |f|)^(1/8)` against
-    /// the scale of the solution. Stage 0 must hold `f(t, z)`; uses one evaluation of `rhs`.
+    /// the scale of the solution. Stage 0 must hold `f(t, z)`; uses one evaluation of `rhs`
+    /// (stored as stage 1, which the next attempt overwrites).
     pub fn initial_step(
         &mut self,
         rhs: &mut Rhs<'_>,
@@ -220,7 +229,7 @@ impl Dop853 {
         let mut dny = 0.0;
         for c in 0..n {
             let scale = atol + rtol * z[c].abs();
-            dnf += (self.stages[c] / scale).powi(2);
+            dnf += (self.component(c)[0] / scale).powi(2);
             dny += (z[c] / scale).powi(2);
         }
         let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
@@ -230,16 +239,14 @@ impl Dop853 {
         };
         h = h.min(max_step);
         for c in 0..dim {
-            self.argument[c] = z[c] + h * self.stages[c];
+            self.argument[c] = z[c] + h * self.component(c)[0];
         }
-        {
-            let row = &mut self.stages[dim..2 * dim];
-            rhs(t + h, &self.argument, row);
-        }
+        self.evaluate_stage(rhs, 1, t + h, dim);
         let mut der2 = 0.0;
         for c in 0..n {
             let scale = atol + rtol * z[c].abs();
-            der2 += ((self.stages[dim + c] - self.stages[c]) / scale).powi(2);
+            let k = self.component(c);
+            der2 += ((k[1] - k[0]) / scale).powi(2);
         }
         let der2 = der2.sqrt() / h;
         let der12 = der2.abs().max(dnf.sqrt());
@@ -271,7 +278,7 @@ mod tests {
         let mut t = 0.0;
         let mut f = rhs;
         for _ in 0..steps {
-            rhs(t, &z, rk.stage_mut(0));
+            rk.evaluate_first_stage(&mut f, t, &z);
             rk.attempt(&mut f, t, &z, h, &mut z_new, 1e-12, 1e-12);
             z = z_new;
             t += h;
@@ -304,7 +311,7 @@ mod tests {
             let z = [1.0, 0.0];
             let mut z_new = [0.0; 2];
             let mut f = rhs;
-            rhs(0.0, &z, rk.stage_mut(0));
+            rk.evaluate_first_stage(&mut f, 0.0, &z);
             rk.attempt(&mut f, 0.0, &z, h, &mut z_new, 1e-12, 1e-12);
             rk.derivative_at_end(&mut f, 0.0, &z_new);
             rk.dense_coefficients(&mut f, 0.0, &z, &z_new, 2);

@@ -551,7 +551,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             field.eval(system, mode, t, z, dz, true);
         };
         if !self.first_same_as_last {
-            rhs(t0, &self.z, self.rk.stage_mut(0));
+            self.rk.evaluate_first_stage(&mut rhs, t0, &self.z);
         }
         let mut h = match self.proposed_step {
             Some(h) => h,

@@ -62,7 +62,10 @@ fn hertz_contact_statistics_are_pinned() {
     }
 }
 
-/// Bouncing ball, 20 impacts (the run of `impact_times_match_geometric_series`).
+/// Bouncing ball, 20 impacts (the run of `impact_times_match_geometric_series`). The flight is
+/// a quadratic, so the local error estimates are at rounding level and the step count is
+/// sensitive to the order of floating-point sums (it changed from 24 to 25 when the stage
+/// sums became dot products).
 #[test]
 fn bouncing_ball_statistics_are_pinned() {
     let ball = BouncingBall {
@@ -83,10 +86,10 @@ fn bouncing_ball_statistics_are_pinned() {
     assert_eq!(
         result.statistics,
         Statistics {
-            steps: 24,
+            steps: 25,
             rejected_steps: 0,
             exact_steps: 0,
-            rhs_evaluations: 402,
+            rhs_evaluations: 417,
             events: 20,
         }
     );
