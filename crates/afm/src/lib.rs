@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 pub mod amplitude_ratio;
+pub mod bifurcation_diagram;
 pub mod cantilever;
 pub mod case;
 pub mod drive;
@@ -38,6 +39,10 @@ pub mod trigonometric;
 mod validation;
 
 pub use amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
+pub use bifurcation_diagram::{
+    approach_diagram, diagram, BifurcationDiagram, DiagramPoint, DiagramSettings,
+    DiagramSpecialPoint,
+};
 pub use cantilever::Cantilever;
 pub use case::{Case, CaseFile};
 pub use drive::Drive;

@@ -17,12 +17,16 @@ struct Cli {
 enum Command {
     /// The steady periodic orbit at one separation Z (or one amplitude ratio A/A0).
     Simulate(drumroll::simulate::SimulateArgs),
+    /// The bifurcation diagram in Z: periodic orbits continued from above first contact down
+    /// to a floor, grazing points G1, G2, G3, ..., folds and period doubling located.
+    Continue(drumroll::continue_diagram::ContinueArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Simulate(args) => drumroll::simulate::run(args),
+        Command::Continue(args) => drumroll::continue_diagram::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

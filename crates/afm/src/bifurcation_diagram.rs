@@ -1,0 +1,279 @@
+//! The bifurcation diagram of the tapping cantilever in the separation `Z`: the branch of
+//! periodic orbits continued by pseudo-arclength from the free orbit above first contact down to
+//! a floor (the paper's approach, Fig. 2), or back up (retract), with the observables of every
+//! branch point and every special point (grazing `G_n`, folds, period doubling, ...) located to
+//! `|dZ| < 1e-9 nm` (MODEL.md section 5).
+
+use continuation::{
+    BranchPoint, Continuation, ContinuationSettings, HybridPeriodicProblem, ParameterDirection,
+    Parametrised,
+    SpecialPoint, StopReason,
+};
+use nalgebra::Complex;
+use serde::Serialize;
+
+use crate::error::AfmError;
+use crate::model::TappingModel;
+use crate::observables::{orbit_observables, GapMinimum, OrbitObservables};
+use crate::separation::Separation;
+use crate::steady_orbit::SteadyOrbitSettings;
+
+/// How a diagram is computed. [`DiagramSettings::approach`] and [`DiagramSettings::retract`]
+/// give the defaults; every field is checked by [`DiagramSettings::validate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiagramSettings {
+    /// Integration and Newton settings of every orbit.
+    pub orbit: SteadyOrbitSettings,
+    /// Direction of `Z` at the start: decreasing for an approach, increasing for a retract.
+    pub direction: ParameterDirection,
+    /// The branch stops at this separation, nm (the floor of an approach or the ceiling of a
+    /// retract; a last point is computed exactly there).
+    pub z_limit_nm: f64,
+    /// An approach also stops once `A/A0` falls below this ratio (default 0.3). In `[0, 1)`.
+    pub min_amplitude_ratio: f64,
+    /// Largest arclength step in the `(x, Z)` space, nm and nm/us (default `A0 / 250`, so that
+    /// a diagram from first contact to `A/A0 = 0.3` has several hundred points). `> 0`.
+    pub max_step: f64,
+    /// Largest number of branch points (default 20000). `>= 2`.
+    pub max_points: usize,
+}
+
+impl DiagramSettings {
+    /// The approach of `model`: from `Z_G1 + 0.02 A0` down to `Z = 0.05 A0` or `A/A0 = 0.3`,
+    /// whichever comes first (the brief's floor: a small fraction of A0, or A/A0 = 0.3).
+    pub fn approach(model: &TappingModel) -> Self {
+        let a0 = model.free_amplitude_nm();
+        Self {
+            orbit: SteadyOrbitSettings::default(),
+            direction: ParameterDirection::Decreasing,
+            z_limit_nm: 0.05 * a0,
+            min_amplitude_ratio: 0.3,
+            max_step: a0 / 250.0,
+            max_points: 20_000,
+        }
+    }
+
+    /// The retract of `model`: from the lowest point of an approach up to above first contact.
+    pub fn retract(model: &TappingModel) -> Self {
+        let a0 = model.free_amplitude_nm();
+        Self {
+            direction: ParameterDirection::Increasing,
+            z_limit_nm: model.grazing_separation_nm() + 0.02 * a0,
+            min_amplitude_ratio: 0.0,
+            ..Self::approach(model)
+        }
+    }
+
+    /// Check every field against its documented range.
+    pub fn validate(&self) -> Result<(), AfmError> {
+        self.orbit.validate()?;
+        let invalid = |field: &str, value: String, allowed: &str| AfmError::InvalidField {
+            file: String::from("diagram settings"),
+            field: field.to_string(),
+            value,
+            allowed: allowed.to_string(),
+        };
+        if !self.z_limit_nm.is_finite() {
+            return Err(invalid("z_limit_nm", self.z_limit_nm.to_string(), "a finite separation, nm"));
+        }
+        if !(0.0..1.0).contains(&self.min_amplitude_ratio) {
+            return Err(invalid("min_amplitude_ratio", self.min_amplitude_ratio.to_string(), "0 <= ratio < 1"));
+        }
+        if !(self.max_step.is_finite() && self.max_step > 0.0) {
+            return Err(invalid("max_step", self.max_step.to_string(), "> 0, finite"));
+        }
+        if self.max_points < 2 {
+            return Err(invalid("max_points", self.max_points.to_string(), ">= 2"));
+        }
+        Ok(())
+    }
+}
+
+/// One point of the diagram: a periodic orbit at a separation, with its observables.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagramPoint {
+    /// Separation `Z`, nm.
+    pub z_nm: f64,
+    /// `A / A0` of the photodiode signal's first harmonic.
+    pub amplitude_ratio: f64,
+    /// Phase lag `Phi` of that harmonic, degrees.
+    pub phase_deg: f64,
+    /// Impacts per period.
+    pub impacts_per_period: usize,
+    /// Every local minimum of the gap over the period.
+    pub gap_minima: Vec<GapMinimum>,
+    /// Largest tip-sample force, nN.
+    pub peak_force_nn: f64,
+    /// Floquet multipliers `[re, im]`, by decreasing modulus.
+    pub floquet_multipliers: Vec<[f64; 2]>,
+    /// Whether every multiplier lies inside the unit circle.
+    pub stable: bool,
+    /// The orbit's state at `t = 0`, `[q_1, q_1', ..., q_N, q_N']` (nm, nm/us).
+    pub state: Vec<f64>,
+    /// Newton updates of the corrector at this point.
+    pub iterations: usize,
+    /// `|P(x) - x|` at this point (state units).
+    pub residual: f64,
+}
+
+/// A located special point with the observables of its orbit.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagramSpecialPoint {
+    /// `G1`, `G2`, ... (grazing onset of n impacts), `fold`, `period-doubling`,
+    /// `neimark-sacker`, `merge`, `split`, `impact-vanish`, `impact-appear`, ...
+    pub label: String,
+    /// Separation `Z` at the point, nm.
+    pub z_nm: f64,
+    /// `A / A0` there.
+    pub amplitude_ratio: f64,
+    /// Phase lag there, degrees.
+    pub phase_deg: f64,
+    /// Impacts per period on the side before the point (in the direction of continuation).
+    pub impacts_before: usize,
+    /// Impacts per period after it.
+    pub impacts_after: usize,
+    /// The final bracket `[Z_low, Z_high]` of the location, nm.
+    pub bracket_nm: [f64; 2],
+    /// Achieved precision of `Z`, nm.
+    pub precision_nm: f64,
+    /// Whether the location reached its tolerance.
+    pub converged: bool,
+    /// The orbit's state at the point.
+    pub state: Vec<f64>,
+}
+
+/// A computed diagram.
+#[derive(Debug, Clone, Serialize)]
+pub struct BifurcationDiagram {
+    /// Branch points in branch order.
+    pub points: Vec<DiagramPoint>,
+    /// Special points in branch order.
+    pub special_points: Vec<DiagramSpecialPoint>,
+    /// Why the branch ended, in words.
+    pub stop: String,
+    /// The error that ended the branch early, if any, in words.
+    pub error: Option<String>,
+}
+
+/// The approach diagram of `model` (its separation is ignored): the branch from the free orbit
+/// at `Z_G1 + 0.02 A0` with `Z` decreasing, continued through every grazing and fold.
+pub fn approach_diagram(model: &TappingModel, settings: &DiagramSettings) -> Result<BifurcationDiagram, AfmError> {
+    let z_start = model.grazing_separation_nm() + 0.02 * model.free_amplitude_nm();
+    diagram(model, &model.free_state(), z_start, settings)
+}
+
+/// The diagram of `model` continued from the periodic orbit near `x0` at `z_start` in the
+/// direction and to the limit of `settings`.
+pub fn diagram(
+    model: &TappingModel,
+    x0: &[f64],
+    z_start: f64,
+    settings: &DiagramSettings,
+) -> Result<BifurcationDiagram, AfmError> {
+    settings.validate()?;
+    let mut system = model.clone();
+    system.set_separation(Separation::Constant(z_start))?;
+    let problem = HybridPeriodicProblem::new(system.clone(), 1, settings.orbit.integration.clone())?;
+    let (parameter_min, parameter_max) = match settings.direction {
+        ParameterDirection::Decreasing => (settings.z_limit_nm, f64::INFINITY),
+        ParameterDirection::Increasing => (f64::NEG_INFINITY, settings.z_limit_nm),
+    };
+    let continuation_settings = ContinuationSettings {
+        initial_step: settings.max_step * 0.1,
+        max_step: settings.max_step,
+        direction: settings.direction,
+        parameter_min,
+        parameter_max,
+        max_points: settings.max_points,
+        corrector: settings.orbit.newton.clone(),
+        ..ContinuationSettings::default()
+    };
+    let a0 = model.free_amplitude_nm();
+    let min_ratio = settings.min_amplitude_ratio;
+    let integration = settings.orbit.integration.clone();
+    // Observables are computed once per point, inside the stop predicate, and kept.
+    let mut observed: Vec<Result<OrbitObservables, AfmError>> = Vec::new();
+    let branch = {
+        let observed = &mut observed;
+        let mut at_point = system.clone();
+        Continuation::new(&problem, x0, z_start, continuation_settings)?
+            .stop_when(move |point: &BranchPoint| {
+                at_point.set_parameter(point.parameter);
+                let observables = orbit_observables(&at_point, point.state.as_slice(), &integration);
+                let stop = match &observables {
+                    Ok(o) => o.amplitude_nm / a0 < min_ratio,
+                    Err(_) => true,
+                };
+                observed.push(observables);
+                stop
+            })
+            .run()
+    };
+    let mut points = Vec::with_capacity(branch.points.len());
+    for (point, observables) in branch.points.iter().zip(observed) {
+        points.push(diagram_point(point, &observables?));
+    }
+    let mut special_points = Vec::with_capacity(branch.special_points.len());
+    for special in &branch.special_points {
+        special_points.push(diagram_special_point(&system, special, &settings.orbit.integration)?);
+    }
+    Ok(BifurcationDiagram {
+        points,
+        special_points,
+        stop: stop_words(branch.stop),
+        error: branch.error.map(|e| e.to_string()),
+    })
+}
+
+fn stop_words(stop: StopReason) -> String {
+    match stop {
+        StopReason::MaxPoints => "the maximum number of points was reached",
+        StopReason::ParameterBound => "the separation limit was reached",
+        StopReason::UserStop => "the amplitude ratio fell below its floor",
+        StopReason::StepTooSmall => "the corrector failed at the smallest step",
+        StopReason::Error => "an error ended the branch",
+    }
+    .to_string()
+}
+
+fn multipliers_of(multipliers: &[Complex<f64>]) -> Vec<[f64; 2]> {
+    multipliers.iter().map(|m| [m.re, m.im]).collect()
+}
+
+fn diagram_point(point: &BranchPoint, observables: &OrbitObservables) -> DiagramPoint {
+    DiagramPoint {
+        z_nm: point.parameter,
+        amplitude_ratio: observables.amplitude_ratio,
+        phase_deg: observables.phase_deg,
+        impacts_per_period: observables.impacts.len(),
+        gap_minima: observables.gap_minima.clone(),
+        peak_force_nn: observables.peak_force_nn,
+        floquet_multipliers: multipliers_of(&point.multipliers),
+        stable: point.stable,
+        state: point.state.as_slice().to_vec(),
+        iterations: point.iterations,
+        residual: point.residual,
+    }
+}
+
+fn diagram_special_point(
+    system: &TappingModel,
+    special: &SpecialPoint,
+    integration: &hybrid::Settings,
+) -> Result<DiagramSpecialPoint, AfmError> {
+    let mut at_point = system.clone();
+    at_point.set_parameter(special.parameter);
+    let observables = orbit_observables(&at_point, special.state.as_slice(), integration)?;
+    Ok(DiagramSpecialPoint {
+        label: special.label.clone(),
+        z_nm: special.parameter,
+        amplitude_ratio: observables.amplitude_ratio,
+        phase_deg: observables.phase_deg,
+        impacts_before: special.impacts_before,
+        impacts_after: special.impacts_after,
+        bracket_nm: [special.bracket.0.min(special.bracket.1), special.bracket.0.max(special.bracket.1)],
+        precision_nm: special.precision,
+        converged: special.converged,
+        state: special.state.as_slice().to_vec(),
+    })
+}
