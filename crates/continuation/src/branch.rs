@@ -4,11 +4,24 @@
 //! Each step predicts along the unit tangent, `u_pred = u_A + ds t_A`, and corrects on the
 //! hyperplane `t_A . (u - u_pred) = 0` (Keller's pseudo-arclength method), so the branch goes
 //! on through folds and its unstable parts are computed too. The step grows after easy steps
-//! and is cut when the corrector fails, when the tangent turns by more than
-//! `max_tangent_angle`, or when two structure events (MODEL.md Sec. 5) fall in one step and can
-//! be separated. Every test function that changes sign between two accepted points is located
-//! by root finding along that step ([`crate::location`]); the branch then carries on from the
-//! ordinary point that ends the step, so it crosses every grazing by itself.
+//! and is cut when the corrector fails (or lands further than `ds` from the predictor), when
+//! the tangent turns by more than `max_tangent_angle`, when two structure events (MODEL.md
+//! Sec. 5) fall in one step and can be separated, or when the impact count changes with no
+//! extremum crossing zero (cut down to the minimum step, so that such a change is resolved as
+//! sharply as possible). Every test function that changes sign between two accepted points is
+//! located by root finding along that step (`location.rs`); the branch then carries on from
+//! the ordinary point that ends the step, so it crosses every grazing by itself.
+//!
+//! **Corners.** At the grazing of a *hard* impact (a reset map) the branch has a square-root
+//! corner (Nordmark): the impacting orbits move away from the grazing orbit like a power of
+//! the parameter distance below one, and the corrector cannot turn there. When the corrector
+//! keeps failing (six times, or at the minimum step) at a point where an extremum of the
+//! switching function is within `1e-3` of its value past the change, the continuation *jumps*:
+//! it shoots at fixed parameters `1e-4 .. 100` initial steps ahead and accepts the first orbit
+//! with the changed structure; the grazing is then located in the natural parameter. If no
+//! orbit exists past the corner (no period-one impacting orbit near grazing) the branch ends
+//! there with [`StopReason::StepTooSmall`], after locating the grazing it ran into between the
+//! last orbit and the first parameter without one.
 
 use nalgebra::{Complex, DVector};
 
@@ -517,6 +530,14 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 if separable && self.cut() {
                     continue;
                 }
+            }
+            // An impact count change that no extremum explains (for example a minimum born
+            // and through zero within the step): cut the step to resolve it.
+            let unexplained = structure
+                .iter()
+                .any(|t| matches!(t, StructureTest::ImpactCount { .. }));
+            if unexplained && !at_bound && !jumped && self.cut() {
+                continue;
             }
             let index = self.produced;
             let mut a = self.current.clone();
