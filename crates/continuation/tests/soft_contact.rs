@@ -1,0 +1,183 @@
+//! A forced oscillator against a soft (Hertz-like, `F = K (x - Z)^{3/2}`) wall at `x = Z`,
+//! continued in the wall position `Z` decreasing, as the AFM model is in the separation: the
+//! contact force is continuous, so the branch crosses grazing with the ordinary corrector.
+//! First contact G1 happens where the free steady state's maximum `A |G|` reaches `Z`.
+
+use std::cell::Cell;
+use std::time::Instant;
+
+use continuation::{
+    Continuation, ContinuationError, ContinuationSettings, HybridPeriodicProblem,
+    ParameterDirection, Parametrised, PeriodMap, PeriodicProblem, SpecialPointKind, StopReason,
+};
+use hybrid::{HybridSystem, Mode, Settings, SwitchingPartials};
+use nalgebra::DMatrix;
+
+/// `x'' + c x' + k x = A cos(w t) - K max(x - Z, 0)^{3/2}`, parameter `p = Z`, switching
+/// function `h = Z - x` (the gap), contact mode when `h < 0`.
+#[derive(Debug, Clone, Copy)]
+struct SoftWall {
+    k: f64,
+    c: f64,
+    w: f64,
+    amplitude: f64,
+    stiffness: f64,
+    wall: f64,
+}
+
+impl SoftWall {
+    /// `A |G|`, `G = 1 / (k - w^2 + i c w)`: the free steady-state amplitude.
+    fn free_amplitude(&self) -> f64 {
+        self.amplitude / ((self.k - self.w * self.w).powi(2) + (self.c * self.w).powi(2)).sqrt()
+    }
+}
+
+impl HybridSystem for SoftWall {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn surface_count(&self) -> usize {
+        1
+    }
+    fn vector_field(&self, mode: Mode, t: f64, x: &[f64], dxdt: &mut [f64]) {
+        dxdt[0] = x[1];
+        dxdt[1] = self.amplitude * (self.w * t).cos() - self.c * x[1] - self.k * x[0];
+        if mode & 1 != 0 {
+            let penetration = (x[0] - self.wall).max(0.0);
+            dxdt[1] -= self.stiffness * penetration.powf(1.5);
+        }
+    }
+    fn jacobian(&self, mode: Mode, _t: f64, x: &[f64], jacobian: &mut DMatrix<f64>) {
+        jacobian[(0, 0)] = 0.0;
+        jacobian[(0, 1)] = 1.0;
+        jacobian[(1, 0)] = -self.k;
+        jacobian[(1, 1)] = -self.c;
+        if mode & 1 != 0 {
+            let penetration = (x[0] - self.wall).max(0.0);
+            jacobian[(1, 0)] -= 1.5 * self.stiffness * penetration.sqrt();
+        }
+    }
+    fn parameter_derivative(&self, mode: Mode, _t: f64, x: &[f64], dfdp: &mut [f64]) {
+        dfdp[0] = 0.0;
+        dfdp[1] = 0.0;
+        if mode & 1 != 0 {
+            let penetration = (x[0] - self.wall).max(0.0);
+            dfdp[1] = 1.5 * self.stiffness * penetration.sqrt();
+        }
+    }
+    fn switching(&self, _k: usize, _t: f64, x: &[f64]) -> f64 {
+        self.wall - x[0]
+    }
+    fn switching_rate(&self, _k: usize, _mode: Mode, _t: f64, x: &[f64]) -> f64 {
+        -x[1]
+    }
+    fn switching_gradient(
+        &self,
+        _k: usize,
+        _t: f64,
+        _x: &[f64],
+        gradient: &mut [f64],
+    ) -> SwitchingPartials {
+        gradient[0] = -1.0;
+        gradient[1] = 0.0;
+        SwitchingPartials { t: 0.0, p: 1.0 }
+    }
+}
+
+impl Parametrised for SoftWall {
+    fn parameter(&self) -> f64 {
+        self.wall
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.wall = p;
+    }
+    fn period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.w
+    }
+}
+
+/// Counts the period-map evaluations of the problem it wraps.
+struct Counted<P> {
+    inner: P,
+    calls: Cell<usize>,
+}
+
+impl<P: PeriodicProblem> PeriodicProblem for Counted<P> {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError> {
+        self.calls.set(self.calls.get() + 1);
+        self.inner.period_map(x, p)
+    }
+}
+
+/// G1 at `Z = A |G|` to the location tolerance 1e-9 (the free orbit's maximum is integrated to
+/// ~1e-12 relative); the branch goes on in contact with one impact per period, minimum gap
+/// negative, down to the floor, and never fails.
+#[test]
+fn first_contact_of_a_soft_wall_at_the_free_amplitude() {
+    let system = SoftWall {
+        k: 1.0,
+        c: 0.3,
+        w: 0.9,
+        amplitude: 1.0,
+        stiffness: 50.0,
+        wall: 0.0,
+    };
+    let z_g = system.free_amplitude();
+    let mut start = system;
+    start.wall = 1.5 * z_g;
+    let problem = Counted {
+        inner: HybridPeriodicProblem::new(start, 1, Settings::default()).expect("problem"),
+        calls: Cell::new(0),
+    };
+    let settings = ContinuationSettings {
+        initial_step: 0.05,
+        max_step: 0.05,
+        direction: ParameterDirection::Decreasing,
+        parameter_min: 0.5 * z_g,
+        ..ContinuationSettings::default()
+    };
+    let started = Instant::now();
+    let branch = Continuation::new(&problem, &[0.0, 0.0], start.wall, settings)
+        .expect("start")
+        .run();
+    let elapsed = started.elapsed();
+    assert_eq!(
+        branch.stop,
+        StopReason::ParameterBound,
+        "{:?}",
+        branch.error
+    );
+    let calls = problem.calls.get();
+    eprintln!(
+        "{} points, {} period maps ({:.1} per point), {:.3} ms per point",
+        branch.points.len(),
+        calls,
+        calls as f64 / branch.points.len() as f64,
+        elapsed.as_secs_f64() * 1e3 / branch.points.len() as f64
+    );
+    let grazings: Vec<_> = branch
+        .special_points
+        .iter()
+        .filter(|s| s.kind == SpecialPointKind::Grazing)
+        .collect();
+    assert_eq!(grazings.len(), 1, "{:?}", branch.special_points);
+    let g1 = grazings[0];
+    assert_eq!(g1.label, "G1");
+    assert!(g1.converged && g1.precision <= 1e-9, "{g1:?}");
+    assert!(
+        (g1.parameter - z_g).abs() < 1e-9,
+        "{} vs {z_g}",
+        g1.parameter
+    );
+    for point in &branch.points {
+        if point.parameter < z_g - 1e-6 {
+            assert_eq!(point.structure.impacts, 1, "Z = {}", point.parameter);
+            assert!(point.structure.minima.iter().any(|m| m.1 < 0.0));
+        } else if point.parameter > z_g + 1e-6 {
+            assert_eq!(point.structure.impacts, 0, "Z = {}", point.parameter);
+        }
+    }
+}
