@@ -6,8 +6,7 @@
 
 use continuation::{
     BranchPoint, Continuation, ContinuationSettings, HybridPeriodicProblem, ParameterDirection,
-    Parametrised,
-    SpecialPoint, StopReason,
+    Parametrised, SpecialPoint, SpecialPointKind, StopReason,
 };
 use nalgebra::Complex;
 use serde::Serialize;
@@ -74,13 +73,25 @@ impl DiagramSettings {
             allowed: allowed.to_string(),
         };
         if !self.z_limit_nm.is_finite() {
-            return Err(invalid("z_limit_nm", self.z_limit_nm.to_string(), "a finite separation, nm"));
+            return Err(invalid(
+                "z_limit_nm",
+                self.z_limit_nm.to_string(),
+                "a finite separation, nm",
+            ));
         }
         if !(0.0..1.0).contains(&self.min_amplitude_ratio) {
-            return Err(invalid("min_amplitude_ratio", self.min_amplitude_ratio.to_string(), "0 <= ratio < 1"));
+            return Err(invalid(
+                "min_amplitude_ratio",
+                self.min_amplitude_ratio.to_string(),
+                "0 <= ratio < 1",
+            ));
         }
         if !(self.max_step.is_finite() && self.max_step > 0.0) {
-            return Err(invalid("max_step", self.max_step.to_string(), "> 0, finite"));
+            return Err(invalid(
+                "max_step",
+                self.max_step.to_string(),
+                "> 0, finite",
+            ));
         }
         if self.max_points < 2 {
             return Err(invalid("max_points", self.max_points.to_string(), ">= 2"));
@@ -119,7 +130,8 @@ pub struct DiagramPoint {
 /// A located special point with the observables of its orbit.
 #[derive(Debug, Clone, Serialize)]
 pub struct DiagramSpecialPoint {
-    /// `G1`, `G2`, ... (grazing onset of n impacts), `fold`, `period-doubling`,
+    /// `G1`, `G2`, ... (grazing onset of n impacts on approach; the same name when met on a
+    /// retract), `fold`, `period-doubling`,
     /// `neimark-sacker`, `merge`, `split`, `impact-vanish`, `impact-appear`, ...
     pub label: String,
     /// Separation `Z` at the point, nm.
@@ -155,9 +167,46 @@ pub struct BifurcationDiagram {
     pub error: Option<String>,
 }
 
+impl BifurcationDiagram {
+    /// The separation ranges where the branch holds two or more stable orbits at the same `Z`
+    /// (hysteresis: an approach and a retract follow different ones there), as sorted
+    /// `[Z_low, Z_high]` intervals, nm. Computed from the branch's stable segments (consecutive
+    /// stable points): a `Z` covered by two or more of them is bistable.
+    pub fn bistable_ranges(&self) -> Vec<[f64; 2]> {
+        let segments: Vec<[f64; 2]> = self
+            .points
+            .windows(2)
+            .filter(|w| w[0].stable && w[1].stable)
+            .map(|w| [w[0].z_nm.min(w[1].z_nm), w[0].z_nm.max(w[1].z_nm)])
+            .collect();
+        let mut edges: Vec<f64> = self.points.iter().map(|p| p.z_nm).collect();
+        edges.sort_by(f64::total_cmp);
+        edges.dedup();
+        let mut ranges: Vec<[f64; 2]> = Vec::new();
+        for pair in edges.windows(2) {
+            let middle = 0.5 * (pair[0] + pair[1]);
+            let cover = segments
+                .iter()
+                .filter(|s| s[0] < middle && middle < s[1])
+                .count();
+            if cover < 2 {
+                continue;
+            }
+            match ranges.last_mut() {
+                Some(last) if last[1] == pair[0] => last[1] = pair[1],
+                _ => ranges.push([pair[0], pair[1]]),
+            }
+        }
+        ranges
+    }
+}
+
 /// The approach diagram of `model` (its separation is ignored): the branch from the free orbit
 /// at `Z_G1 + 0.02 A0` with `Z` decreasing, continued through every grazing and fold.
-pub fn approach_diagram(model: &TappingModel, settings: &DiagramSettings) -> Result<BifurcationDiagram, AfmError> {
+pub fn approach_diagram(
+    model: &TappingModel,
+    settings: &DiagramSettings,
+) -> Result<BifurcationDiagram, AfmError> {
     let z_start = model.grazing_separation_nm() + 0.02 * model.free_amplitude_nm();
     diagram(model, &model.free_state(), z_start, settings)
 }
@@ -173,7 +222,8 @@ pub fn diagram(
     settings.validate()?;
     let mut system = model.clone();
     system.set_separation(Separation::Constant(z_start))?;
-    let problem = HybridPeriodicProblem::new(system.clone(), 1, settings.orbit.integration.clone())?;
+    let problem =
+        HybridPeriodicProblem::new(system.clone(), 1, settings.orbit.integration.clone())?;
     let (parameter_min, parameter_max) = match settings.direction {
         ParameterDirection::Decreasing => (settings.z_limit_nm, f64::INFINITY),
         ParameterDirection::Increasing => (f64::NEG_INFINITY, settings.z_limit_nm),
@@ -199,7 +249,8 @@ pub fn diagram(
         Continuation::new(&problem, x0, z_start, continuation_settings)?
             .stop_when(move |point: &BranchPoint| {
                 at_point.set_parameter(point.parameter);
-                let observables = orbit_observables(&at_point, point.state.as_slice(), &integration);
+                let observables =
+                    orbit_observables(&at_point, point.state.as_slice(), &integration);
                 let stop = match &observables {
                     Ok(o) => o.amplitude_nm / a0 < min_ratio,
                     Err(_) => true,
@@ -215,7 +266,11 @@ pub fn diagram(
     }
     let mut special_points = Vec::with_capacity(branch.special_points.len());
     for special in &branch.special_points {
-        special_points.push(diagram_special_point(&system, special, &settings.orbit.integration)?);
+        special_points.push(diagram_special_point(
+            &system,
+            special,
+            &settings.orbit.integration,
+        )?);
     }
     Ok(BifurcationDiagram {
         points,
@@ -264,14 +319,26 @@ fn diagram_special_point(
     let mut at_point = system.clone();
     at_point.set_parameter(special.parameter);
     let observables = orbit_observables(&at_point, special.state.as_slice(), integration)?;
+    // A grazing is named after the impact count on its impacting side, whichever way the
+    // branch runs: G_n is the onset of n impacts per period on approach (MODEL.md section 5),
+    // and the same point met on a retract (n -> n - 1) keeps its name.
+    let label = match special.kind {
+        SpecialPointKind::Grazing => {
+            format!("G{}", special.impacts_before.max(special.impacts_after))
+        }
+        _ => special.label.clone(),
+    };
     Ok(DiagramSpecialPoint {
-        label: special.label.clone(),
+        label,
         z_nm: special.parameter,
         amplitude_ratio: observables.amplitude_ratio,
         phase_deg: observables.phase_deg,
         impacts_before: special.impacts_before,
         impacts_after: special.impacts_after,
-        bracket_nm: [special.bracket.0.min(special.bracket.1), special.bracket.0.max(special.bracket.1)],
+        bracket_nm: [
+            special.bracket.0.min(special.bracket.1),
+            special.bracket.0.max(special.bracket.1),
+        ],
         precision_nm: special.precision,
         converged: special.converged,
         state: special.state.as_slice().to_vec(),

@@ -2,7 +2,9 @@
 //! periodic orbits from above first contact down to a floor, every special point labelled and
 //! located, and optionally the retract branch back up.
 
-use afm::{approach_diagram, diagram, BifurcationDiagram, DiagramPoint, DiagramSettings, TappingModel};
+use afm::{
+    approach_diagram, diagram, BifurcationDiagram, DiagramPoint, DiagramSettings, TappingModel,
+};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
@@ -48,8 +50,16 @@ pub struct ContinueArgs {
 /// Run `drumroll continue`.
 pub fn run(args: &ContinueArgs) -> Result<()> {
     let (case, model) = args.model.model()?;
-    let csv_path = args.csv.as_ref().map(|p| output_path(p, "csv", "--csv")).transpose()?;
-    let plot_path = args.plot.as_ref().map(|p| output_path(p, "svg", "--plot")).transpose()?;
+    let csv_path = args
+        .csv
+        .as_ref()
+        .map(|p| output_path(p, "csv", "--csv"))
+        .transpose()?;
+    let plot_path = args
+        .plot
+        .as_ref()
+        .map(|p| output_path(p, "svg", "--plot"))
+        .transpose()?;
     let mut settings = DiagramSettings::approach(&model);
     if let Some(floor) = args.floor {
         if !floor.is_finite() || floor >= model.grazing_separation_nm() {
@@ -61,27 +71,47 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         settings.z_limit_nm = floor;
     }
     if !(0.0..1.0).contains(&args.min_amplitude_ratio) {
-        bail!("--min-amplitude-ratio {}: allowed 0 <= R < 1", args.min_amplitude_ratio);
+        bail!(
+            "--min-amplitude-ratio {}: allowed 0 <= R < 1",
+            args.min_amplitude_ratio
+        );
     }
     settings.min_amplitude_ratio = args.min_amplitude_ratio;
     if let Some(step) = args.max_step {
         if !(step.is_finite() && step > 0.0 && step <= model.free_amplitude_nm()) {
-            bail!("--max-step {step}: allowed 0 < step <= A0 = {} nm", model.free_amplitude_nm());
+            bail!(
+                "--max-step {step}: allowed 0 < step <= A0 = {} nm",
+                model.free_amplitude_nm()
+            );
         }
         settings.max_step = step;
     }
     let approach = approach_diagram(&model, &settings)
         .with_context(|| format!("continuation of case `{}` failed", case.name))?;
     let retract = if args.retract {
-        let Some(lowest) = approach.points.iter().min_by(|a, b| a.z_nm.total_cmp(&b.z_nm)) else {
+        let Some(lowest) = approach
+            .points
+            .iter()
+            .min_by(|a, b| a.z_nm.total_cmp(&b.z_nm))
+        else {
             bail!("the approach produced no point to retract from");
         };
-        let retract_settings = DiagramSettings { max_step: settings.max_step, ..DiagramSettings::retract(&model) };
-        Some(diagram(&model, &lowest.state, lowest.z_nm, &retract_settings).context("retract continuation failed")?)
+        let retract_settings = DiagramSettings {
+            max_step: settings.max_step,
+            ..DiagramSettings::retract(&model)
+        };
+        Some(
+            diagram(&model, &lowest.state, lowest.z_nm, &retract_settings)
+                .context("retract continuation failed")?,
+        )
     } else {
         None
     };
-    let bistable = retract.as_ref().and_then(|r| bistable_range(&approach, r));
+    let bistable = retract.as_ref().map(|retract| {
+        let mut ranges = approach.bistable_ranges();
+        ranges.extend(retract.bistable_ranges());
+        merge_ranges(ranges)
+    });
     if args.json {
         let mut object = json!({
             "case": case.name,
@@ -99,40 +129,64 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
                 "stop": retract.stop,
                 "error": retract.error,
             });
-            object["bistable_range_nm"] = json!(bistable);
+            object["bistable_ranges_nm"] = json!(bistable);
         }
         println!("{}", serde_json::to_string(&object)?);
     } else {
         print!("{}", table(&case.name, &model, "approach", &approach));
         if let Some(retract) = &retract {
             print!("{}", table(&case.name, &model, "retract", retract));
-            match bistable {
-                Some([low, high]) => println!(
-                    "bistable range: Z in [{low:.6}, {high:.6}] nm (approach and retract branches differ there)"
-                ),
-                None => println!("no bistable range: approach and retract agree"),
+            match bistable.as_deref() {
+                Some([]) | None => {
+                    println!("no bistable range: approach and retract follow one stable orbit")
+                }
+                Some(ranges) => {
+                    for [low, high] in ranges {
+                        println!(
+                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)"
+                        );
+                    }
+                }
             }
         }
     }
     if let Some(path) = csv_path {
         let mut text = csv_text(&approach, "approach");
         if let Some(retract) = &retract {
-            text.push_str(csv_text(retract, "retract").split_once('\n').map_or("", |(_, rows)| rows));
+            text.push_str(
+                csv_text(retract, "retract")
+                    .split_once('\n')
+                    .map_or("", |(_, rows)| rows),
+            );
         }
         write_atomically(&path, text.as_bytes())?;
     }
     if let Some(path) = plot_path {
-        let svg = render_svg(&panels(&model, &approach, retract.as_ref()), 1, 3, (520, 440))?;
+        let svg = render_svg(
+            &panels(&model, &approach, retract.as_ref()),
+            1,
+            3,
+            (520, 440),
+        )?;
         write_atomically(&path, svg.as_bytes())?;
     }
     Ok(())
 }
 
 /// The readable table of special points of one diagram.
-fn table(case: &str, model: &TappingModel, direction: &str, diagram: &BifurcationDiagram) -> String {
+fn table(
+    case: &str,
+    model: &TappingModel,
+    direction: &str,
+    diagram: &BifurcationDiagram,
+) -> String {
     let mut s = String::new();
     let z: Vec<f64> = diagram.points.iter().map(|p| p.z_nm).collect();
-    let (low, high) = z.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &z| (l.min(z), h.max(z)));
+    let (low, high) = z
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &z| {
+            (l.min(z), h.max(z))
+        });
     let _ = writeln!(
         s,
         "case {case} ({direction}): A0 = {} nm, first contact Z_G1 = {:.9} nm; {} branch points, Z from {high:.4} to {low:.4} nm; {}",
@@ -144,7 +198,11 @@ fn table(case: &str, model: &TappingModel, direction: &str, diagram: &Bifurcatio
     if let Some(error) = &diagram.error {
         let _ = writeln!(s, "  the branch ended early: {error}");
     }
-    let _ = writeln!(s, "{:<16} {:>16} {:>10} {:>10} {:>8} {:>10} {:>10}", "label", "Z (nm)", "A/A0", "phase", "impacts", "|dZ| (nm)", "located");
+    let _ = writeln!(
+        s,
+        "{:<16} {:>16} {:>10} {:>10} {:>8} {:>10} {:>10}",
+        "label", "Z (nm)", "A/A0", "phase", "impacts", "|dZ| (nm)", "located"
+    );
     for p in &diagram.special_points {
         let _ = writeln!(
             s,
@@ -162,52 +220,54 @@ fn table(case: &str, model: &TappingModel, direction: &str, diagram: &Bifurcatio
     s
 }
 
-/// The separation range where the approach and retract branches hold different stable orbits:
-/// the union of the `Z` where the two differ in `A/A0` by more than 1e-6 at the same `Z`,
-/// comparing stable points only (linear interpolation along each branch).
-fn bistable_range(approach: &BifurcationDiagram, retract: &BifurcationDiagram) -> Option<[f64; 2]> {
-    let stable_ratio_at = |diagram: &BifurcationDiagram, z: f64| -> Vec<f64> {
-        diagram
-            .points
-            .windows(2)
-            .filter(|w| w[0].stable && w[1].stable)
-            .filter(|w| (w[0].z_nm - z) * (w[1].z_nm - z) <= 0.0 && w[0].z_nm != w[1].z_nm)
-            .map(|w| {
-                let s = (z - w[0].z_nm) / (w[1].z_nm - w[0].z_nm);
-                w[0].amplitude_ratio + s * (w[1].amplitude_ratio - w[0].amplitude_ratio)
-            })
-            .collect()
-    };
-    let mut range: Option<[f64; 2]> = None;
-    for point in approach.points.iter().filter(|p| p.stable) {
-        let others = stable_ratio_at(retract, point.z_nm);
-        if others.iter().any(|r| (r - point.amplitude_ratio).abs() > 1e-6) {
-            range = Some(match range {
-                Some([l, h]) => [l.min(point.z_nm), h.max(point.z_nm)],
-                None => [point.z_nm, point.z_nm],
-            });
+/// Sort and merge overlapping `[low, high]` ranges.
+fn merge_ranges(mut ranges: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    ranges.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let mut merged: Vec<[f64; 2]> = Vec::new();
+    for range in ranges {
+        match merged.last_mut() {
+            Some(last) if range[0] <= last[1] => last[1] = last[1].max(range[1]),
+            _ => merged.push(range),
         }
     }
-    range
+    merged
 }
 
 /// The CSV of a diagram's points (header line first).
 fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> String {
     let mut text = String::from("direction,z_nm,amplitude_ratio,phase_deg,impacts_per_period,stable,peak_force_nn,min_gap_nm,spectral_radius\n");
     for p in &diagram.points {
-        let min_gap = p.gap_minima.iter().map(|m| m.gap_nm).fold(f64::INFINITY, f64::min);
-        let radius = p.floquet_multipliers.iter().map(|m| m[0].hypot(m[1])).fold(0.0, f64::max);
+        let min_gap = p
+            .gap_minima
+            .iter()
+            .map(|m| m.gap_nm)
+            .fold(f64::INFINITY, f64::min);
+        let radius = p
+            .floquet_multipliers
+            .iter()
+            .map(|m| m[0].hypot(m[1]))
+            .fold(0.0, f64::max);
         let _ = writeln!(
             text,
             "{direction},{},{},{},{},{},{},{},{}",
-            p.z_nm, p.amplitude_ratio, p.phase_deg, p.impacts_per_period, p.stable, p.peak_force_nn, min_gap, radius
+            p.z_nm,
+            p.amplitude_ratio,
+            p.phase_deg,
+            p.impacts_per_period,
+            p.stable,
+            p.peak_force_nn,
+            min_gap,
+            radius
         );
     }
     text
 }
 
 /// Split a diagram's points into runs of equal stability, as polylines of `(x, y)`.
-fn runs(points: &[DiagramPoint], xy: impl Fn(&DiagramPoint) -> (f64, f64)) -> Vec<(bool, Vec<(f64, f64)>)> {
+fn runs(
+    points: &[DiagramPoint],
+    xy: impl Fn(&DiagramPoint) -> (f64, f64),
+) -> Vec<(bool, Vec<(f64, f64)>)> {
     let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
     for p in points {
         match runs.last_mut() {
@@ -233,28 +293,47 @@ fn branch_series(
         .into_iter()
         .enumerate()
         .map(|(i, (stable, points))| Series {
-            label: if i == 0 { label.to_string() } else { String::new() },
+            label: if i == 0 {
+                label.to_string()
+            } else {
+                String::new()
+            },
             points,
-            stroke: if stable { Stroke::Solid } else { Stroke::Dashed },
+            stroke: if stable {
+                Stroke::Solid
+            } else {
+                Stroke::Dashed
+            },
             colour,
         })
         .collect()
 }
 
 /// The three panels of the figure.
-fn panels(model: &TappingModel, approach: &BifurcationDiagram, retract: Option<&BifurcationDiagram>) -> Vec<Panel> {
-    let diagrams: Vec<(&BifurcationDiagram, &str, usize)> = std::iter::once((approach, "approach", 0))
-        .chain(retract.map(|r| (r, "retract", 1)))
-        .collect();
+fn panels(
+    model: &TappingModel,
+    approach: &BifurcationDiagram,
+    retract: Option<&BifurcationDiagram>,
+) -> Vec<Panel> {
+    let diagrams: Vec<(&BifurcationDiagram, &str, usize)> =
+        std::iter::once((approach, "approach", 0))
+            .chain(retract.map(|r| (r, "retract", 1)))
+            .collect();
     let phase_markers = approach
         .special_points
         .iter()
-        .map(|p| Marker { label: p.label.clone(), at: (p.amplitude_ratio, p.phase_deg) })
+        .map(|p| Marker {
+            label: p.label.clone(),
+            at: (p.amplitude_ratio, p.phase_deg),
+        })
         .collect();
     let z_markers = approach
         .special_points
         .iter()
-        .map(|p| Marker { label: p.label.clone(), at: (p.z_nm, p.amplitude_ratio) })
+        .map(|p| Marker {
+            label: p.label.clone(),
+            at: (p.z_nm, p.amplitude_ratio),
+        })
         .collect();
     let title = format!("A0 = {} nm (dashed: unstable)", model.free_amplitude_nm());
     vec![
@@ -262,14 +341,20 @@ fn panels(model: &TappingModel, approach: &BifurcationDiagram, retract: Option<&
             title: format!("phase vs A/A0, {title}"),
             x_label: String::from("A/A0"),
             y_label: String::from("phase (deg)"),
-            series: diagrams.iter().flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.amplitude_ratio, p.phase_deg))).collect(),
+            series: diagrams
+                .iter()
+                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.amplitude_ratio, p.phase_deg)))
+                .collect(),
             markers: phase_markers,
         },
         Panel {
             title: String::from("A/A0 vs Z"),
             x_label: String::from("Z (nm)"),
             y_label: String::from("A/A0"),
-            series: diagrams.iter().flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.amplitude_ratio))).collect(),
+            series: diagrams
+                .iter()
+                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.amplitude_ratio)))
+                .collect(),
             markers: z_markers,
         },
         Panel {
@@ -278,7 +363,9 @@ fn panels(model: &TappingModel, approach: &BifurcationDiagram, retract: Option<&
             y_label: String::from("impacts per period"),
             series: diagrams
                 .iter()
-                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.impacts_per_period as f64)))
+                .flat_map(|(d, l, c)| {
+                    branch_series(d, l, *c, |p| (p.z_nm, p.impacts_per_period as f64))
+                })
                 .collect(),
             markers: Vec::new(),
         },
