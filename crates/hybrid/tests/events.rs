@@ -359,3 +359,72 @@ fn step_to_current_time_reports_nothing() {
     assert_eq!(solver.step(event_time), Ok(StepOutcome::EndTime));
     assert!(solver.step_extrema().is_empty());
 }
+
+/// Three surfaces, two of them crossed at the same instants (`h2 = -h0`). From `(1, 0)` over
+/// `2 pi + 0.5`: `h0` up and `h2` down at `pi/3`, `h1` up at `pi + asin 0.2`, `h0` down and
+/// `h2` up at `5 pi / 3`, `h1` down at `2 pi - asin 0.2` (closed form). Every event fires
+/// exactly once, in time order, and the final mode matches the side of every surface.
+#[test]
+fn several_surfaces_and_simultaneous_crossings() {
+    use common::ThreeSurfaces;
+    use hybrid::HybridSystem;
+    let x0 = [1.0, 0.0];
+    let result = flow_map(
+        &ThreeSurfaces,
+        0.0,
+        &x0,
+        2.0 * PI + 0.5,
+        Sensitivity::Transition,
+        &Settings::default(),
+    )
+    .expect("integration succeeds");
+    let s = 0.2f64.asin();
+    let mut expected = [
+        (PI / 3.0, 0, Direction::Up),
+        (PI / 3.0, 2, Direction::Down),
+        (PI + s, 1, Direction::Up),
+        (5.0 * PI / 3.0, 0, Direction::Down),
+        (5.0 * PI / 3.0, 2, Direction::Up),
+        (2.0 * PI - s, 1, Direction::Down),
+    ];
+    assert_eq!(result.events.len(), expected.len(), "{:?}", result.events);
+    let mut found: Vec<_> = result
+        .events
+        .iter()
+        .map(|e| (e.t, e.surface, e.direction))
+        .collect();
+    assert!(found.windows(2).all(|w| w[0].0 <= w[1].0), "time order");
+    // Simultaneous events may come in either surface order: compare sorted by (time bucket,
+    // surface).
+    found.sort_by(|a, b| {
+        (a.0 * 1e6)
+            .round()
+            .total_cmp(&(b.0 * 1e6).round())
+            .then(a.1.cmp(&b.1))
+    });
+    expected.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (f, e) in found.iter().zip(&expected) {
+        // Crossing rates are >= 0.5 and the state is accurate to ~1e-12: times to 1e-9.
+        assert!(
+            (f.0 - e.0).abs() < 1e-9 && f.1 == e.1 && f.2 == e.2,
+            "{f:?} vs {e:?}"
+        );
+    }
+    // The mode after the run is the side of every surface at the final state.
+    let t_end = 2.0 * PI + 0.5;
+    let mut solver = Solver::new(
+        &ThreeSurfaces,
+        0.0,
+        &x0,
+        Sensitivity::None,
+        Settings::default(),
+    )
+    .expect("valid");
+    while solver.step(t_end).expect("integration succeeds") != StepOutcome::EndTime {}
+    assert_eq!(solver.mode(), ThreeSurfaces.mode_of(t_end, solver.state()));
+    assert_eq!(solver.mode(), 0b011, "h0 < 0, h1 < 0, h2 > 0 at 2 pi + 0.5");
+    // Saltation is the identity (same field everywhere): the transition is the rotation.
+    let (sn, cs) = t_end.sin_cos();
+    assert!((result.transition[(0, 0)] - cs).abs() < 1e-10);
+    assert!((result.transition[(0, 1)] - sn).abs() < 1e-10);
+}

@@ -463,3 +463,56 @@ impl HybridSystem for ImpactOscillator {
         dxdp.fill(0.0);
     }
 }
+
+/// Rotation `u = cos t, v = -sin t` with three switching functions:
+/// `h0 = 0.5 - u`, `h1 = v - 0.2`, `h2 = u - 0.5` (`h2 = -h0`: both cross at the same instants,
+/// in opposite directions). The field is the same in every mode.
+#[derive(Clone, Copy, Debug)]
+pub struct ThreeSurfaces;
+
+impl HybridSystem for ThreeSurfaces {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn surface_count(&self) -> usize {
+        3
+    }
+    fn vector_field(&self, _mode: Mode, _t: f64, x: &[f64], dxdt: &mut [f64]) {
+        dxdt[0] = x[1];
+        dxdt[1] = -x[0];
+    }
+    fn jacobian(&self, _mode: Mode, _t: f64, _x: &[f64], j: &mut DMatrix<f64>) {
+        j[(0, 0)] = 0.0;
+        j[(0, 1)] = 1.0;
+        j[(1, 0)] = -1.0;
+        j[(1, 1)] = 0.0;
+    }
+    fn switching(&self, k: usize, _t: f64, x: &[f64]) -> f64 {
+        match k {
+            0 => 0.5 - x[0],
+            1 => x[1] - 0.2,
+            _ => x[0] - 0.5,
+        }
+    }
+    fn switching_rate(&self, k: usize, _mode: Mode, _t: f64, x: &[f64]) -> f64 {
+        match k {
+            0 => -x[1],
+            1 => -x[0],
+            _ => x[1],
+        }
+    }
+    fn switching_gradient(
+        &self,
+        k: usize,
+        _t: f64,
+        _x: &[f64],
+        g: &mut [f64],
+    ) -> SwitchingPartials {
+        match k {
+            0 => g.copy_from_slice(&[-1.0, 0.0]),
+            1 => g.copy_from_slice(&[0.0, 1.0]),
+            _ => g.copy_from_slice(&[1.0, 0.0]),
+        }
+        SwitchingPartials::default()
+    }
+}
