@@ -12,6 +12,42 @@
 //!   [`BranchPoint`]s, which detects and locates [`SpecialPoint`]s: folds, period doubling,
 //!   Neimark-Sacker, grazing `G<n>` (a minimum of the gap through zero), merging and
 //!   splitting of impacts, and impact-count changes that are not grazing.
+//!
+//! ```
+//! use continuation::{
+//!     Continuation, ContinuationError, ContinuationSettings, OrbitStructure, PeriodMap,
+//!     PeriodicProblem,
+//! };
+//! use nalgebra::{DMatrix, DVector};
+//!
+//! /// `P(x; p) = x + p - x^2`: fixed points `x = +-sqrt(p)`, a fold at `p = 0`.
+//! struct Quadratic;
+//!
+//! impl PeriodicProblem for Quadratic {
+//!     fn dim(&self) -> usize {
+//!         1
+//!     }
+//!     fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError> {
+//!         Ok(PeriodMap {
+//!             image: DVector::from_element(1, x[0] + p - x[0] * x[0]),
+//!             monodromy: DMatrix::from_element(1, 1, 1.0 - 2.0 * x[0]),
+//!             parameter_derivative: DVector::from_element(1, 1.0),
+//!             structure: OrbitStructure::default(),
+//!         })
+//!     }
+//! }
+//!
+//! let settings = ContinuationSettings {
+//!     direction: continuation::ParameterDirection::Decreasing,
+//!     parameter_max: 0.5,
+//!     ..ContinuationSettings::default()
+//! };
+//! let branch = Continuation::new(&Quadratic, &[-0.5], 0.25, settings)?.run();
+//! let fold = &branch.special_points[0];
+//! assert_eq!(fold.label, "fold");
+//! assert!(fold.parameter.abs() < 1e-9 && fold.converged);
+//! # Ok::<(), ContinuationError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod branch;

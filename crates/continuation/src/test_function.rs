@@ -209,3 +209,55 @@ impl StructureTest {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn period_doubling_test_changes_sign_through_minus_one() {
+        // prod(1 + mu): 1 + (-0.9) = 0.1 and 1 + (-1.1) = -0.1, times 1 + 0.5 = 1.5.
+        let before = [Complex::new(-0.9, 0.0), Complex::new(0.5, 0.0)];
+        let after = [Complex::new(-1.1, 0.0), Complex::new(0.5, 0.0)];
+        assert!((period_doubling_test(&before) - 0.15).abs() < 1e-15);
+        assert!((period_doubling_test(&after) + 0.15).abs() < 1e-15);
+    }
+
+    #[test]
+    fn neimark_sacker_test_is_the_modulus_squared_minus_one_of_a_pair() {
+        // For a pair r e^{+-i}: mu conj(mu) - 1 = r^2 - 1.
+        for r in [0.9, 1.1] {
+            let pair = [Complex::from_polar(r, 1.0), Complex::from_polar(r, -1.0)];
+            assert!((neimark_sacker_test(&pair) - (r * r - 1.0)).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn extrema_are_matched_across_the_period_boundary() {
+        // A minimum moving from t = 0.99 to t = 0.01 (period 1) through zero, next to another
+        // minimum at t = 0.5 that stays positive.
+        let a = OrbitStructure {
+            minima: vec![(0.5, 0.3), (0.99, 0.01)],
+            maxima: vec![],
+            impacts: 0,
+            duration: 1.0,
+        };
+        let b = OrbitStructure {
+            minima: vec![(0.01, -0.01), (0.5, 0.3)],
+            maxima: vec![],
+            impacts: 1,
+            duration: 1.0,
+        };
+        let tests = structure_changes(&a, &b);
+        assert_eq!(tests.len(), 1, "{tests:?}");
+        // Half-way the followed minimum is the one nearest t = 0.99 + 0.5 * 0.02 = 1.0 = 0.0.
+        let mid = OrbitStructure {
+            minima: vec![(0.0, 0.002), (0.5, 0.3)],
+            maxima: vec![],
+            impacts: 0,
+            duration: 1.0,
+        };
+        assert_eq!(tests[0].value(0.5, &mid), 0.002);
+        assert!((tests[0].linear_root() - 0.5).abs() < 1e-15);
+    }
+}
