@@ -821,8 +821,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
         self.x.copy_from_slice(&self.z[..n]);
         let rate = system.switching_rate(k, mode, t_event, &self.x);
-        system.vector_field(mode, t_event, &self.x, &mut self.f_minus);
-        self.field.evaluations += 1;
+        if self.sensitivity.transition() {
+            system.vector_field(mode, t_event, &self.x, &mut self.f_minus);
+            self.field.evaluations += 1;
+        }
         let negative_after = if reset {
             system.reset(
                 k,
