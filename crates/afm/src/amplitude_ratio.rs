@@ -1,9 +1,10 @@
-//! The separation at which a slow approach reaches a given amplitude ratio `A/A0`: `Z` decreases
-//! from first contact in steps, each steady orbit started from the previous one (as the
-//! paper's slow approach does, so that a fold is jumped over the way an instrument jumps), and
-//! the crossing of `A/A0 = R` is then bracketed and refined by the secant/bisection hybrid
-//! (Illinois) on `Z`.
+//! The separation at which a slow approach reaches a given amplitude ratio `A/A0`: the approach
+//! branch (pseudo-arclength continuation from first contact, `Z` decreasing) is walked through
+//! its stable points in order, as the paper's slow approach meets them (an unstable part
+//! between folds is jumped over, the way an instrument jumps), and the crossing of `A/A0 = R`
+//! is bracketed and refined by the secant/bisection hybrid (Illinois) on `Z`.
 
+use crate::bifurcation_diagram::{approach_diagram, DiagramSettings};
 use crate::error::AfmError;
 use crate::model::TappingModel;
 use crate::steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};
@@ -14,10 +15,6 @@ use crate::steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};
 pub struct AmplitudeRatioSearch {
     /// The target `R = A/A0`, in (0, 1).
     pub ratio: f64,
-    /// The approach step in `Z` as a fraction of `A0` (default 0.005, i.e. 0.05 nm for the
-    /// Biolever's A0 = 10 nm); halved down to 1/1024 of itself where Newton from the previous
-    /// orbit fails.
-    pub step_fraction: f64,
     /// The lowest separation the approach goes to, as a fraction of `A0` (default -1: the
     /// cantilever's base a full free amplitude below the undeformed sample surface).
     pub floor_fraction: f64,
@@ -40,7 +37,6 @@ impl AmplitudeRatioSearch {
         }
         Ok(Self {
             ratio,
-            step_fraction: 0.005,
             floor_fraction: -1.0,
             z_tolerance_nm: 1e-9,
         })
@@ -49,54 +45,58 @@ impl AmplitudeRatioSearch {
 
 /// The steady orbit on the approach branch where `A/A0` first falls to `search.ratio`.
 ///
-/// Errors when the approach reaches its floor first, when a step cannot be converged even at
-/// the smallest step, or when the ratio lies inside a jump of the approach curve (a fold: the
-/// branch jumps from above `R` to below it, and no steady orbit on it has `A/A0 = R`).
+/// The branch is the pseudo-arclength continuation of the periodic orbit from above first
+/// contact with `Z` decreasing ([`approach_diagram`]); its stable points are walked in branch
+/// order, as a slow approach meets them, and the first pair of consecutive stable points that
+/// brackets the ratio is refined on `Z`. Errors when the branch ends first, or when the ratio
+/// lies only in a jump of the approach (an unstable part of the branch between folds, which a
+/// slow approach jumps over).
 pub fn find_amplitude_ratio(
     model: &TappingModel,
     search: &AmplitudeRatioSearch,
     settings: &SteadyOrbitSettings,
 ) -> Result<SteadyOrbit, AfmError> {
     let a0 = model.free_amplitude_nm();
-    let ratio_of = |orbit: &SteadyOrbit| orbit.lockin(a0).0;
-    let step = search.step_fraction * a0;
-    let floor = search.floor_fraction * a0;
-    let mut above = steady_orbit(
-        model,
-        model.grazing_separation_nm(),
-        Some(&model.free_state()),
-        settings,
-    )?;
-    let mut h = step;
-    loop {
-        if above.z_nm - h < floor {
-            return Err(AfmError::NotReached {
-                what: format!("A/A0 = {}", search.ratio),
-                reason: format!(
-                    "the approach reached its floor Z = {floor} nm with A/A0 = {:.6}",
-                    ratio_of(&above)
-                ),
-            });
-        }
-        let next = steady_orbit(model, above.z_nm - h, Some(&above.state), settings)?;
-        if !next.converged || next.multiplicity != above.multiplicity {
-            if h > step / 1024.0 {
-                h *= 0.5;
-                continue;
-            }
-            if !next.converged {
-                return Err(AfmError::NotReached {
-                    what: format!("A/A0 = {}", search.ratio),
-                    reason: format!("no converged steady orbit at Z = {} nm", next.z_nm),
-                });
-            }
-        }
-        if ratio_of(&next) <= search.ratio {
-            return refine(model, search, settings, above, next);
-        }
-        above = next;
-        h = (2.0 * h).min(step);
-    }
+    let diagram_settings = DiagramSettings {
+        orbit: settings.clone(),
+        z_limit_nm: search.floor_fraction * a0,
+        min_amplitude_ratio: (search.ratio - 0.05).max(0.0),
+        ..DiagramSettings::approach(model)
+    };
+    let branch = approach_diagram(model, &diagram_settings)?;
+    let bracket = branch.points.windows(2).find(|pair| {
+        pair[0].stable
+            && pair[1].stable
+            && pair[0].amplitude_ratio > search.ratio
+            && pair[1].amplitude_ratio <= search.ratio
+    });
+    let Some([above, below]) = bracket else {
+        let lowest = branch
+            .points
+            .iter()
+            .map(|p| p.amplitude_ratio)
+            .fold(f64::INFINITY, f64::min);
+        let reason = if lowest <= search.ratio {
+            String::from("the ratio is crossed only on an unstable part of the branch (a jump of the approach between folds)")
+        } else {
+            format!(
+                "the branch ended ({}) with A/A0 >= {lowest:.6}{}",
+                branch.stop,
+                branch
+                    .error
+                    .as_deref()
+                    .map(|e| format!(": {e}"))
+                    .unwrap_or_default()
+            )
+        };
+        return Err(AfmError::NotReached {
+            what: format!("A/A0 = {}", search.ratio),
+            reason,
+        });
+    };
+    let above = steady_orbit(model, above.z_nm, Some(&above.state), settings)?;
+    let below = steady_orbit(model, below.z_nm, Some(&below.state), settings)?;
+    refine(model, search, settings, above, below)
 }
 
 /// Refine the bracket `above` (A/A0 > R) / `below` (A/A0 <= R) by the Illinois method on Z,
