@@ -158,6 +158,14 @@ fn first_contact_of_a_soft_wall_at_the_free_amplitude() {
         calls as f64 / branch.points.len() as f64,
         elapsed.as_secs_f64() * 1e3 / branch.points.len() as f64
     );
+    // Leanness (the AFM budget is ~1 ms per point at ~30 us per period map): a smooth branch
+    // costs the corrector's 2-3 evaluations per point plus the location of G1 (~10 more).
+    // Measured 2.5 per point; a regression in the predictor or the step control shows here.
+    assert!(
+        calls as f64 <= 3.0 * branch.points.len() as f64,
+        "{calls} period maps for {} points",
+        branch.points.len()
+    );
     let grazings: Vec<_> = branch
         .special_points
         .iter()
@@ -180,4 +188,71 @@ fn first_contact_of_a_soft_wall_at_the_free_amplitude() {
             assert_eq!(point.structure.impacts, 0, "Z = {}", point.parameter);
         }
     }
+}
+
+/// Above resonance (`w = 1.5`) a stiff wall bends the response: after first contact the branch
+/// turns at a fold (the mechanism of the AFM's phase jumps on stiff samples) and goes back up
+/// in `Z`. Checks independent of the location: at a fold of fixed points one Floquet
+/// multiplier is exactly 1 (here to 1e-3: the fold is bracketed to 1e-9 in `Z`, i.e. to
+/// ~3e-5 in arclength, where `mu - 1` is proportional to the arclength); `Z` is a local minimum
+/// there (no branch point has a smaller `Z`); and stability changes across it.
+#[test]
+fn fold_after_first_contact_on_a_stiff_wall() {
+    let system = SoftWall {
+        k: 1.0,
+        c: 0.05,
+        w: 1.5,
+        amplitude: 1.0,
+        stiffness: 100.0,
+        wall: 0.0,
+    };
+    let z_g = system.free_amplitude();
+    let mut start = system;
+    start.wall = 1.5 * z_g;
+    let problem = HybridPeriodicProblem::new(start, 1, Settings::default()).expect("problem");
+    let settings = ContinuationSettings {
+        initial_step: 0.05,
+        max_step: 0.05,
+        direction: ParameterDirection::Decreasing,
+        parameter_max: 2.0 * z_g,
+        ..ContinuationSettings::default()
+    };
+    let branch = Continuation::new(&problem, &[0.0, 0.0], start.wall, settings)
+        .expect("start")
+        .run();
+    assert_eq!(
+        branch.stop,
+        StopReason::ParameterBound,
+        "{:?}",
+        branch.error
+    );
+    let labels: Vec<&str> = branch
+        .special_points
+        .iter()
+        .map(|s| s.label.as_str())
+        .collect();
+    assert_eq!(labels, ["G1", "fold"], "{:?}", branch.special_points);
+    let (g1, fold) = (&branch.special_points[0], &branch.special_points[1]);
+    assert!((g1.parameter - z_g).abs() < 1e-9);
+    assert!(fold.converged && fold.precision <= 1e-9, "{fold:?}");
+    assert!(fold.parameter < g1.parameter);
+    let unit = fold
+        .multipliers
+        .iter()
+        .map(|m| (m - 1.0).norm())
+        .fold(f64::INFINITY, f64::min);
+    assert!(unit < 1e-3, "closest multiplier to 1 is {unit:e} away");
+    let lowest = branch
+        .points
+        .iter()
+        .map(|p| p.parameter)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        lowest >= fold.parameter - 1e-9,
+        "{lowest} < {}",
+        fold.parameter
+    );
+    let before = &branch.points[fold.branch_index - 1];
+    let after = &branch.points[fold.branch_index];
+    assert_ne!(before.stable, after.stable);
 }
