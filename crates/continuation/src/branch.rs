@@ -58,7 +58,8 @@ pub struct BranchPoint {
     pub iterations: usize,
     /// `|P(x; p) - x|_2` (state units).
     pub residual: f64,
-    /// Arclength step that reached this point (0 for the start).
+    /// Arclength step that reached this point (0 for the start; for a point reached by a
+    /// jump over a corner, the distance jumped in `(x, p)`).
     pub step: f64,
     /// Special points located in the step that ended at this point, in branch order.
     pub special_points: Vec<SpecialPoint>,
@@ -551,10 +552,14 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 jumped,
             );
             let special = self.locate_all(&segment, &structure, index, jumped, true)?;
+            let covered = if jumped {
+                (&b.u - &self.current.u).norm()
+            } else {
+                ds
+            };
             if jumped {
                 // Past a corner the branch's own scale is the jump.
-                let jump = (&b.u - &self.current.u).norm();
-                self.step = self.step.max(jump.min(self.settings.max_step));
+                self.step = self.step.max(covered.min(self.settings.max_step));
             } else if iterations <= self.settings.easy_iterations {
                 self.step = (self.step * self.settings.step_growth).min(self.settings.max_step);
             }
@@ -568,7 +573,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 structure: b.map.structure.clone(),
                 iterations,
                 residual,
-                step: ds,
+                step: covered,
                 special_points: special.clone(),
             };
             self.special_points.extend(special);

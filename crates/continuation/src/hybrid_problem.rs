@@ -1,5 +1,6 @@
 //! The periodic-orbit problem of a parametrised hybrid system: its period map is the hybrid
-//! solver's flow map over a whole number of forcing periods from `t0 = 0`, with the monodromy
+//! solver's flow map over a whole number of forcing periods from `t0 = 0` (or another section
+//! time), with the monodromy
 //! and `dx/dp` carried through every event by saltation matrices (hybrid-api.md).
 //!
 //! The orbit structure is read from the flow map: the local minima and maxima of the contact
@@ -39,6 +40,7 @@ pub trait Parametrised: HybridSystem + Clone {
 pub struct HybridPeriodicProblem<S: Parametrised> {
     system: RefCell<S>,
     periods: usize,
+    start_time: f64,
     settings: Settings,
     buffers: RefCell<Buffers>,
 }
@@ -90,12 +92,41 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
         Ok(Self {
             system: RefCell::new(system),
             periods,
+            start_time: 0.0,
             settings,
             buffers: RefCell::new(Buffers {
                 field: vec![0.0; n],
                 shifted: vec![0.0; n],
             }),
         })
+    }
+
+    /// The same problem with the Poincare section at time `t0` instead of 0 (the period map
+    /// is then `x(t0) -> x(t0 + periods T)` and extremum times are measured from `t0`).
+    ///
+    /// With a reset map the period map is discontinuous where an impact happens exactly at
+    /// the section time, so a branch of a hard-impact system stops where its impact time
+    /// crosses `t0`; another section moves that point. Continuous contact (Hertz) has no such
+    /// discontinuity.
+    ///
+    /// # Errors
+    /// [`ContinuationError::InvalidSettings`] for a non-finite `t0`.
+    pub fn with_start_time(mut self, t0: f64) -> Result<Self, ContinuationError> {
+        if !t0.is_finite() {
+            return Err(ContinuationError::InvalidSettings {
+                field: "start_time",
+                value: t0,
+                allowed: "finite",
+            });
+        }
+        self.start_time = t0;
+        Ok(self)
+    }
+
+    /// The time `t0` of the Poincare section (0 unless set by
+    /// [`HybridPeriodicProblem::with_start_time`]).
+    pub fn start_time(&self) -> f64 {
+        self.start_time
     }
 
     /// A copy of the system with its parameter set to `p` (to integrate observables on a
@@ -121,7 +152,8 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
         &self.settings
     }
 
-    /// The flow map over one period map at `(x, p)` with the requested sensitivities.
+    /// The flow map over one period map at `(x, p)` from the section time, with the requested
+    /// sensitivities (event and extremum times are absolute).
     ///
     /// # Errors
     /// [`ContinuationError::Hybrid`] if the integration fails.
@@ -134,11 +166,17 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
         self.system.borrow_mut().set_parameter(p);
         let system = self.system.borrow();
         let duration = self.periods as f64 * system.period();
-        flow_map(&*system, 0.0, x, duration, sensitivity, &self.settings).map_err(|source| {
-            ContinuationError::Hybrid {
-                parameter: p,
-                source,
-            }
+        flow_map(
+            &*system,
+            self.start_time,
+            x,
+            duration,
+            sensitivity,
+            &self.settings,
+        )
+        .map_err(|source| ContinuationError::Hybrid {
+            parameter: p,
+            source,
         })
     }
 
@@ -187,7 +225,7 @@ impl<S: Parametrised> PeriodicProblem for HybridPeriodicProblem<S> {
             duration,
         };
         for extremum in flow.extrema.iter().filter(|e| e.surface == k) {
-            let entry = (extremum.t, extremum.value);
+            let entry = (extremum.t - self.start_time, extremum.value);
             match extremum.kind {
                 ExtremumKind::Minimum => structure.minima.push(entry),
                 ExtremumKind::Maximum => structure.maxima.push(entry),
@@ -201,7 +239,7 @@ impl<S: Parametrised> PeriodicProblem for HybridPeriodicProblem<S> {
             structure.impacts += 1;
             if event.reset {
                 let value = self.virtual_minimum(&system, k, event.t, event.rate, &event.state);
-                structure.minima.push((event.t, value));
+                structure.minima.push((event.t - self.start_time, value));
             }
         }
         structure.minima.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -7,8 +7,8 @@
 mod oscillator;
 
 use continuation::{
-    floquet_multipliers, shoot, HybridPeriodicProblem, NewtonSettings, PeriodicProblem,
-    SpecialPointKind,
+    floquet_multipliers, shoot, Continuation, ContinuationSettings, HybridPeriodicProblem,
+    NewtonSettings, PeriodicProblem, SpecialPointKind, StopReason,
 };
 use hybrid::{flow_map, Sensitivity, Settings};
 use nalgebra::Complex;
@@ -150,5 +150,96 @@ fn grazing_amplitude_matches_the_closed_form() {
                 assert_eq!(point.structure.impacts, 0, "w = {w}: {}", point.parameter);
             }
         }
+    }
+}
+
+/// At `w = 1` the impacting branch's impact time drifts to the section time `t0 = 0` near
+/// `A = 4.13`, where the stroboscopic map of a system with a reset is discontinuous: the
+/// branch stops there cleanly (minimum step, the last orbit impacting at `t = 0`). With the
+/// section at `T/4` it passes that amplitude, G1 is the same to the location tolerance, and
+/// the orbit found from either section at `A = 4` is the same orbit (the `t0 = 0` state
+/// propagated over `T/4` is the `t0 = T/4` state, to the Newton tolerance amplified by the
+/// integration over a quarter period, 1e-8).
+#[test]
+fn moving_the_section_carries_the_branch_past_the_impact_at_the_section_time() {
+    let osc = oscillator(1.0, 0.05);
+    let t = 2.0 * std::f64::consts::PI;
+    let mut ends = Vec::new();
+    let mut orbits = Vec::new();
+    for t0 in [0.0, 0.25 * t] {
+        let problem = HybridPeriodicProblem::new(osc, 1, Settings::default())
+            .expect("problem")
+            .with_start_time(t0)
+            .expect("section");
+        // The free steady state x(t) = Re(X e^{i t}) (w = 1) at the section time.
+        let [re, v0] = osc.free_steady_state();
+        let im = -v0;
+        let guess = [
+            re * t0.cos() - im * t0.sin(),
+            -(re * t0.sin() + im * t0.cos()),
+        ];
+        let settings = ContinuationSettings {
+            initial_step: 1e-2,
+            max_step: 0.1,
+            min_step: 1e-9,
+            parameter_max: 5.0,
+            ..ContinuationSettings::default()
+        };
+        let branch = Continuation::new(&problem, &guess, osc.amplitude, settings)
+            .expect("start")
+            .run();
+        let g1 = first_grazing(&branch).expect("G1");
+        assert!((g1 - 0.1).abs() <= 1e-9, "t0 = {t0}: {g1}");
+        ends.push((branch.stop, branch.points.last().expect("points").clone()));
+        // The orbit at A = 4 from the branch point nearest to it.
+        let near = branch
+            .points
+            .iter()
+            .min_by(|a, b| {
+                (a.parameter - 4.0)
+                    .abs()
+                    .total_cmp(&(b.parameter - 4.0).abs())
+            })
+            .expect("points");
+        let orbit = shoot(
+            &problem,
+            near.state.as_slice(),
+            4.0,
+            &NewtonSettings::default(),
+        )
+        .expect("shoot");
+        assert!(orbit.converged && orbit.period_map.structure.impacts == 1);
+        orbits.push(orbit.state);
+    }
+    let (stop0, last0) = &ends[0];
+    assert_eq!(*stop0, StopReason::StepTooSmall);
+    assert!((last0.parameter - 4.13).abs() < 0.01, "{}", last0.parameter);
+    let impact_time = last0.structure.minima[0].0;
+    assert!(
+        impact_time.min(t - impact_time) < 1e-3,
+        "{:?}",
+        last0.structure
+    );
+    let (stop1, last1) = &ends[1];
+    assert_eq!(*stop1, StopReason::ParameterBound);
+    assert!((last1.parameter - 5.0).abs() < 1e-12);
+    let mut at_four = osc;
+    at_four.amplitude = 4.0;
+    let quarter = flow_map(
+        &at_four,
+        0.0,
+        orbits[0].as_slice(),
+        0.25 * t,
+        Sensitivity::None,
+        &Settings::default(),
+    )
+    .expect("quarter period");
+    for i in 0..2 {
+        assert!(
+            (quarter.state[i] - orbits[1][i]).abs() < 1e-8,
+            "{:?} vs {:?}",
+            quarter.state,
+            orbits[1]
+        );
     }
 }
