@@ -27,8 +27,11 @@ const MAX_FACTOR: f64 = 6.0;
 pub(crate) struct Dop853 {
     /// Length `N` of the augmented state.
     dim: usize,
-    /// Number `n` of leading components under error control.
+    /// Number `n` of leading (state) components under error control with the main tolerances.
     controlled: usize,
+    /// Tolerance (relative and absolute) for the remaining (variational) components, if they
+    /// are under error control.
+    variational_tolerance: Option<f64>,
     /// Stage derivatives, component-major; stage 0 holds `f(t, z)`, stage 12 `f(t + h, z_new)`
     /// after [`Dop853::derivative_at_end`].
     stages: Vec<f64>,
@@ -49,10 +52,11 @@ fn dot(a: &[f64], k: &[f64]) -> f64 {
 }
 
 impl Dop853 {
-    pub fn new(dim: usize, controlled: usize) -> Self {
+    pub fn new(dim: usize, controlled: usize, variational_tolerance: Option<f64>) -> Self {
         Self {
             dim,
             controlled,
+            variational_tolerance,
             stages: vec![0.0; STAGES_EXTENDED * dim],
             argument: vec![0.0; dim],
             derivative: vec![0.0; dim],
@@ -125,11 +129,32 @@ impl Dop853 {
         for c in 0..dim {
             z_new[c] = z[c] + h * dot(b, &self.component(c)[..STAGES]);
         }
-        // Error estimate on the controlled components (Hairer's err / err2 combination).
-        let n = self.controlled;
+        // Error estimate (Hairer's err / err2 combination) on the state, and on the
+        // variational components with their own tolerance if they are controlled: the larger.
+        let state = self.error_norm(0..self.controlled, z, z_new, h, rtol, atol);
+        match self.variational_tolerance {
+            Some(tol) if dim > self.controlled => {
+                state.max(self.error_norm(self.controlled..dim, z, z_new, h, tol, tol))
+            }
+            _ => state,
+        }
+    }
+
+    /// Hairer's scaled error norm of the last attempt over `components`.
+    fn error_norm(
+        &self,
+        components: std::ops::Range<usize>,
+        z: &[f64],
+        z_new: &[f64],
+        h: f64,
+        rtol: f64,
+        atol: f64,
+    ) -> f64 {
+        let b = &A[12][..STAGES];
+        let count = components.len();
         let mut err5 = 0.0;
         let mut err3 = 0.0;
-        for c in 0..n {
+        for c in components {
             let scale = atol + rtol * z[c].abs().max(z_new[c].abs());
             let k = &self.component(c)[..STAGES];
             let e5 = dot(&E5, k);
@@ -141,7 +166,7 @@ impl Dop853 {
             return 0.0;
         }
         let denominator = err5 + 0.01 * err3;
-        h.abs() * err5 / (denominator * n as f64).sqrt()
+        h.abs() * err5 / (denominator * count as f64).sqrt()
     }
 
     /// Next step size from the error norm of an attempt (Hairer's controller with `beta = 0`):
@@ -271,7 +296,7 @@ mod tests {
 
     /// Global error at `t = 2` after `steps` fixed DOP853 steps (error estimate ignored).
     fn fixed_step_error(steps: usize) -> f64 {
-        let mut rk = Dop853::new(2, 2);
+        let mut rk = Dop853::new(2, 2, None);
         let h = 2.0 / steps as f64;
         let mut z = [1.0, 0.0];
         let mut z_new = [0.0; 2];
@@ -307,7 +332,7 @@ mod tests {
     #[test]
     fn dense_output_order_is_seven() {
         let error_at_midstep = |h: f64| {
-            let mut rk = Dop853::new(2, 2);
+            let mut rk = Dop853::new(2, 2, None);
             let z = [1.0, 0.0];
             let mut z_new = [0.0; 2];
             let mut f = rhs;

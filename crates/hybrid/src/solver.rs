@@ -176,14 +176,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             transition: DMatrix::identity(n, n),
             zero_parameter: vec![0.0; n],
             field: VariationalField::new(n, sensitivity),
-            rk: Dop853::new(
-                dim,
-                if settings.sensitivity_error_control {
-                    dim
-                } else {
-                    n
-                },
-            ),
+            rk: Dop853::new(dim, n, settings.sensitivity_tolerance),
             proposed_step: settings.initial_step,
             first_same_as_last: false,
             kind: StepKind::None,

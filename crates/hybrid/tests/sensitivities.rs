@@ -11,13 +11,13 @@ use proptest::prelude::*;
 
 /// Tight tolerances so that the finite differences (steps 1e-5 and 5e-6, Richardson
 /// extrapolated) are not swamped by the solver's own error: ~1e-13 / 5e-6 = 2e-8. The sensitivities
-/// are under error control too (`sensitivity_error_control`), see
+/// are under error control too (`sensitivity_tolerance`), see
 /// `hertz_sensitivities_without_their_error_control` for the default.
 fn tight() -> Settings {
     Settings {
         relative_tolerance: 1e-13,
         absolute_tolerance: 1e-13,
-        sensitivity_error_control: true,
+        sensitivity_tolerance: Some(1e-13),
         ..Settings::default()
     }
 }
@@ -162,7 +162,7 @@ fn hertz_sensitivities_without_their_error_control() {
     let duration = 3.0 * 2.0 * std::f64::consts::PI / 1.2;
     let d = HertzOscillator::reference().obstacle;
     let state_only = Settings {
-        sensitivity_error_control: false,
+        sensitivity_tolerance: None,
         ..tight()
     };
     let result = run_with(
