@@ -160,7 +160,7 @@ mod tests {
 
     #[test]
     fn bad_fields_are_named() {
-        let cases: [(Settings, &str); 5] = [
+        let cases: [(Settings, &str); 6] = [
             (
                 Settings {
                     relative_tolerance: f64::NAN,
@@ -195,6 +195,13 @@ mod tests {
                     ..Settings::default()
                 },
                 "event_time_tolerance",
+            ),
+            (
+                Settings {
+                    sensitivity_tolerance: Some(0.0),
+                    ..Settings::default()
+                },
+                "sensitivity_tolerance",
             ),
         ];
         for (settings, name) in cases {
