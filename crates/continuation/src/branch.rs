@@ -208,7 +208,9 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         })
     }
 
-    /// End the branch after the first point on which `predicate` returns `true`.
+    /// End the branch after the first point on which `predicate` returns `true`. The
+    /// predicate is called once on every point produced, the start and the last included
+    /// (so it may also collect per-point data).
     pub fn stop_when(mut self, predicate: impl FnMut(&BranchPoint) -> bool + 'a) -> Self {
         self.stop_predicate = Some(Box::new(predicate));
         self
@@ -257,17 +259,20 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         true
     }
 
-    /// Count a produced point and apply the stop rules to it.
+    /// Count a produced point and apply the stop rules to it (the user's predicate sees
+    /// every point, the start and the last included).
     fn emit(&mut self, point: BranchPoint, at_bound: bool) -> BranchPoint {
         self.produced += 1;
+        let user = self
+            .stop_predicate
+            .as_mut()
+            .is_some_and(|predicate| predicate(&point));
         if at_bound {
             self.stop = Some(StopReason::ParameterBound);
+        } else if user {
+            self.stop = Some(StopReason::UserStop);
         } else if self.produced >= self.settings.max_points {
             self.stop = Some(StopReason::MaxPoints);
-        } else if let Some(predicate) = self.stop_predicate.as_mut() {
-            if predicate(&point) {
-                self.stop = Some(StopReason::UserStop);
-            }
         }
         point
     }

@@ -136,3 +136,32 @@ fn stop_predicate_and_point_limit_end_the_branch() {
         assert!(point.stable, "multipliers of A have modulus < 1");
     }
 }
+
+#[test]
+fn stop_predicate_sees_every_point_including_the_last() {
+    for (max_points, parameter_max) in [(4, f64::INFINITY), (10_000, 0.7)] {
+        let settings = ContinuationSettings {
+            initial_step: 0.1,
+            max_step: 0.5,
+            max_points,
+            parameter_max,
+            ..ContinuationSettings::default()
+        };
+        let mut seen = Vec::new();
+        let branch = Continuation::new(&Affine, &[0.0, 0.0], 0.0, settings)
+            .expect("start")
+            .stop_when(|point| {
+                seen.push(point.index);
+                false
+            })
+            .run();
+        let indices: Vec<usize> = branch.points.iter().map(|p| p.index).collect();
+        assert_eq!(seen, indices);
+        let expected = if max_points == 4 {
+            StopReason::MaxPoints
+        } else {
+            StopReason::ParameterBound
+        };
+        assert_eq!(branch.stop, expected);
+    }
+}
