@@ -25,6 +25,21 @@
 //!   the mode always matches the side the state is on and no later crossing can be missed;
 //!   other bits are unchanged. A Zeno accumulation (a bouncing ball coming to rest) ends in
 //!   [`HybridError::TooManyEvents`].
+//! * Resolution: an extremum is found when `dh/dt` changes sign between neighbouring samples
+//!   (`samples_per_step` interior points per step); two extrema closer than the sample spacing
+//!   (a minimum and a maximum between the same two samples) are not seen, and nor is a dip
+//!   through a surface that lies between them.
+//!
+//! # Step-size control
+//!
+//! Hairer's DOP853 controller (`safe = 0.9`, step ratio in `[1/3, 6]`, no growth right after a
+//! rejection) on the state components, and on the sensitivities if
+//! `Settings::sensitivity_tolerance` is set. Two additions for non-smooth fields: a rejected
+//! trial that ends across a switching surface is retried once, landing `1e-6` of a step past
+//! the crossing estimated by cubic Hermite interpolation of `h` (so the kink of the field is
+//! inside the step's last millionth instead of forcing a sequence of shrinking steps); and on
+//! successive rejections the error's actual order in `h` is estimated from the last two
+//! attempts (far below 8 next to a singularity such as a Hertz contact onset).
 
 use nalgebra::{DMatrix, DMatrixView};
 
