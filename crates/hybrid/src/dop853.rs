@@ -311,20 +311,20 @@ mod tests {
         ((z[0] - 2.0f64.cos()).powi(2) + (z[1] + 2.0f64.sin()).powi(2)).sqrt()
     }
 
-    /// Halving a fixed step divides the global error by `2^8` for an 8th-order method. Measured
-    /// (this implementation): slopes 8.01 and 8.03 between 4/8 and 8/16 steps; asserted within
-    /// `[7.5, 8.6]` (the asymptotic regime is not exact at these step sizes, and the 16-step
-    /// error, ~1e-12, is still well above rounding).
+    /// Halving a fixed step divides the global error by `2^8` for an 8th-order method.
+    /// Measured (this implementation): errors 5.1e-9, 2.0e-11, 7.6e-14 with 3, 6, 12 steps over
+    /// [0, 2], slopes 8.02 and 8.01; asserted within `[7.5, 8.6]` (the 12-step error is still
+    /// ~300 times the rounding level).
     #[test]
     fn global_order_is_eight() {
-        let e4 = fixed_step_error(4);
-        let e8 = fixed_step_error(8);
-        let e16 = fixed_step_error(16);
-        let s1 = (e4 / e8).log2();
-        let s2 = (e8 / e16).log2();
-        eprintln!("fixed-step errors {e4:e} {e8:e} {e16:e}; slopes {s1:.3} {s2:.3}");
-        assert!((7.5..=8.6).contains(&s1), "slope {s1} ({e4:e}, {e8:e})");
-        assert!((7.5..=8.6).contains(&s2), "slope {s2} ({e8:e}, {e16:e})");
+        let e3 = fixed_step_error(3);
+        let e6 = fixed_step_error(6);
+        let e12 = fixed_step_error(12);
+        let s1 = (e3 / e6).log2();
+        let s2 = (e6 / e12).log2();
+        eprintln!("fixed-step errors {e3:e} {e6:e} {e12:e}; slopes {s1:.3} {s2:.3}");
+        assert!((7.5..=8.6).contains(&s1), "slope {s1} ({e3:e}, {e6:e})");
+        assert!((7.5..=8.6).contains(&s2), "slope {s2} ({e6:e}, {e12:e})");
     }
 
     /// The dense output inside one step has local error `O(h^8)` (order 7): halving the step
