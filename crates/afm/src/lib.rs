@@ -29,11 +29,14 @@ pub mod free_flight;
 pub mod free_response;
 pub mod hertz;
 pub mod impact_numbers;
+pub mod lockin;
 pub mod model;
 pub mod observables;
 pub mod sample;
 pub mod separation;
 pub mod steady_orbit;
+pub mod sweep;
+pub mod theory;
 pub mod trajectory;
 pub mod trigonometric;
 mod validation;
@@ -64,4 +67,9 @@ pub use observables::{
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};
+pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
+pub use theory::{
+    compare_theory, measure_impacts, ImpactImpulse, ImpactMeasurement, ImpactPrediction,
+    ImpactTheory, Ringing, TheoryComparison,
+};
 pub use trajectory::{sample_trajectory, TrajectorySample};

@@ -1,0 +1,79 @@
+//! Benchmark of the time-domain approach sweep (`afm::Sweep`): the Biolever on mica
+//! (A0 = 10 nm) from Z = 11 nm down to 0 at the paper's 1 nm/s, about 100,000 drive cycles,
+//! one record per cycle. Reports the wall time, cycles per second and microseconds per cycle
+//! overall and per impact regime, and the ratio to a scipy integration with event location at
+//! about 24 ms per drive cycle (the issue's reference figure).
+//!
+//! Run with `cargo bench -p afm --bench approach` (release build, one core). Pass `--quick`
+//! after `--` to sweep only 11 nm -> 8 nm.
+
+use afm::{builtin_case, Sweep, SweepSettings, TappingModel};
+use std::time::Instant;
+
+/// The issue's reference: scipy `solve_ivp` with event location, seconds per drive cycle.
+const SCIPY_SECONDS_PER_CYCLE: f64 = 0.024;
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let case = builtin_case("biolever-mica").expect("built-in case");
+    let model = TappingModel::from_case(&case).expect("model");
+    let mut settings = SweepSettings::for_model(&model);
+    settings.from_nm = 11.0;
+    settings.to_nm = if quick { 8.0 } else { 0.0 };
+    settings.rate_nm_per_s = 1.0;
+    settings.settle_cycles = 0;
+    let mut sweep = Sweep::new(&model, settings).expect("sweep");
+    let cycles = sweep.total_cycles();
+    println!(
+        "approach sweep, Biolever on mica, A0 = 10 nm, Z_G1 = {:.4} nm, {} -> {} nm at 1 nm/s: \
+         {cycles} drive cycles",
+        model.grazing_separation_nm(),
+        sweep.settings().from_nm,
+        sweep.settings().to_nm
+    );
+    // Wall time per regime (impacts per cycle), and overall.
+    let mut per_regime: Vec<(usize, u64, f64)> = Vec::new(); // (impacts, cycles, seconds)
+    let start = Instant::now();
+    let mut last = Instant::now();
+    let mut last_z_print = f64::INFINITY;
+    while let Some(record) = sweep.next_record().expect("sweep runs") {
+        let now = Instant::now();
+        let seconds = (now - last).as_secs_f64();
+        last = now;
+        let impacts = record.impacts as usize;
+        match per_regime.iter_mut().find(|r| r.0 == impacts) {
+            Some(regime) => {
+                regime.1 += 1;
+                regime.2 += seconds;
+            }
+            None => per_regime.push((impacts, 1, seconds)),
+        }
+        if record.z_nm < last_z_print - 1.0 {
+            last_z_print = record.z_nm;
+            println!(
+                "  Z = {:7.3} nm  A/A0 = {:.4}  phase = {:8.3} deg  impacts = {}",
+                record.z_nm, record.amplitude_ratio, record.phase_deg, record.impacts
+            );
+        }
+    }
+    let total = start.elapsed().as_secs_f64();
+    per_regime.sort_by_key(|r| r.0);
+    println!("{:>8} {:>10} {:>14}", "impacts", "cycles", "us per cycle");
+    for (impacts, count, seconds) in &per_regime {
+        println!(
+            "{:>8} {:>10} {:>14.2}",
+            impacts,
+            count,
+            seconds / *count as f64 * 1e6
+        );
+    }
+    let per_cycle = total / cycles as f64;
+    println!(
+        "total {total:.3} s, {:.0} cycles/s, {:.2} us per cycle; scipy at 24 ms per cycle: \
+         {:.0} s, ratio {:.0}x",
+        1.0 / per_cycle,
+        per_cycle * 1e6,
+        SCIPY_SECONDS_PER_CYCLE * cycles as f64,
+        SCIPY_SECONDS_PER_CYCLE / per_cycle
+    );
+}
