@@ -132,6 +132,9 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     settings: ContinuationSettings,
     stop_predicate: Option<StopPredicate<'a>>,
     current: Sample,
+    /// The point before `current` and its tangent, for the cubic predictor (`None` at the
+    /// start and after a jump over a corner).
+    previous: Option<(DVector<f64>, DVector<f64>)>,
     start: Option<BranchPoint>,
     step: f64,
     produced: usize,
@@ -201,6 +204,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             settings,
             stop_predicate: None,
             current,
+            previous: None,
             start: Some(first),
             produced: 0,
             special_points: Vec::new(),
@@ -424,6 +428,31 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         Ok(Vec::new())
     }
 
+    /// The cubic Hermite extrapolation, `ds` beyond the current point, of the branch through
+    /// the previous and the current point with their unit tangents (arclength measured by
+    /// the chord). Its error is `O(ds^4)` against `O(ds^2)` for the tangent predictor, which
+    /// saves a Newton iteration per point on smooth branches. `None` when there is no previous
+    /// point, the extrapolation reaches more than two chords ahead, or it strays further than
+    /// `ds / 2` from the tangent predictor.
+    fn cubic_predictor(&self, ds: f64) -> Option<DVector<f64>> {
+        let (u0, t0) = self.previous.as_ref()?;
+        let (u1, t1) = (&self.current.u, &self.current.tangent);
+        let h = (u1 - u0).norm();
+        if h.is_nan() || h <= 0.0 || ds > 2.0 * h {
+            return None;
+        }
+        let tau = 1.0 + ds / h;
+        let (t2, t3) = (tau * tau, tau * tau * tau);
+        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+        let h10 = t3 - 2.0 * t2 + tau;
+        let h01 = -2.0 * t3 + 3.0 * t2;
+        let h11 = t3 - t2;
+        let guess = h00 * u0 + (h10 * h) * t0 + h01 * u1 + (h11 * h) * t1;
+        let linear = u1 + ds * t1;
+        let finite = guess.iter().all(|v| v.is_finite());
+        (finite && (&guess - &linear).norm() <= 0.5 * ds).then_some(guess)
+    }
+
     /// One continuation step: the next accepted point, or an error.
     fn advance(&mut self) -> Result<BranchPoint, ContinuationError> {
         let n = self.problem.dim();
@@ -433,9 +462,12 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             let ds = self.step;
             let t_a = self.current.tangent.clone();
             let predicted = &self.current.u + ds * &t_a;
+            let guess = self
+                .cubic_predictor(ds)
+                .unwrap_or_else(|| predicted.clone());
             let corrected = correct(
                 self.problem,
-                predicted.clone(),
+                guess,
                 &predicted,
                 &t_a,
                 &self.settings.corrector,
@@ -582,7 +614,12 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 special_points: special.clone(),
             };
             self.special_points.extend(special);
-            self.current = b;
+            let accepted = std::mem::replace(&mut self.current, b);
+            self.previous = if jumped {
+                None
+            } else {
+                Some((accepted.u, accepted.tangent))
+            };
             return Ok(self.emit(point, at_bound));
         }
     }

@@ -113,10 +113,12 @@ fn impacting_orbit_agrees_with_a_long_time_domain_run() {
     assert_eq!(problem.dim(), 2);
 }
 
-/// The continuation in `A` finds the first contact G1 at the closed-form grazing amplitude:
-/// within the location tolerance 1e-9 (the free orbit's minimum of `h` is integrated to
-/// ~1e-12, which moves the root by ~1e-12 / |dh_min/dA| <= 1e-11), and the closed form lies
-/// in the reported bracket up to that margin.
+/// The continuation in `A` finds the first contact G1 at the closed-form grazing amplitude.
+/// Error budget: the location tolerance 1e-9, plus the error of the free orbits themselves:
+/// Newton stops at a residual of 1e-10, i.e. a state error up to 1e-10 |(M - I)^-1| <= 4e-10
+/// (multipliers of modulus <= 0.75), which moves the minimum of `h` by as much and the root
+/// by that over `|dh_min/dA| = |G| >= 1/3.01` (w = 2): 1.2e-9. Hence 2.5e-9, for the point
+/// and for the closed form lying in the reported bracket.
 #[test]
 fn grazing_amplitude_matches_the_closed_form() {
     for w in [0.5, 0.8, 1.0, 1.2, 2.0] {
@@ -139,11 +141,15 @@ fn grazing_amplitude_matches_the_closed_form() {
         assert_eq!((g1.impacts_before, g1.impacts_after), (0, 1));
         assert!(g1.converged && g1.precision <= 1e-9, "w = {w}: {g1:?}");
         assert!(
-            (a_g - exact).abs() <= 1e-9,
+            (a_g - exact).abs() <= 2.5e-9,
             "w = {w}: A_g = {a_g} vs {exact} (error {:e})",
             a_g - exact
         );
-        assert!(g1.bracket.0 - 1e-11 <= exact && exact <= g1.bracket.1 + 1e-11);
+        assert!(
+            g1.bracket.0 - 1.5e-9 <= exact && exact <= g1.bracket.1 + 1.5e-9,
+            "w = {w}: {exact} outside {:?}",
+            g1.bracket
+        );
         // Before G1 every orbit is free (no impact), after it the orbits impact.
         for point in &branch.points {
             if point.parameter < g1.bracket.0 && point.index <= g1.branch_index {
@@ -189,7 +195,8 @@ fn moving_the_section_carries_the_branch_past_the_impact_at_the_section_time() {
             .expect("start")
             .run();
         let g1 = first_grazing(&branch).expect("G1");
-        assert!((g1 - 0.1).abs() <= 1e-9, "t0 = {t0}: {g1}");
+        // Location tolerance 1e-9 plus the state error 4e-10 over |G| = 10 (see above).
+        assert!((g1 - 0.1).abs() <= 1.1e-9, "t0 = {t0}: {g1}");
         ends.push((branch.stop, branch.points.last().expect("points").clone()));
         // The orbit at A = 4 from the branch point nearest to it.
         let near = branch
