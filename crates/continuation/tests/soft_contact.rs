@@ -161,7 +161,8 @@ fn first_contact_of_a_soft_wall_at_the_free_amplitude() {
     );
     // Leanness (the AFM budget is ~1 ms per point at ~30 us per period map): a smooth branch
     // costs the corrector's 2-3 evaluations per point plus the location of G1 (~10 more).
-    // Measured 2.2 per point (cubic predictor); a regression in the predictor or the step control shows here.
+    // Measured 2.2 per point (cubic predictor); a regression in the predictor or the step
+    // control shows here.
     assert!(
         calls as f64 <= 3.0 * branch.points.len() as f64,
         "{calls} period maps for {} points",
