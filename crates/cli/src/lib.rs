@@ -2,6 +2,7 @@
 //! lives in the library crates (`hybrid`, `continuation`, `afm`, `beam`).
 #![warn(missing_docs)]
 
+pub mod approach;
 pub mod continue_diagram;
 pub mod model_args;
 pub mod output;

@@ -20,6 +20,9 @@ enum Command {
     /// The bifurcation diagram in Z: periodic orbits continued from above first contact down
     /// to a floor, grazing points G1, G2, G3, ..., folds and period doubling located.
     Continue(drumroll::continue_diagram::ContinueArgs),
+    /// A time-domain approach (and retract) sweep at a constant rate, read by a lock-in once
+    /// per drive cycle (or block of cycles); the records stream out as CSV or JSON Lines.
+    Approach(drumroll::approach::ApproachArgs),
 }
 
 fn main() -> ExitCode {
@@ -27,6 +30,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => drumroll::simulate::run(args),
         Command::Continue(args) => drumroll::continue_diagram::run(args),
+        Command::Approach(args) => drumroll::approach::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,328 @@
+//! `drumroll approach`: a time-domain approach (and retract) sweep at a constant rate, read by
+//! a lock-in amplifier once per block of drive cycles, as in the paper's simulations and in
+//! every experiment. The records stream out as they are computed (CSV or JSON Lines).
+
+use afm::sweep::{MAX_CYCLE_COUNT, MAX_RATE_NM_PER_S, MAX_SEPARATION_NM};
+use afm::{Sweep, SweepDirection, SweepRecord, SweepSettings, TappingModel};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::model_args::{output_path, ModelArgs};
+use crate::output::write_atomically;
+use crate::plot::{render_svg, Panel, Series, Stroke};
+
+/// The CSV header: the issue's required prefix, then the sweep direction.
+pub const CSV_HEADER: &str = "cycle,z_nm,amplitude_ratio,phase_deg,impacts,peak_force_nn,direction";
+
+/// The most points drawn per series in `--plot` (records are thinned evenly beyond this).
+const MAX_PLOT_POINTS: usize = 20_000;
+
+/// Progress bar updates: at most one per this many cycles (indicatif also limits redraws).
+const PROGRESS_STRIDE: u64 = 256;
+
+/// Options of `drumroll approach`.
+#[derive(Debug, Clone, Args)]
+pub struct ApproachArgs {
+    /// The cantilever, sample and drive.
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Separation at the start of the approach, nm, in (--to, 1e5]. The cantilever starts
+    /// from the free steady state there and settles for --settle-cycles cycles. Default: 0.2 nm
+    /// above first contact Z_G1.
+    #[arg(long, allow_negative_numbers = true, value_name = "NM")]
+    pub from: Option<f64>,
+    /// The floor: separation at the end of the approach, nm, in [0, --from). Default 0.
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "NM",
+        default_value_t = 0.0
+    )]
+    pub to: f64,
+    /// Sweep speed |dZ/dt|, nm/s, in (0, 1e6]. The paper's simulations use 1 nm/s.
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "NM_PER_S",
+        default_value_t = 1.0
+    )]
+    pub rate: f64,
+    /// After the approach, retract from the floor back up to --from at the same rate (rows
+    /// labelled `retract`), so that approach/retract hysteresis shows.
+    #[arg(long)]
+    pub retract: bool,
+    /// Drive cycles per lock-in reading: each record averages the Fourier coefficients of u
+    /// over this many consecutive, non-overlapping cycles (an integration time of N periods);
+    /// impacts are then per cycle, averaged; the peak force is the block's maximum.
+    /// In [1, 1e8].
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub lockin_cycles: usize,
+    /// Output every N-th lock-in reading of each direction (the first included). In [1, 1e8].
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub every: usize,
+    /// Drive cycles integrated at --from before the sweep starts (not reported). In [0, 1e8].
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    pub settle_cycles: usize,
+    /// Relative and absolute tolerance of the contact integration (nm, nm/us), in
+    /// [1e-14, 1e-4]. Free flight is exact regardless.
+    #[arg(long, value_name = "TOL", default_value_t = afm::sweep::DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+    /// Write JSON Lines (one object per reading) instead of CSV.
+    #[arg(long)]
+    pub jsonl: bool,
+    /// Write the records to FILE instead of standard output. FILE is written while the sweep
+    /// runs, one complete record per write, flushed at once: an interrupted run leaves every
+    /// record computed so far, and never half a record.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Draw phase vs A/A0 and A/A0 vs Z (approach and retract in two colours) into this SVG
+    /// file when the sweep ends (written atomically).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+impl ApproachArgs {
+    /// The sweep settings for `model`, every option checked (errors name the option and its
+    /// allowed range).
+    pub fn settings(&self, model: &TappingModel) -> Result<SweepSettings> {
+        let mut settings = SweepSettings::for_model(model);
+        check_range("--rate", self.rate, 0.0, false, MAX_RATE_NM_PER_S, "nm/s")?;
+        check_range("--to", self.to, 0.0, true, MAX_SEPARATION_NM, "nm")?;
+        let from = self.from.unwrap_or(settings.from_nm);
+        if !from.is_finite() || from <= self.to || from > MAX_SEPARATION_NM {
+            bail!(
+                "--from {from}: the start must be a finite separation above --to ({} nm) and \
+                 at most {MAX_SEPARATION_NM} nm",
+                self.to
+            );
+        }
+        check_count("--lockin-cycles", self.lockin_cycles, 1)?;
+        check_count("--every", self.every, 1)?;
+        check_count("--settle-cycles", self.settle_cycles, 0)?;
+        check_range("--tolerance", self.tolerance, 1e-14, true, 1e-4, "")?;
+        let cycle_travel = self.rate * 1e-6 * model.period_us();
+        if from - self.to < cycle_travel {
+            bail!(
+                "--from {from} --to {}: the sweep must span at least one drive cycle's travel \
+                 ({cycle_travel:e} nm at --rate {} nm/s)",
+                self.to,
+                self.rate
+            );
+        }
+        settings.from_nm = from;
+        settings.to_nm = self.to;
+        settings.rate_nm_per_s = self.rate;
+        settings.retract = self.retract;
+        settings.settle_cycles = self.settle_cycles;
+        settings.lockin_cycles = self.lockin_cycles;
+        settings.every = self.every;
+        settings.integration.relative_tolerance = self.tolerance;
+        settings.integration.absolute_tolerance = self.tolerance;
+        settings.validate().context("invalid sweep settings")?;
+        Ok(settings)
+    }
+}
+
+fn check_range(
+    option: &str,
+    value: f64,
+    min: f64,
+    min_inclusive: bool,
+    max: f64,
+    unit: &str,
+) -> Result<()> {
+    let above = if min_inclusive {
+        value >= min
+    } else {
+        value > min
+    };
+    if value.is_finite() && above && value <= max {
+        return Ok(());
+    }
+    let open = if min_inclusive { '[' } else { '(' };
+    bail!("{option} {value}: allowed range {open}{min}, {max}] {unit}")
+}
+
+fn check_count(option: &str, value: usize, min: usize) -> Result<()> {
+    if value < min || value > MAX_CYCLE_COUNT {
+        bail!("{option} {value}: allowed range [{min}, {MAX_CYCLE_COUNT}]");
+    }
+    Ok(())
+}
+
+/// Where the records go: standard output or a file, one complete line per write.
+enum RecordSink {
+    Stdout(std::io::Stdout),
+    File(std::fs::File, PathBuf),
+}
+
+impl RecordSink {
+    /// Write one line; `Ok(false)` when standard output was closed by its reader (a pipe into
+    /// `head`): the sweep then stops quietly.
+    fn write_line(&mut self, line: &str) -> Result<bool> {
+        match self {
+            Self::Stdout(stdout) => {
+                let mut lock = stdout.lock();
+                match lock.write_all(line.as_bytes()).and_then(|()| lock.flush()) {
+                    Ok(()) => Ok(true),
+                    Err(error) if error.kind() == std::io::ErrorKind::BrokenPipe => Ok(false),
+                    Err(error) => Err(error).context("cannot write to standard output"),
+                }
+            }
+            Self::File(file, path) => file
+                .write_all(line.as_bytes())
+                .and_then(|()| file.flush())
+                .map(|()| true)
+                .with_context(|| format!("cannot write {}", path.display())),
+        }
+    }
+}
+
+/// Format one record as a CSV line or a JSON Lines object (with the newline) into `line`.
+pub fn format_record(record: &SweepRecord, jsonl: bool, line: &mut String) -> Result<()> {
+    line.clear();
+    if jsonl {
+        line.push_str(&serde_json::to_string(record)?);
+        line.push('\n');
+    } else {
+        writeln!(
+            line,
+            "{},{},{},{},{},{},{}",
+            record.cycle,
+            record.z_nm,
+            record.amplitude_ratio,
+            record.phase_deg,
+            record.impacts,
+            record.peak_force_nn,
+            record.direction.name()
+        )?;
+    }
+    Ok(())
+}
+
+/// Run `drumroll approach`.
+pub fn run(args: &ApproachArgs) -> Result<()> {
+    let (case, model) = args.model.model()?;
+    let plot_path = args
+        .plot
+        .as_ref()
+        .map(|p| output_path(p, "svg", "--plot"))
+        .transpose()?;
+    let settings = args.settings(&model)?;
+    let mut sweep = Sweep::new(&model, settings).context("cannot set up the sweep")?;
+    let mut sink = match &args.out {
+        None => RecordSink::Stdout(std::io::stdout()),
+        Some(path) => RecordSink::File(
+            std::fs::File::create(path)
+                .with_context(|| format!("cannot create {}", path.display()))?,
+            path.clone(),
+        ),
+    };
+    if !args.jsonl && !sink.write_line(&format!("{CSV_HEADER}\n"))? {
+        return Ok(());
+    }
+    let progress = progress_bar(sweep.total_cycles());
+    let mut kept: Vec<SweepRecord> = Vec::new();
+    let mut line = String::with_capacity(160);
+    let mut shown = 0;
+    loop {
+        let record = match sweep.next_record() {
+            Ok(Some(record)) => record,
+            Ok(None) => break,
+            Err(error) => {
+                progress.abandon();
+                return Err(error).with_context(|| {
+                    format!(
+                        "the sweep of case `{}` failed at Z = {} nm after {} cycles",
+                        case.name,
+                        sweep.z_nm(),
+                        sweep.cycles_done()
+                    )
+                });
+            }
+        };
+        format_record(&record, args.jsonl, &mut line)?;
+        if !sink.write_line(&line)? {
+            progress.finish_and_clear();
+            return Ok(());
+        }
+        if plot_path.is_some() {
+            kept.push(record);
+        }
+        if sweep.cycles_done() >= shown + PROGRESS_STRIDE {
+            shown = sweep.cycles_done();
+            progress.set_position(shown);
+            progress.set_message(format!("{:8.4}", sweep.z_nm()));
+        }
+    }
+    progress.finish_and_clear();
+    if let Some(path) = plot_path {
+        let panels = sweep_panels(&case.name, &kept);
+        let svg = render_svg(&panels, 1, 2, (640, 480))?;
+        write_atomically(&path, svg.as_bytes())?;
+        eprintln!("figure: {}", path.display());
+    }
+    if let Some(path) = &args.out {
+        eprintln!("records: {}", Path::new(path).display());
+    }
+    Ok(())
+}
+
+/// A progress bar on standard error showing Z, cycles done and the time left; indicatif draws
+/// nothing when standard error is not a terminal.
+fn progress_bar(total_cycles: u64) -> ProgressBar {
+    let bar = ProgressBar::new(total_cycles);
+    if let Ok(style) = ProgressStyle::with_template(
+        "Z = {msg} nm {wide_bar} {human_pos}/{human_len} cycles, {eta} left",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// The two panels of `--plot`: phase vs A/A0, and A/A0 vs Z; approach and retract as dots of
+/// two colours.
+pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
+    let series =
+        |direction: SweepDirection, colour: usize, point: fn(&SweepRecord) -> (f64, f64)| {
+            let selected: Vec<&SweepRecord> = records
+                .iter()
+                .filter(|r| r.direction == direction)
+                .collect();
+            let stride = selected.len().div_ceil(MAX_PLOT_POINTS).max(1);
+            Series {
+                label: direction.name().to_string(),
+                points: selected.iter().step_by(stride).map(|r| point(r)).collect(),
+                stroke: Stroke::Dots,
+                colour,
+            }
+        };
+    let both = |point: fn(&SweepRecord) -> (f64, f64)| {
+        let mut all = vec![series(SweepDirection::Approach, 0, point)];
+        let retract = series(SweepDirection::Retract, 1, point);
+        if !retract.points.is_empty() {
+            all.push(retract);
+        }
+        all
+    };
+    vec![
+        Panel {
+            title: format!("{case}: phase vs amplitude ratio"),
+            x_label: String::from("A/A0"),
+            y_label: String::from("phase (deg)"),
+            series: both(|r| (r.amplitude_ratio, r.phase_deg)),
+            markers: Vec::new(),
+        },
+        Panel {
+            title: format!("{case}: amplitude ratio vs separation"),
+            x_label: String::from("Z (nm)"),
+            y_label: String::from("A/A0"),
+            series: both(|r| (r.z_nm, r.amplitude_ratio)),
+            markers: Vec::new(),
+        },
+    ]
+}
