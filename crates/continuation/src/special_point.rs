@@ -62,10 +62,12 @@ pub struct SpecialPoint {
     pub bracket: (f64, f64),
     /// `high - low` of the bracket: the achieved precision (parameter units).
     pub precision: f64,
-    /// Whether the bracket reached the location tolerance with a continuous sign change.
+    /// Whether the bracket reached the location tolerance with a sign change between its ends.
     /// False when the root finder ran out of iterations, a trial point failed, or the test
     /// function jumped across a structure change (a discontinuous crossing, reported at the
-    /// structure change's bracket).
+    /// structure change's bracket). At a hard-impact corner (a jump, or the end of a branch
+    /// that cannot go on) the far end of the bracket may be a parameter at which no orbit was
+    /// found, which counts as the far side (see [`crate::Continuation`]).
     pub converged: bool,
     /// Impacts per period on the side of the bracket the branch comes from.
     pub impacts_before: usize,

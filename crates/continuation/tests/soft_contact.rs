@@ -260,3 +260,77 @@ fn fold_after_first_contact_on_a_stiff_wall() {
     let after = &branch.points[fold.branch_index];
     assert_ne!(before.stable, after.stable);
 }
+
+/// Far above resonance (`w = 2.5`) the orbit loses stability by period doubling just after
+/// first contact. Independent check: at a period doubling one Floquet multiplier is exactly
+/// `-1`; the point is located to 1e-9 in `Z` and the multiplier moves by about 260 per unit
+/// of `Z` there (from -1.50 at `Z = 0.1860` to -1 at 0.1879), so it is `-1` to 1e-6. The
+/// orbits before it are stable, the ones after it unstable.
+#[test]
+fn period_doubling_after_first_contact_far_above_resonance() {
+    let system = SoftWall {
+        k: 1.0,
+        c: 0.1,
+        w: 2.5,
+        amplitude: 1.0,
+        stiffness: 100.0,
+        wall: 0.0,
+    };
+    let z_g = system.free_amplitude();
+    let mut start = system;
+    start.wall = 1.2 * z_g;
+    let problem = HybridPeriodicProblem::new(start, 1, Settings::default()).expect("problem");
+    let settings = ContinuationSettings {
+        initial_step: 0.02,
+        max_step: 0.02,
+        direction: ParameterDirection::Decreasing,
+        parameter_min: 0.1,
+        ..ContinuationSettings::default()
+    };
+    let branch = Continuation::new(&problem, &[0.0, 0.0], start.wall, settings)
+        .expect("start")
+        .run();
+    assert_eq!(
+        branch.stop,
+        StopReason::ParameterBound,
+        "{:?}",
+        branch.error
+    );
+    let labels: Vec<&str> = branch
+        .special_points
+        .iter()
+        .map(|s| s.label.as_str())
+        .collect();
+    assert_eq!(
+        labels,
+        ["G1", "period-doubling"],
+        "{:?}",
+        branch.special_points
+    );
+    let pd = &branch.special_points[1];
+    assert!(pd.converged && pd.precision <= 1e-9, "{pd:?}");
+    let closest = pd
+        .multipliers
+        .iter()
+        .map(|m| (m + 1.0).norm())
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        closest < 1e-6,
+        "closest multiplier to -1 is {closest:e} away"
+    );
+    for point in &branch.points {
+        if point.parameter > pd.parameter + 1e-6 {
+            assert!(
+                point.stable,
+                "Z = {}: {:?}",
+                point.parameter, point.multipliers
+            );
+        } else if point.parameter < pd.parameter - 1e-6 {
+            assert!(
+                !point.stable,
+                "Z = {}: {:?}",
+                point.parameter, point.multipliers
+            );
+        }
+    }
+}
