@@ -70,4 +70,4 @@ pub use problem::{OrbitStructure, PeriodMap, PeriodicProblem};
 pub use settings::{ContinuationSettings, ParameterDirection};
 pub use shooting::{shoot, NewtonSettings, ShootingResult};
 pub use special_point::{SpecialPoint, SpecialPointKind};
-pub use test_function::{neimark_sacker_test, period_doubling_test, ExtremumKind, TestValues};
+pub use test_function::{neimark_sacker_test, period_doubling_test, TestValues};

@@ -61,7 +61,7 @@ pub fn neimark_sacker_test(multipliers: &[Complex<f64>]) -> f64 {
 
 /// Which kind of extremum of the switching function a structure test follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ExtremumKind {
+pub(crate) enum ExtremumKind {
     /// A local minimum of `h` (a near impact, an impact, or grazing at value 0).
     Minimum,
     /// A local maximum of `h` (between two contacts when negative).
