@@ -3,9 +3,11 @@
 #![warn(missing_docs)]
 
 pub mod approach;
+pub mod cantilever;
 pub mod continue_diagram;
 pub mod model_args;
 pub mod output;
 pub mod plot;
 pub mod simulate;
+pub mod theory;
 pub mod trajectory_plot;

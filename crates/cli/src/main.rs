@@ -23,6 +23,12 @@ enum Command {
     /// A time-domain approach (and retract) sweep at a constant rate, read by a lock-in once
     /// per drive cycle (or block of cycles); the records stream out as CSV or JSON Lines.
     Approach(drumroll::approach::ApproachArgs),
+    /// The paper's approximate theory (Eqs. 3-4, lambda_1..3, the ring-down criterion) beside
+    /// the same quantities measured on the simulated steady orbit at one Z or A/A0.
+    Theory(drumroll::theory::TheoryArgs),
+    /// The Euler-Bernoulli modal table of a cantilever with a point tip mass, and a cantilever
+    /// file built from measured k_1, frequencies and quality factors.
+    Cantilever(drumroll::cantilever::CantileverArgs),
 }
 
 fn main() -> ExitCode {
@@ -31,6 +37,8 @@ fn main() -> ExitCode {
         Command::Simulate(args) => drumroll::simulate::run(args),
         Command::Continue(args) => drumroll::continue_diagram::run(args),
         Command::Approach(args) => drumroll::approach::run(args),
+        Command::Theory(args) => drumroll::theory::run(args),
+        Command::Cantilever(args) => drumroll::cantilever::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

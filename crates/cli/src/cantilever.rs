@@ -1,0 +1,521 @@
+//! `drumroll cantilever`: the Euler-Bernoulli modal table of a cantilever with a point tip mass
+//! (`beam::modal_table`), and a cantilever file built from measured values (`k_1`, natural
+//! frequencies, quality factors, tip radius) completed by the table's ratios.
+//!
+//! What is measured and what is computed: `k_1`, `f_1` and every `Q_n` must be given (there is
+//! no theory for the quality factors in liquid here, so a missing `Q_n` is refused);
+//! `f_n` (n >= 2) are used when given, otherwise `f_1` times the vacuum frequency ratio
+//! (liquid loading lowers the higher frequencies less than proportionally, so measured values
+//! are better: the paper's `f_2/f_1` in water, 7.74 and 8.0, differ from the vacuum 6.27 and
+//! 7.3); `k_n = k_1 (k_n/k_1)`, `chi_n` and `F_n/F_1` always come from the beam model.
+
+use afm::{Cantilever, Eigenmode};
+use anyhow::{bail, Context, Result};
+use beam::ModalProperties;
+use clap::{Args, ValueEnum};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::model_args::output_path;
+use crate::output::write_atomically;
+
+/// Largest accepted stiffness `k_1`, N/m (the cantilever file's bound).
+const MAX_STIFFNESS: f64 = 1e6;
+/// Largest accepted frequency, kHz (the cantilever file's bound).
+const MAX_FREQUENCY: f64 = 1e6;
+/// Largest accepted quality factor (the cantilever file's bound).
+const MAX_QUALITY: f64 = 1e6;
+/// Largest accepted tip radius, nm (the cantilever file's bound).
+const MAX_RADIUS: f64 = 1e5;
+/// Modes whose frequency and quality factor have their own option (`--f1 .. --f4`,
+/// `--q1 .. --q4`); more modes take the `--frequencies` and `--quality-factors` lists.
+const NUMBERED_MODES: usize = 4;
+
+/// How the cantilever is driven: which forcing ratios `F_n / F_1` go into the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DriveKind {
+    /// A uniformly distributed force on the beam (magnetic excitation, the paper's case).
+    Distributed,
+    /// A force at the tip.
+    Tip,
+}
+
+impl DriveKind {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Distributed => "distributed",
+            Self::Tip => "tip",
+        }
+    }
+
+    fn force_ratio(self, mode: &ModalProperties) -> f64 {
+        match self {
+            Self::Distributed => mode.force_ratio_distributed,
+            Self::Tip => mode.force_ratio_tip,
+        }
+    }
+}
+
+/// Options of `drumroll cantilever`.
+#[derive(Debug, Clone, Args)]
+pub struct CantileverArgs {
+    /// Tip mass over cantilever mass, m_tip / m_c (dimensionless, 0 to 1000; the paper: 0 for
+    /// the Biolever, 0.16 for the MAClever).
+    #[arg(long, allow_negative_numbers = true)]
+    pub tip_mass_ratio: f64,
+    /// Number of eigenmodes N (1 to 50).
+    #[arg(long, default_value_t = 2)]
+    pub modes: usize,
+    /// Measured stiffness of the first mode k_1, N/m (e.g. by Sader's method).
+    #[arg(long, allow_negative_numbers = true)]
+    pub k1: Option<f64>,
+    /// Measured natural frequency of mode 1 (in liquid), kHz.
+    #[arg(long, allow_negative_numbers = true)]
+    pub f1: Option<f64>,
+    /// Measured natural frequency of mode 2, kHz (default: f_1 times the vacuum ratio).
+    #[arg(long, allow_negative_numbers = true)]
+    pub f2: Option<f64>,
+    /// Measured natural frequency of mode 3, kHz (default: f_1 times the vacuum ratio).
+    #[arg(long, allow_negative_numbers = true)]
+    pub f3: Option<f64>,
+    /// Measured natural frequency of mode 4, kHz (default: f_1 times the vacuum ratio).
+    #[arg(long, allow_negative_numbers = true)]
+    pub f4: Option<f64>,
+    /// Measured natural frequencies of modes 1, 2, ... (kHz, comma separated; instead of
+    /// --f1 .. --f4; modes beyond the list use f_1 times the vacuum ratio).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, conflicts_with_all = ["f1", "f2", "f3", "f4"])]
+    pub frequencies: Vec<f64>,
+    /// Measured quality factor of mode 1 (in liquid).
+    #[arg(long, allow_negative_numbers = true)]
+    pub q1: Option<f64>,
+    /// Measured quality factor of mode 2.
+    #[arg(long, allow_negative_numbers = true)]
+    pub q2: Option<f64>,
+    /// Measured quality factor of mode 3.
+    #[arg(long, allow_negative_numbers = true)]
+    pub q3: Option<f64>,
+    /// Measured quality factor of mode 4.
+    #[arg(long, allow_negative_numbers = true)]
+    pub q4: Option<f64>,
+    /// Measured quality factors of modes 1..N (comma separated; instead of --q1 .. --q4).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, conflicts_with_all = ["q1", "q2", "q3", "q4"])]
+    pub quality_factors: Vec<f64>,
+    /// Tip radius R, nm.
+    #[arg(long, allow_negative_numbers = true)]
+    pub radius: Option<f64>,
+    /// Which forcing ratios F_n / F_1 the file gets: a uniformly distributed drive
+    /// (magnetic excitation) or a tip force.
+    #[arg(long, value_enum, default_value_t = DriveKind::Distributed)]
+    pub drive: DriveKind,
+    /// The cantilever's name in the file (default: the --out file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Write the cantilever file (JSON, accepted by --cantilever and case files) here.
+    #[arg(long, value_name = "FILE.json")]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object {"modes": [...]} (with "cantilever" when one is built) instead of
+    /// the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Where a mode's natural frequency comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FrequencySource {
+    Measured,
+    VacuumRatio,
+}
+
+impl FrequencySource {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Measured => "measured",
+            Self::VacuumRatio => "f1 x vacuum ratio",
+        }
+    }
+}
+
+impl CantileverArgs {
+    /// Whether any option beyond the table's (`--tip-mass-ratio`, `--modes`, `--drive`,
+    /// `--json`) asks for a cantilever to be built.
+    fn builds(&self) -> bool {
+        self.k1.is_some()
+            || self.numbered_frequencies().iter().any(Option::is_some)
+            || !self.frequencies.is_empty()
+            || self.numbered_qualities().iter().any(Option::is_some)
+            || !self.quality_factors.is_empty()
+            || self.radius.is_some()
+            || self.name.is_some()
+            || self.out.is_some()
+    }
+
+    fn numbered_frequencies(&self) -> [Option<f64>; NUMBERED_MODES] {
+        [self.f1, self.f2, self.f3, self.f4]
+    }
+
+    fn numbered_qualities(&self) -> [Option<f64>; NUMBERED_MODES] {
+        [self.q1, self.q2, self.q3, self.q4]
+    }
+
+    /// The measured frequency of each of the N modes, or `None`.
+    fn frequency_inputs(&self) -> Result<Vec<Option<f64>>> {
+        per_mode(
+            self.modes,
+            &self.numbered_frequencies(),
+            &self.frequencies,
+            "--f",
+            "--frequencies",
+        )
+    }
+
+    /// The quality factor of each of the N modes, or `None`.
+    fn quality_inputs(&self) -> Result<Vec<Option<f64>>> {
+        per_mode(
+            self.modes,
+            &self.numbered_qualities(),
+            &self.quality_factors,
+            "--q",
+            "--quality-factors",
+        )
+    }
+}
+
+/// Merge numbered options and a list into one value per mode; refuse values for modes beyond N.
+fn per_mode(
+    modes: usize,
+    numbered: &[Option<f64>; NUMBERED_MODES],
+    list: &[f64],
+    prefix: &str,
+    list_option: &str,
+) -> Result<Vec<Option<f64>>> {
+    if !list.is_empty() {
+        if list.len() > modes {
+            bail!(
+                "{list_option} has {} values but --modes is {modes}",
+                list.len()
+            );
+        }
+        let mut values: Vec<Option<f64>> = list.iter().copied().map(Some).collect();
+        values.resize(modes, None);
+        return Ok(values);
+    }
+    if let Some(index) = (modes..NUMBERED_MODES).find(|&i| numbered[i].is_some()) {
+        bail!(
+            "{prefix}{} is given but --modes is {modes}: raise --modes or drop it",
+            index + 1
+        );
+    }
+    let mut values: Vec<Option<f64>> = numbered.iter().take(modes).copied().collect();
+    values.resize(modes, None);
+    Ok(values)
+}
+
+/// Check `value` lies in `(0, max]` and is finite; the message names the option and the unit.
+fn check_positive(option: &str, value: f64, max: f64, unit: &str) -> Result<()> {
+    if value.is_finite() && value > 0.0 && value <= max {
+        Ok(())
+    } else {
+        let unit = if unit.is_empty() {
+            "(dimensionless)"
+        } else {
+            unit
+        };
+        bail!("{option} {value}: must be in (0, {max}] {unit}")
+    }
+}
+
+/// Run `drumroll cantilever`.
+pub fn run(args: &CantileverArgs) -> Result<()> {
+    let table = beam::modal_table(args.tip_mass_ratio, args.modes)
+        .context("invalid --tip-mass-ratio or --modes")?;
+    let out = args
+        .out
+        .as_ref()
+        .map(|p| output_path(p, "json", "--out"))
+        .transpose()?;
+    let built = if args.builds() {
+        Some(build(args, &table, out.as_deref())?)
+    } else {
+        None
+    };
+    if let (Some(path), Some((cantilever, _))) = (&out, &built) {
+        let mut text = serde_json::to_string_pretty(cantilever)?;
+        text.push('\n');
+        write_atomically(path, text.as_bytes())?;
+        afm::fixtures::load_cantilever(path).with_context(|| {
+            format!(
+                "the written file {} does not load back as a cantilever",
+                path.display()
+            )
+        })?;
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&table_json(
+                args,
+                &table,
+                built.as_ref(),
+                out.as_deref()
+            ))?
+        );
+    } else {
+        print!("{}", summary(args, &table, built.as_ref(), out.as_deref()));
+    }
+    Ok(())
+}
+
+/// The cantilever from the measured values and the table, with where each frequency came from.
+fn build(
+    args: &CantileverArgs,
+    table: &[ModalProperties],
+    out: Option<&Path>,
+) -> Result<(Cantilever, Vec<FrequencySource>)> {
+    let frequencies = args.frequency_inputs()?;
+    let qualities = args.quality_inputs()?;
+    // Every value given is checked first, so that a bad value is named even when others are
+    // missing.
+    if let Some(k1) = args.k1 {
+        check_positive("--k1", k1, MAX_STIFFNESS, "N/m")?;
+    }
+    if let Some(radius) = args.radius {
+        check_positive("--radius", radius, MAX_RADIUS, "nm")?;
+    }
+    for (index, frequency) in frequencies.iter().enumerate() {
+        if let Some(frequency) = frequency {
+            check_positive(
+                &format!("--f{}", index + 1),
+                *frequency,
+                MAX_FREQUENCY,
+                "kHz",
+            )?;
+        }
+    }
+    for (index, quality) in qualities.iter().enumerate() {
+        if let Some(quality) = quality {
+            check_positive(&format!("--q{}", index + 1), *quality, MAX_QUALITY, "")?;
+        }
+    }
+    let (Some(k1), Some(Some(f1)), Some(radius)) = (args.k1, frequencies.first(), args.radius)
+    else {
+        bail!(
+            "to build a cantilever give --k1 (N/m), --f1 (kHz), --radius (nm) and a quality \
+             factor for every mode (--q1 .. --q{}, or --quality-factors); with only \
+             --tip-mass-ratio and --modes the modal table is printed alone",
+            args.modes
+        );
+    };
+    let missing: Vec<String> = qualities
+        .iter()
+        .enumerate()
+        .filter(|(_, q)| q.is_none())
+        .map(|(index, _)| format!("--q{}", index + 1))
+        .collect();
+    if !missing.is_empty() {
+        bail!(
+            "missing quality factor(s) {}: give a measured Q for every mode (e.g. from thermal \
+             spectra in liquid); there is no theory for Q in liquid here",
+            missing.join(", ")
+        );
+    }
+    let mut modes = Vec::with_capacity(table.len());
+    let mut sources = Vec::with_capacity(table.len());
+    for ((mode, frequency), quality) in table.iter().zip(&frequencies).zip(&qualities) {
+        let index = mode.index;
+        let quality = quality.unwrap_or(f64::NAN);
+        let (frequency, source) = match frequency {
+            Some(value) => (*value, FrequencySource::Measured),
+            None => (*f1 * mode.frequency_ratio, FrequencySource::VacuumRatio),
+        };
+        let first = index == 1;
+        modes.push(Eigenmode {
+            stiffness_n_per_m: k1 * mode.stiffness_ratio,
+            frequency_khz: frequency,
+            quality_factor: quality,
+            optical_sensitivity: if first { 1.0 } else { mode.chi },
+            force_ratio: if first {
+                1.0
+            } else {
+                args.drive.force_ratio(mode)
+            },
+        });
+        sources.push(source);
+    }
+    for (index, pair) in modes.windows(2).enumerate() {
+        if pair[1].frequency_khz <= pair[0].frequency_khz {
+            bail!(
+                "f{} = {} kHz is not above f{} = {} kHz: the natural frequencies must increase \
+                 with the mode number",
+                index + 2,
+                pair[1].frequency_khz,
+                index + 1,
+                pair[0].frequency_khz
+            );
+        }
+    }
+    let name = match (&args.name, out) {
+        (Some(name), _) => name.clone(),
+        (None, Some(path)) => path
+            .file_stem()
+            .and_then(|stem| stem.to_str())
+            .unwrap_or("cantilever")
+            .to_string(),
+        (None, None) => String::from("cantilever"),
+    };
+    let measured_frequencies: Vec<String> = sources
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| **s == FrequencySource::Measured)
+        .map(|(index, _)| format!("f{}", index + 1))
+        .collect();
+    let cantilever = Cantilever {
+        name,
+        description: format!(
+            "built by `drumroll cantilever`: measured k1, {}, Q1..Q{}, R; k_n/k_1, chi_n, \
+             F_n/F_1 ({} drive){} from Euler-Bernoulli modes with m_tip/m_c = {}",
+            measured_frequencies.join(", "),
+            table.len(),
+            args.drive.name(),
+            if measured_frequencies.len() < table.len() {
+                ", the other frequencies f_1 x vacuum ratio"
+            } else {
+                ""
+            },
+            args.tip_mass_ratio
+        ),
+        tip_radius_nm: radius,
+        tip_mass_ratio: args.tip_mass_ratio,
+        tip_youngs_modulus_gpa: afm::cantilever::DEFAULT_TIP_YOUNGS_MODULUS_GPA,
+        tip_poisson_ratio: afm::cantilever::DEFAULT_POISSON_RATIO,
+        modes,
+    };
+    cantilever
+        .validate("the built cantilever")
+        .context("the built cantilever is not valid")?;
+    Ok((cantilever, sources))
+}
+
+/// The JSON of `drumroll cantilever --json`: `{"modes": [...]}` with every table ratio, plus
+/// the built values per mode and the whole cantilever when one is built.
+fn table_json(
+    args: &CantileverArgs,
+    table: &[ModalProperties],
+    built: Option<&(Cantilever, Vec<FrequencySource>)>,
+    out: Option<&Path>,
+) -> serde_json::Value {
+    let modes: Vec<serde_json::Value> = table
+        .iter()
+        .enumerate()
+        .map(|(index, mode)| {
+            let mut entry = json!({
+                "index": mode.index,
+                "eigenvalue": mode.eigenvalue,
+                "frequency_ratio": mode.frequency_ratio,
+                "stiffness_ratio": mode.stiffness_ratio,
+                "chi": mode.chi,
+                "force_ratio_distributed": mode.force_ratio_distributed,
+                "force_ratio_tip": mode.force_ratio_tip,
+            });
+            if let (Some((cantilever, sources)), Some(map)) = (built, entry.as_object_mut()) {
+                let eigenmode = &cantilever.modes[index];
+                map.insert(
+                    "stiffness_n_per_m".into(),
+                    eigenmode.stiffness_n_per_m.into(),
+                );
+                map.insert("frequency_khz".into(), eigenmode.frequency_khz.into());
+                map.insert("frequency_source".into(), sources[index].name().into());
+                map.insert("quality_factor".into(), eigenmode.quality_factor.into());
+                map.insert(
+                    "optical_sensitivity".into(),
+                    eigenmode.optical_sensitivity.into(),
+                );
+                map.insert("force_ratio".into(), eigenmode.force_ratio.into());
+            }
+            entry
+        })
+        .collect();
+    let mut value = json!({
+        "tip_mass_ratio": args.tip_mass_ratio,
+        "drive": args.drive.name(),
+        "frequency_ratios": "in vacuum (liquid loading changes them)",
+        "modes": modes,
+    });
+    if let (Some((cantilever, _)), Some(map)) = (built, value.as_object_mut()) {
+        map.insert("cantilever".into(), json!(cantilever));
+        if let Some(path) = out {
+            map.insert("out".into(), path.display().to_string().into());
+        }
+    }
+    value
+}
+
+/// The readable output: the modal table, then the built cantilever's modes.
+fn summary(
+    args: &CantileverArgs,
+    table: &[ModalProperties],
+    built: Option<&(Cantilever, Vec<FrequencySource>)>,
+    out: Option<&Path>,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Euler-Bernoulli cantilever, tip mass ratio m_tip/m_c = {}, modes normalised to unit tip \
+         deflection",
+        args.tip_mass_ratio
+    );
+    let _ = writeln!(
+        s,
+        "{:>4}{:>12}{:>12}{:>12}{:>10}{:>16}{:>14}",
+        "n", "b_n", "w_n/w_1", "k_n/k_1", "chi_n", "F_n/F_1 distr.", "F_n/F_1 tip"
+    );
+    for mode in table {
+        let _ = writeln!(
+            s,
+            "{:>4}{:>12.6}{:>12.6}{:>12.4}{:>10.4}{:>16.4}{:>14.4}",
+            mode.index,
+            mode.eigenvalue,
+            mode.frequency_ratio,
+            mode.stiffness_ratio,
+            mode.chi,
+            mode.force_ratio_distributed,
+            mode.force_ratio_tip
+        );
+    }
+    let _ = writeln!(
+        s,
+        "(w_n/w_1 in vacuum: liquid loading changes the frequency ratios; measured frequencies \
+         are better)"
+    );
+    if let Some((cantilever, sources)) = built {
+        let _ = writeln!(
+            s,
+            "cantilever `{}`: R = {} nm, {} drive",
+            cantilever.name,
+            cantilever.tip_radius_nm,
+            args.drive.name()
+        );
+        let _ = writeln!(
+            s,
+            "{:>4}{:>14}{:>14}{:>20}{:>10}{:>10}{:>10}",
+            "n", "k_n [N/m]", "f_n [kHz]", "f_n from", "Q_n", "chi_n", "F_n/F_1"
+        );
+        for (index, (mode, source)) in cantilever.modes.iter().zip(sources).enumerate() {
+            let _ = writeln!(
+                s,
+                "{:>4}{:>14.6}{:>14.6}{:>20}{:>10}{:>10.4}{:>10.4}",
+                index + 1,
+                mode.stiffness_n_per_m,
+                mode.frequency_khz,
+                source.name(),
+                mode.quality_factor,
+                mode.optical_sensitivity,
+                mode.force_ratio
+            );
+        }
+        if let Some(path) = out {
+            let _ = writeln!(s, "written: {}", path.display());
+        }
+    }
+    s
+}
