@@ -6,8 +6,9 @@
 //! no theory for the quality factors in liquid here, so a missing `Q_n` is refused);
 //! `f_n` (n >= 2) are used when given, otherwise `f_1` times the vacuum frequency ratio
 //! (liquid loading lowers the higher frequencies less than proportionally, so measured values
-//! are better: the paper's `f_2/f_1` in water, 7.74 and 8.0, differ from the vacuum 6.27 and
-//! 7.3); `k_n = k_1 (k_n/k_1)`, `chi_n` and `F_n/F_1` always come from the beam model.
+//! are better: the paper's `f_2/f_1` in water, 72/9.3 = 7.74 for the Biolever and 28/3.5 = 8.0
+//! for the MAClever, differ from the vacuum ratios 6.27 at `m_tip/m_c = 0` and 6.78 at 0.16);
+//! `k_n = k_1 (k_n/k_1)`, `chi_n` and `F_n/F_1` always come from the beam model.
 
 use afm::{Cantilever, Eigenmode};
 use anyhow::{bail, Context, Result};

@@ -207,6 +207,13 @@ pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) 
         m.impacts.len(),
         m.contact_time_periods
     );
+    if m.impacts.is_empty() {
+        let _ = writeln!(
+            s,
+            "no impact on this orbit (first contact is at Z_G1 = {:.9} nm): nothing to compare",
+            model.grazing_separation_nm()
+        );
+    }
     let _ = writeln!(
         s,
         "phase used: phi = {:.4} deg, the first harmonic of the simulated q_1 (u's phase is \

@@ -339,7 +339,7 @@ pub fn measure_impacts(
         contact_time_periods: impacts
             .iter()
             .map(|impact| impact.end_periods - impact.start_periods)
-            .sum(),
+            .fold(0.0, |total, duration| total + duration),
         impacts,
         main_impact,
         ringing,
@@ -409,5 +409,57 @@ fn ringing(
         amplitude_at_next_impact_nm: at_next,
         decay_over_period: at_next / initial,
         effective_decay_time_us: elapsed / (initial / at_next).ln(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{merge_wrapped, wrap, Fragment};
+    use std::f64::consts::PI;
+
+    /// An impact in progress at both ends of the window is one impact: onset from the tail,
+    /// release from the head shifted by T, impulses added, and the first moment of the head
+    /// taken at `t + T` (so the centroid lies between onset and release).
+    #[test]
+    fn wrapped_contact_is_one_impact() {
+        let period = 10.0;
+        let head = Fragment {
+            start: None,
+            end: Some((0.5, vec![1.0])),
+            impulse: 2.0,
+            moment: 2.0 * 0.25,
+        };
+        let middle = Fragment {
+            start: Some((4.0, vec![2.0])),
+            end: Some((4.5, vec![3.0])),
+            impulse: 1.0,
+            moment: 4.25,
+        };
+        let tail = Fragment {
+            start: Some((9.5, vec![4.0])),
+            end: None,
+            impulse: 2.0,
+            moment: 2.0 * 9.75,
+        };
+        let merged = merge_wrapped(vec![head, middle, tail], period);
+        assert_eq!(merged.len(), 2);
+        let wrapped = &merged[1];
+        assert_eq!(wrapped.start.as_ref().map(|s| s.0), Some(9.5));
+        assert_eq!(wrapped.end.as_ref().map(|e| e.0), Some(10.5));
+        assert_eq!(wrapped.impulse, 4.0);
+        // A symmetric pulse around t = 10: centroid exactly there.
+        assert_eq!(wrapped.moment / wrapped.impulse, 10.0);
+        // Contact throughout: one fragment, neither onset nor release, left alone.
+        let throughout = merge_wrapped(vec![Fragment::open(None)], period);
+        assert_eq!(throughout.len(), 1);
+        assert!(throughout[0].start.is_none() && throughout[0].end.is_none());
+    }
+
+    #[test]
+    fn angles_wrap_into_the_half_open_interval() {
+        assert_eq!(wrap(PI), PI);
+        assert_eq!(wrap(-PI), PI);
+        assert!((wrap(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-15);
+        assert!((wrap(-5.0 * PI / 2.0) + PI / 2.0).abs() < 1e-15);
     }
 }
