@@ -26,6 +26,7 @@ pub mod eigenmode;
 pub mod error;
 pub mod fixtures;
 pub mod free_flight;
+pub mod free_flight_fourier;
 pub mod free_response;
 pub mod hertz;
 pub mod impact_numbers;

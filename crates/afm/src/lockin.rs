@@ -11,20 +11,22 @@
 //! of those readings over consecutive blocks of `N` cycles, as a lock-in amplifier with an
 //! integration time of `N T` reports them.
 //!
-//! The integrals are 4-point Gauss-Legendre quadratures over every solver step (exact to
-//! rounding in free flight, where the solver interpolates with the exact flow; to dense-output
-//! accuracy in contact). Nothing here allocates after construction.
+//! The integrals are taken in closed form over every free-flight interval
+//! ([`crate::free_flight_fourier`], exact to rounding) and by 4-point Gauss-Legendre quadrature
+//! over every contact step (to dense-output accuracy). Nothing here allocates after
+//! construction.
 
-use hybrid::{Direction, ExtremumKind, HybridSystem, Solver, StepOutcome};
+use hybrid::{Direction, ExtremumKind, HybridSystem, Mode, Solver, StepOutcome};
 
+use crate::free_flight_fourier::FreeFlightFourier;
 use crate::model::GAP_SURFACE;
 use crate::TappingModel;
 
-/// Gauss-Legendre nodes on [-1, 1] (positive half) for 4 points. Exact-flow steps are at most
-/// a quarter of the shortest modal period long, so the integrand `u cos(w t)` turns by at most
+/// Gauss-Legendre nodes on [-1, 1] (positive half) for 4 points, for contact steps (and for
+/// free flight only near critical damping). Steps are at most a quarter of the shortest modal
+/// period long (contact steps far shorter), so the integrand `u cos(w t)` turns by at most
 /// `(pi/2)(1 + w / w_N)` over a step; the 4-point rule's error there is below 1e-7 of the
-/// integrand's size (the 8-point rule of `observables` costs twice as many interpolations,
-/// which dominate a sweep's free flight). Contact steps are far shorter.
+/// integrand's size.
 const GAUSS_NODES: [f64; 2] = [0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
 /// The matching Gauss-Legendre weights.
 const GAUSS_WEIGHTS: [f64; 2] = [0.652_145_154_862_546_1, 0.347_854_845_137_453_8];
@@ -57,6 +59,17 @@ pub struct CycleLockIn {
     impacts: usize,
     peak_force: f64,
     state: Vec<f64>,
+    /// The closed form over free flight (`None` near critical damping: quadrature instead).
+    free_flight: Option<FreeFlightFourier>,
+    /// The mode at the start of the next step (the solver's mode after the last one).
+    mode: Mode,
+    /// The state at the end of the last step observed.
+    previous_state: Vec<f64>,
+    /// The end time of the last step observed (a repeated step is not counted twice).
+    previous_end: f64,
+    /// Start time and state of the free-flight interval in progress, if any.
+    free_start: Option<f64>,
+    free_state: Vec<f64>,
 }
 
 impl CycleLockIn {
@@ -70,6 +83,12 @@ impl CycleLockIn {
             impacts: 0,
             peak_force: 0.0,
             state: vec![0.0; model.dim()],
+            free_flight: FreeFlightFourier::new(model),
+            mode: 0,
+            previous_state: vec![0.0; model.dim()],
+            previous_end: 0.0,
+            free_start: None,
+            free_state: vec![0.0; model.dim()],
         }
     }
 
@@ -80,26 +99,37 @@ impl CycleLockIn {
         self.sine = 0.0;
         self.impacts = 0;
         self.peak_force = model.tip_sample_force(0.0, x0);
+        self.mode = model.mode_of(0.0, x0);
+        self.previous_state.copy_from_slice(x0);
+        self.previous_end = 0.0;
+        self.free_start = None;
     }
 
-    /// Accumulate the solver's last step: the Gauss-Legendre quadrature of `u cos(w t)` and
-    /// `u sin(w t)` on `Solver::interpolate`, the Hertz force at every gap minimum of the step,
-    /// and a contact onset if the step ended at one.
+    /// Accumulate the solver's last step: over free flight (exact-flow steps), the closed form
+    /// of [`FreeFlightFourier`] once per free-flight interval; over other steps the 4-point
+    /// Gauss-Legendre quadrature of `u cos(w t)` and `u sin(w t)` on `Solver::interpolate`.
+    /// Also the Hertz force at every gap minimum of the step, and a contact onset if the step
+    /// ended at one. A step reported again (`Solver::step` called at its end time) is skipped.
     pub fn observe(&mut self, solver: &Solver<TappingModel>, outcome: &StepOutcome) {
         let model = solver.system();
         let (a, b) = solver.last_step();
-        if b > a {
-            let middle = 0.5 * (a + b);
-            let half = 0.5 * (b - a);
-            for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
-                for t in [middle - half * node, middle + half * node] {
-                    solver.interpolate(t, &mut self.state);
-                    let u = model.photodiode(&self.state);
-                    let (sin, cos) = (self.angular_frequency * t).sin_cos();
-                    self.cosine += weight * half * u * cos;
-                    self.sine += weight * half * u * sin;
+        if b > a && b > self.previous_end {
+            let closed_form = self.free_flight.is_some() && model.has_exact_flow(self.mode);
+            if closed_form {
+                if self.free_start.is_none() {
+                    self.free_start = Some(a);
+                    self.free_state.copy_from_slice(&self.previous_state);
                 }
+                if !matches!(outcome, StepOutcome::Internal) {
+                    self.close_free_flight(b);
+                }
+            } else {
+                self.close_free_flight(a);
+                self.quadrature(solver, model, a, b);
             }
+            self.previous_end = b;
+            self.previous_state.copy_from_slice(solver.state());
+            self.mode = solver.mode();
         }
         for extremum in solver.step_extrema() {
             if extremum.surface == GAP_SURFACE
@@ -116,8 +146,34 @@ impl CycleLockIn {
         }
     }
 
+    /// Add the closed-form integrals over the free-flight interval in progress, up to `end`.
+    fn close_free_flight(&mut self, end: f64) {
+        if let (Some(start), Some(free_flight)) = (self.free_start.take(), &self.free_flight) {
+            let [cosine, sine] = free_flight.integrate(start, &self.free_state, end);
+            self.cosine += cosine;
+            self.sine += sine;
+        }
+    }
+
+    /// 4-point Gauss-Legendre quadrature of `u cos(w t)`, `u sin(w t)` over `[a, b]` (inside
+    /// the solver's last step).
+    fn quadrature(&mut self, solver: &Solver<TappingModel>, model: &TappingModel, a: f64, b: f64) {
+        let middle = 0.5 * (a + b);
+        let half = 0.5 * (b - a);
+        for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
+            for t in [middle - half * node, middle + half * node] {
+                solver.interpolate(t, &mut self.state);
+                let u = model.photodiode(&self.state);
+                let (sin, cos) = (self.angular_frequency * t).sin_cos();
+                self.cosine += weight * half * u * cos;
+                self.sine += weight * half * u * sin;
+            }
+        }
+    }
+
     /// The reading of the cycle, given the state `x_end` at its end (local time `T`).
-    pub fn finish(&self, model: &TappingModel, x_end: &[f64]) -> CycleReading {
+    pub fn finish(&mut self, model: &TappingModel, x_end: &[f64]) -> CycleReading {
+        self.close_free_flight(self.previous_end);
         let scale = 2.0 / self.period;
         CycleReading {
             cosine_nm: scale * self.cosine,
