@@ -222,6 +222,8 @@ pub fn steady_orbit(
     )?;
     states.push(x.clone());
     let scale = model.free_amplitude_nm();
+    // The best non-converged attempt: (multiplicity, state, iterations, residual, multipliers).
+    #[allow(clippy::type_complexity)]
     let mut best: Option<(usize, Vec<f64>, usize, f64, Vec<Complex<f64>>)> = None;
     for _ in 0..settings.recurrence_periods {
         x = flow_map(

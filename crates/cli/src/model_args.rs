@@ -91,9 +91,9 @@ fn is_file_reference(reference: &str) -> bool {
 pub const DEFAULT_CASE: &str = "biolever-mica";
 
 /// A path for an output file, checked to have the expected extension.
-pub fn output_path(path: &PathBuf, extension: &str, option: &str) -> Result<PathBuf> {
+pub fn output_path(path: &Path, extension: &str, option: &str) -> Result<PathBuf> {
     match path.extension().and_then(|e| e.to_str()) {
-        Some(e) if e.eq_ignore_ascii_case(extension) => Ok(path.clone()),
+        Some(e) if e.eq_ignore_ascii_case(extension) => Ok(path.to_path_buf()),
         _ => bail!(
             "{option} {}: the file name must end in .{extension}",
             path.display()
