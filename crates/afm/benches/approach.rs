@@ -5,7 +5,8 @@
 //! about 24 ms per drive cycle (the reference figure).
 //!
 //! Run with `cargo bench -p afm --bench approach` (release build, one core). Pass `--quick`
-//! after `--` to sweep only 11 nm -> 8 nm.
+//! after `--` to sweep only 11 nm -> 8 nm, `--samples N` to change the solver's samples per
+//! step (default 8).
 
 use afm::{builtin_case, Sweep, SweepSettings, TappingModel};
 use std::time::Instant;
@@ -31,6 +32,18 @@ fn main() {
     settings.to_nm = if quick { 8.0 } else { 0.0 };
     settings.rate_nm_per_s = 1.0;
     settings.settle_cycles = 0;
+    // `--samples N`: the solver's samples per step (extrema search), to weigh its cost.
+    let arguments: Vec<String> = std::env::args().collect();
+    if let Some(index) = arguments.iter().position(|a| a == "--samples") {
+        settings.integration.samples_per_step = arguments
+            .get(index + 1)
+            .and_then(|n| n.parse().ok())
+            .expect("--samples N");
+        println!(
+            "samples per step: {}",
+            settings.integration.samples_per_step
+        );
+    }
     let mut sweep = Sweep::new(&model, settings).expect("sweep");
     let cycles = sweep.total_cycles();
     println!(
