@@ -225,7 +225,8 @@ impl Sweep {
     /// free steady state (exact above first contact) at `settings.from_nm`.
     ///
     /// # Errors
-    /// [`AfmError::InvalidField`] for invalid settings or a sweep shorter than one drive cycle.
+    /// [`AfmError::InvalidField`] for invalid settings, a sweep shorter than one drive cycle,
+    /// or a lock-in block longer than one sweep direction.
     pub fn new(model: &TappingModel, settings: SweepSettings) -> Result<Self, AfmError> {
         settings.validate()?;
         let period = model.period_us();
@@ -247,6 +248,14 @@ impl Sweep {
             ));
         }
         let cycles_per_leg = cycles_per_leg as u64;
+        if settings.lockin_cycles as u64 > cycles_per_leg {
+            return Err(invalid(
+                "sweep settings",
+                "lockin_cycles",
+                settings.lockin_cycles as f64,
+                format!("at most the {cycles_per_leg} drive cycles of one sweep direction"),
+            ));
+        }
         let mut model = model.clone();
         model.set_separation(Separation::Constant(settings.from_nm))?;
         Ok(Self {

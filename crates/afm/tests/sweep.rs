@@ -210,6 +210,14 @@ fn invalid_settings_name_the_field_and_range() {
             },
             "every: an integer in [1,",
         ),
+        // A lock-in block longer than the sweep (1 nm at 1 nm/s is 9300 cycles).
+        (
+            SweepSettings {
+                lockin_cycles: 10_000,
+                ..base.clone()
+            },
+            "lockin_cycles: at most the 9300 drive cycles",
+        ),
         // Shorter than one drive cycle's travel (1e6 nm/s moves 107 nm per cycle).
         (
             SweepSettings {

@@ -199,6 +199,10 @@ fn bad_options_are_refused_with_the_option_named() {
         (vec!["--tolerance", "1"], "--tolerance"),
         (vec!["--from", "10", "--to", "9.9999"], "drive cycle"),
         (vec!["--plot", "figure.png"], ".svg"),
+        (
+            vec!["--from", "9", "--to", "8.99", "--lockin-cycles", "1000"],
+            "lockin_cycles",
+        ),
     ] {
         let output = drumroll()
             .arg("approach")
