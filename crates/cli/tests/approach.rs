@@ -214,3 +214,38 @@ fn bad_options_are_refused_with_the_option_named() {
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
     }
 }
+
+/// A run killed mid-sweep leaves a file of complete records: every line whole (one write per
+/// record), the header first, rows in order.
+#[test]
+fn a_killed_run_leaves_only_complete_records() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let out = directory.path().join("killed.csv");
+    // 11 nm -> 0 at 1 nm/s: ~100,000 cycles, far more than runs before the kill.
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("drumroll"))
+        .args(["approach", "--from", "11", "--to", "0", "--out"])
+        .arg(&out)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("starts");
+    // Wait until some records are there, then kill the process (SIGKILL: no clean-up).
+    let start = std::time::Instant::now();
+    while std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0) < 20_000 {
+        assert!(start.elapsed().as_secs() < 60, "no records within a minute");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().expect("killed");
+    child.wait().expect("reaped");
+    let text = std::fs::read_to_string(&out).expect("records file");
+    assert!(text.ends_with('\n'), "the last record is complete");
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("cycle,z_nm,amplitude_ratio,phase_deg,impacts,peak_force_nn,direction")
+    );
+    let rows: Vec<_> = lines.map(parse_row).collect();
+    assert!(rows.len() > 100);
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row.0, k as u64);
+    }
+}
