@@ -23,10 +23,10 @@ use crate::model::GAP_SURFACE;
 use crate::TappingModel;
 
 /// Gauss-Legendre nodes on [-1, 1] (positive half) for 4 points, for contact steps (and for
-/// free flight only near critical damping). Steps are at most a quarter of the shortest modal
-/// period long (contact steps far shorter), so the integrand `u cos(w t)` turns by at most
-/// `(pi/2)(1 + w / w_N)` over a step; the 4-point rule's error there is below 1e-7 of the
-/// integrand's size.
+/// free flight only near critical damping). The rule is exact for polynomials of degree 7, the
+/// degree of DOP853's dense output, so its error comes from the drive factor `cos(w t)` alone:
+/// about `(w h)^8 / 3e6` relative for a step `h`, below 1e-7 even for a step of a quarter
+/// drive period (contact steps are far shorter).
 const GAUSS_NODES: [f64; 2] = [0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
 /// The matching Gauss-Legendre weights.
 const GAUSS_WEIGHTS: [f64; 2] = [0.652_145_154_862_546_1, 0.347_854_845_137_453_8];
