@@ -123,6 +123,13 @@ impl Dop853 {
         self.evaluate_stage(rhs, 0, t, dim);
     }
 
+    /// Stage 0 (`f(t, z)` at the start of the next attempt) for components `0..out.len()`.
+    pub fn first_stage(&self, out: &mut [f64]) {
+        for (c, o) in out.iter_mut().enumerate() {
+            *o = self.stages[c * STAGES_EXTENDED];
+        }
+    }
+
     /// Copy stage 12 (the derivative at the end of the last accepted step) to stage 0: the
     /// first-same-as-last property.
     pub fn reuse_last_derivative(&mut self) {

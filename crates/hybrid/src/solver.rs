@@ -40,6 +40,18 @@
 //! inside the step's last millionth instead of forcing a sequence of shrinking steps); and on
 //! successive rejections the error's actual order in `h` is estimated from the last two
 //! attempts (far below 8 next to a singularity such as a Hertz contact onset).
+//!
+//! Before each Runge-Kutta step the next crossing is predicted from the state (the quadratic
+//! in time of `h_k`, its rate, and the rate's derivative along the field). A proposed step
+//! reaching `LANDING_REACH` of the predicted distance is stretched to land `1e-3` of the
+//! distance past the crossing, so one step holds it and the event is located by dense output.
+//! If that landing is rejected (next to a Hertz release the error of a step ending at the kink
+//! grows like its length to the power 3.5, whatever the method's order), the distance from
+//! which a landing should pass is estimated from the rejected error, and the crossing is
+//! approached in steps of at most `APPROACH_FRACTION` of the remaining distance (the mirror
+//! image of the step growth after an onset) until a landing is tried from there. Measured on
+//! one period of the Biolever on mica at `A/A0 = 0.95`: 16 rejected steps and 710 RHS
+//! evaluations before, 9 and 633 after.
 
 use nalgebra::{DMatrix, DMatrixView};
 
@@ -111,6 +123,8 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     field: VariationalField,
     rk: Dop853,
     proposed_step: Option<f64>,
+    landing_limit: Option<f64>,
+    x_ahead: Vec<f64>,
     first_same_as_last: bool,
     kind: StepKind,
     step_mode: Mode,
@@ -193,6 +207,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             field: VariationalField::new(n, sensitivity),
             rk: Dop853::new(dim, n, settings.sensitivity_tolerance),
             proposed_step: settings.initial_step,
+            landing_limit: None,
+            x_ahead: vec![0.0; n],
             first_same_as_last: false,
             kind: StepKind::None,
             step_mode: 0,
@@ -249,6 +265,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.mode = self.system.mode_of(t0, x0);
         self.transition.fill_with_identity();
         self.proposed_step = self.settings.initial_step;
+        self.landing_limit = None;
         self.first_same_as_last = false;
         self.kind = StepKind::None;
         self.step_start = t0;
@@ -568,9 +585,36 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 .initial_step(&mut rhs, t0, &self.z, rtol, atol, max_step),
         }
         .min(max_step);
+        // Aim at the predicted crossing (see the module docs): land just past it when the
+        // proposed step reaches it, or approach it in steps of a fixed fraction of the distance
+        // once a landing from too far has failed.
+        let mut landing: Option<f64> = None;
+        if let Some(s) = predict_crossing(
+            system,
+            &self.rk,
+            &mut self.x_ahead,
+            &self.z[..self.n],
+            mode,
+            self.surfaces,
+            t0,
+            h,
+        ) {
+            // Too close to resolve in time (a Zeno accumulation): leave the step to the
+            // controller and the event location.
+            let resolvable = s > 1024.0 * f64::EPSILON * t0.abs();
+            if resolvable && s < t_end - t0 {
+                let limit_ok = self.landing_limit.is_none_or(|limit| s <= limit);
+                if limit_ok && h >= LANDING_REACH * s {
+                    h = (s * (1.0 + PREDICTED_OVERSHOOT)).min(max_step);
+                    landing = Some(s);
+                } else if !limit_ok {
+                    h = h.min(APPROACH_FRACTION * s);
+                }
+            }
+        }
         let mut rejected = false;
         let mut non_finite = false;
-        let mut landing_tried = false;
+        let mut landing_tried = landing.is_some();
         let mut previous: Option<(f64, f64)> = None;
         let (hs, lands, error) = loop {
             let attempts = self.statistics.steps + self.statistics.rejected_steps;
@@ -608,6 +652,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 continue;
             }
             non_finite = false;
+            // A predicted landing that failed: the step ending at a non-smooth crossing is too
+            // long. Its error grows like a power of its length (s^3.5 next to a Hertz
+            // contact's kink, larger for smoother kinks, so the estimate is conservative):
+            // remember the distance from which a landing should succeed and approach it.
+            if let Some(s) = landing.take() {
+                let limit = s * (0.5 / error).powf(1.0 / 3.5).clamp(0.01, 0.9);
+                self.landing_limit = Some(self.landing_limit.map_or(limit, |l| l.min(limit)));
+                h = APPROACH_FRACTION * s;
+                previous = None;
+                continue;
+            }
             // A trial that ends across a switching surface was probably rejected for the kink
             // of the field there: retry once landing just past the estimated crossing, so the
             // step holds the crossing with a negligible non-smooth part (instead of a geometric
@@ -902,6 +957,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.step_end = t_event;
         self.first_same_as_last = false;
         self.samples.start_valid = false;
+        self.landing_limit = None;
         self.sync_transition();
         Ok(Event {
             t: t_event,
@@ -926,6 +982,19 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
 
 /// Fraction of a step past the estimated crossing at which a retried step lands.
 const LANDING_OVERSHOOT: f64 = 1e-6;
+
+/// Fraction of the predicted distance past the predicted crossing at which a step aimed at it
+/// ends (covers the prediction's error, so the crossing lies inside the step).
+const PREDICTED_OVERSHOOT: f64 = 1e-3;
+
+/// A proposed step reaching this fraction of the predicted distance to a crossing is stretched
+/// to land just past it.
+const LANDING_REACH: f64 = 0.6;
+
+/// Once a landing has failed, steps towards the crossing are at most this fraction of the
+/// predicted distance (a graded approach to the non-smooth point, the mirror image of the
+/// step growth after a contact onset).
+const APPROACH_FRACTION: f64 = 0.5;
 
 /// If the trial step from `(t0, z0)` to `(t1, z1)` ends across a switching surface (on the
 /// other side of the one the mode says), the fraction `theta` of the step at which the cubic
@@ -970,6 +1039,71 @@ fn crossing_fraction<S: HybridSystem + ?Sized>(
         }
     }
     earliest
+}
+
+/// The predicted time from `t0` to the first crossing of any switching surface, from the
+/// quadratic `g + r s + a s^2 / 2` in the current state (`g = |h_k|`, `r` its rate, `a`
+/// the rate's derivative along the field by a forward difference over `1e-4 h`), if one
+/// is predicted. Stage 0 of `rk` must hold `f(t0, x)`.
+#[allow(clippy::too_many_arguments)]
+fn predict_crossing<S: HybridSystem + ?Sized>(
+    system: &S,
+    rk: &Dop853,
+    x_ahead: &mut [f64],
+    x: &[f64],
+    mode: Mode,
+    surfaces: usize,
+    t0: f64,
+    h: f64,
+) -> Option<f64> {
+    let delta = 1e-4 * h;
+    if !(delta > 0.0 && delta.is_finite()) {
+        return None;
+    }
+    rk.first_stage(x_ahead);
+    for (ahead, &xc) in x_ahead.iter_mut().zip(x) {
+        *ahead = xc + delta * *ahead;
+    }
+    let mut earliest: Option<f64> = None;
+    for k in 0..surfaces {
+        let sigma = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
+        let g = (sigma * system.switching(k, t0, x)).max(0.0);
+        let r = sigma * system.switching_rate(k, mode, t0, x);
+        let r_ahead = sigma * system.switching_rate(k, mode, t0 + delta, x_ahead);
+        let a = (r_ahead - r) / delta;
+        if let Some(s) = first_positive_root(0.5 * a, r, g) {
+            if earliest.is_none_or(|e| s < e) {
+                earliest = Some(s);
+            }
+        }
+    }
+    earliest
+}
+
+/// The smallest positive root of `a s^2 + b s + c` (`c >= 0`), if any (finite values only).
+fn first_positive_root(a: f64, b: f64, c: f64) -> Option<f64> {
+    if !(a.is_finite() && b.is_finite() && c.is_finite()) {
+        return None;
+    }
+    let root = if a == 0.0 {
+        if b >= 0.0 {
+            return None;
+        }
+        -c / b
+    } else {
+        let discriminant = b * b - 4.0 * a * c;
+        if discriminant < 0.0 {
+            return None;
+        }
+        // Stable form: q = -(b + sign(b) sqrt(D)) / 2; roots q / a and c / q.
+        let q = -0.5 * (b + b.signum() * discriminant.sqrt());
+        let roots = [q / a, if q != 0.0 { c / q } else { f64::NAN }];
+        roots
+            .into_iter()
+            .filter(|r| *r > 0.0)
+            .min_by(f64::total_cmp)?
+    };
+    (root > 0.0 && root.is_finite()).then_some(root)
 }
 
 /// The state at `t` in the current (not yet accepted) step: dense output or exact flow.
