@@ -326,6 +326,58 @@ impl HybridSystem for TappingModel {
         }
     }
 
+    /// The field, Jacobian and `df/dZ` above from one evaluation of the gap, the drive and
+    /// the indentation's square root (the Hertz force `c s^{3/2}` and slope `-1.5 c s^{1/2}`,
+    /// `s = max(-d, 0)`, share it).
+    fn linearisation(
+        &self,
+        mode: Mode,
+        t: f64,
+        x: &[f64],
+        dxdt: &mut [f64],
+        jacobian: &mut DMatrix<f64>,
+        dfdp: Option<&mut [f64]>,
+    ) {
+        let drive = (self.drive.angular_frequency * t).cos();
+        let (force, slope) = if Self::in_contact(mode) {
+            let indentation = (-self.gap(t, x)).max(0.0);
+            let root = indentation.sqrt();
+            let c = self.hertz.coefficient;
+            (c * indentation * root, -1.5 * c * root)
+        } else {
+            (0.0, 0.0)
+        };
+        let n = 2 * self.modes.len();
+        let matrix = jacobian.as_mut_slice();
+        matrix.fill(0.0);
+        for (i, m) in self.modes.iter().enumerate() {
+            let q = x[2 * i];
+            let v = x[2 * i + 1];
+            dxdt[2 * i] = v;
+            dxdt[2 * i + 1] = m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
+                - m.omega_squared * q
+                - m.damping * v;
+            // Column-major: entry (r, c) at r + n c.
+            matrix[2 * i + n * (2 * i + 1)] = 1.0;
+            matrix[2 * i + 1 + n * (2 * i)] = -m.omega_squared;
+            matrix[2 * i + 1 + n * (2 * i + 1)] = -m.damping;
+            if slope != 0.0 {
+                let coupling = m.omega_squared_over_stiffness * slope;
+                for j in 0..self.modes.len() {
+                    matrix[2 * i + 1 + n * (2 * j)] += coupling;
+                }
+            }
+        }
+        if let Some(dfdp) = dfdp {
+            dfdp.fill(0.0);
+            if slope != 0.0 {
+                for (i, m) in self.modes.iter().enumerate() {
+                    dfdp[2 * i + 1] = m.omega_squared_over_stiffness * slope;
+                }
+            }
+        }
+    }
+
     /// `h_0 = d = Z(t) + sum_i q_i`, nm.
     fn switching(&self, _k: usize, t: f64, x: &[f64]) -> f64 {
         self.gap(t, x)
@@ -402,6 +454,45 @@ impl HybridSystem for TappingModel {
         }
         if let Some(dxdp) = dxdp {
             dxdp.fill(0.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::builtin_case;
+
+    /// The fused `linearisation` is a performance override: it must give exactly (bit for bit:
+    /// the same expressions in the same order) what the three separate calls give, in contact
+    /// (at several indentations), at the surface and in free flight.
+    #[test]
+    fn linearisation_matches_the_separate_calls() {
+        let case = builtin_case("biolever-mica").expect("built-in case");
+        let model = TappingModel::from_case(&case).expect("model");
+        let n = model.dim();
+        for (mode, shift) in [
+            (CONTACT, -0.3),
+            (CONTACT, -1e-6),
+            (CONTACT, 0.0),
+            (CONTACT, 0.2),
+            (FREE_FLIGHT, -0.3),
+            (FREE_FLIGHT, 0.5),
+        ] {
+            let t = 0.37;
+            let mut x: Vec<f64> = (0..n).map(|i| 0.1 * (i as f64 + 1.0)).collect();
+            // Place the gap at `shift` nm.
+            x[0] += shift - model.gap(t, &x);
+            let (mut f1, mut f2) = (vec![0.0; n], vec![0.0; n]);
+            let (mut j1, mut j2) = (DMatrix::zeros(n, n), DMatrix::from_element(n, n, 7.0));
+            let (mut p1, mut p2) = (vec![0.0; n], vec![3.0; n]);
+            model.vector_field(mode, t, &x, &mut f1);
+            model.jacobian(mode, t, &x, &mut j1);
+            model.parameter_derivative(mode, t, &x, &mut p1);
+            model.linearisation(mode, t, &x, &mut f2, &mut j2, Some(&mut p2));
+            assert_eq!(f1, f2, "field, mode {mode}, gap {shift}");
+            assert_eq!(j1, j2, "Jacobian, mode {mode}, gap {shift}");
+            assert_eq!(p1, p2, "df/dZ, mode {mode}, gap {shift}");
         }
     }
 }

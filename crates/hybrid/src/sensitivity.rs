@@ -5,7 +5,7 @@
 //! with `x' = f(t, x)`, `Phi' = J Phi`, `s' = J s + df/dp`, `J = df/dx`: the first variational
 //! equation of the flow (Hairer, Norsett, Wanner I, Sec. I.14).
 
-use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut, DVectorView, DVectorViewMut};
+use nalgebra::DMatrix;
 
 use crate::system::{HybridSystem, Mode};
 
@@ -77,25 +77,39 @@ impl VariationalField {
         variational: bool,
     ) {
         let n = self.n;
-        system.vector_field(mode, t, &z[..n], &mut dz[..n]);
         self.evaluations += 1;
         if !variational || !self.sensitivity.transition() {
+            system.vector_field(mode, t, &z[..n], &mut dz[..n]);
             return;
         }
-        system.jacobian(mode, t, &z[..n], &mut self.jacobian);
-        let nn = n * n;
-        {
-            let phi = DMatrixView::from_slice(&z[n..n + nn], n, n);
-            let mut dphi = DMatrixViewMut::from_slice(&mut dz[n..n + nn], n, n);
-            dphi.gemm(1.0, &self.jacobian, &phi, 0.0);
-        }
-        if self.sensitivity.parameter() {
-            system.parameter_derivative(mode, t, &z[..n], &mut self.dfdp);
-            let s = DVectorView::from_slice(&z[n + nn..n + nn + n], n);
-            let ds_slice = &mut dz[n + nn..n + nn + n];
-            ds_slice.copy_from_slice(&self.dfdp);
-            let mut ds = DVectorViewMut::from_slice(ds_slice, n);
-            ds.gemv(1.0, &self.jacobian, &s, 1.0);
+        let parameter = self.sensitivity.parameter();
+        let (dx, dvar) = dz.split_at_mut(n);
+        system.linearisation(
+            mode,
+            t,
+            &z[..n],
+            dx,
+            &mut self.jacobian,
+            parameter.then_some(&mut self.dfdp[..]),
+        );
+        // Phi' = J Phi and s' = J s + df/dp, column by column (column-major storage; the
+        // columns of Phi and s are contiguous): small dense products written out, faster than
+        // a general matrix product for the handful of components of a mechanical model.
+        let j = self.jacobian.as_slice();
+        let columns = if parameter { n + 1 } else { n };
+        for col in 0..columns {
+            let input = &z[n + col * n..n + col * n + n];
+            let out = &mut dvar[col * n..col * n + n];
+            if col == n {
+                out.copy_from_slice(&self.dfdp);
+            } else {
+                out.fill(0.0);
+            }
+            for (k, &v) in input.iter().enumerate() {
+                for (o, &a) in out.iter_mut().zip(&j[k * n..k * n + n]) {
+                    *o += a * v;
+                }
+            }
         }
     }
 }

@@ -82,6 +82,27 @@ pub trait HybridSystem {
         dfdp.fill(0.0);
     }
 
+    /// The field, its Jacobian and (if `dfdp` is `Some`) its parameter derivative at one point:
+    /// what the variational equations need per evaluation. The default calls
+    /// [`HybridSystem::vector_field`], [`HybridSystem::jacobian`] and
+    /// [`HybridSystem::parameter_derivative`]; override it (with the same results) when the
+    /// three share expensive work, such as a contact force and its slope.
+    fn linearisation(
+        &self,
+        mode: Mode,
+        t: f64,
+        x: &[f64],
+        dxdt: &mut [f64],
+        jacobian: &mut DMatrix<f64>,
+        dfdp: Option<&mut [f64]>,
+    ) {
+        self.vector_field(mode, t, x, dxdt);
+        self.jacobian(mode, t, x, jacobian);
+        if let Some(dfdp) = dfdp {
+            self.parameter_derivative(mode, t, x, dfdp);
+        }
+    }
+
     /// The switching function `h_k(t, x)`; the surface is `h_k = 0`.
     fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64;
 
