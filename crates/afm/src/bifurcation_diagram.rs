@@ -144,7 +144,9 @@ pub struct DiagramSpecialPoint {
     pub impacts_before: usize,
     /// Impacts per period after it.
     pub impacts_after: usize,
-    /// The final bracket `[Z_low, Z_high]` of the location, nm.
+    /// The Z range `[Z_low, Z_high]` of the final location bracket along the branch and of the
+    /// point, nm. At a fold `Z` is extremal: both ends of the branch bracket lie on one side of
+    /// the fold's `Z`, so one end of this range is the point itself.
     pub bracket_nm: [f64; 2],
     /// Achieved precision of `Z`, nm.
     pub precision_nm: f64,
@@ -335,9 +337,20 @@ fn diagram_special_point(
         phase_deg: observables.phase_deg,
         impacts_before: special.impacts_before,
         impacts_after: special.impacts_after,
+        // The location brackets the point along the branch; at a fold both ends of that
+        // bracket lie on one side of the fold's Z (Z is extremal there), so the Z range
+        // reported spans the ends and the point itself.
         bracket_nm: [
-            special.bracket.0.min(special.bracket.1),
-            special.bracket.0.max(special.bracket.1),
+            special
+                .bracket
+                .0
+                .min(special.bracket.1)
+                .min(special.parameter),
+            special
+                .bracket
+                .0
+                .max(special.bracket.1)
+                .max(special.parameter),
         ],
         precision_nm: special.precision,
         converged: special.converged,
