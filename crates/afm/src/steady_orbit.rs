@@ -8,10 +8,11 @@
 //! settles on none within the budget is reported as not converged, never dressed up as one.
 
 use continuation::{
-    floquet_multipliers, is_stable, shoot, HybridPeriodicProblem, NewtonSettings, Parametrised,
+    floquet_multipliers, is_stable, shoot, ContinuationError, HybridPeriodicProblem,
+    NewtonSettings, Parametrised,
 };
 use hybrid::{flow_map, Sensitivity, Settings};
-use nalgebra::Complex;
+use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 use crate::error::AfmError;
@@ -197,19 +198,20 @@ pub fn steady_orbit(
         )?,
     };
 
-    let period_one = HybridPeriodicProblem::new(model.clone(), 1, settings.integration.clone())?;
-    let first = shoot(&period_one, &initial, z_nm, &settings.newton)?;
-    let first_multipliers = floquet_multipliers(&first.period_map.monodromy);
+    let first = shoot_observed(&model, &initial, &settings.newton, &settings.integration)?;
+    let first_multipliers = floquet_multipliers(&first.monodromy);
     if first.converged && is_stable(&first_multipliers) {
-        return finish(
-            &model,
-            1,
-            first.state.as_slice(),
-            first.iterations,
-            first.residual,
-            first_multipliers,
-            settings,
-        );
+        return Ok(SteadyOrbit {
+            z_nm: model.parameter(),
+            multiplicity: 1,
+            converged: true,
+            iterations: first.iterations,
+            residual: first.residual,
+            state: first.state,
+            stable: true,
+            multipliers: first_multipliers,
+            periods: vec![first.observables],
+        });
     }
 
     // Period-1 Newton failed or found a repelling orbit: look for the attractor by iteration.
@@ -273,7 +275,7 @@ pub fn steady_orbit(
         Some(best) if best.3 < first.residual => best,
         _ => (
             1,
-            first.state.as_slice().to_vec(),
+            first.state.clone(),
             first.iterations,
             first.residual,
             first_multipliers,
@@ -290,6 +292,103 @@ pub fn steady_orbit(
     )?;
     orbit.converged = false;
     Ok(orbit)
+}
+
+/// The outcome of [`shoot_observed`]: Newton's last iterate with the monodromy and the
+/// observables of the period map evaluated there.
+struct ObservedShot {
+    state: Vec<f64>,
+    iterations: usize,
+    residual: f64,
+    converged: bool,
+    monodromy: DMatrix<f64>,
+    observables: OrbitObservables,
+}
+
+/// Newton on the period-1 stroboscopic map `P(x) - x = 0` with the exact monodromy (the same
+/// iteration, convergence test and divergence guard as `continuation::shoot`), each period
+/// map integrated with its observables: the last evaluation, at the returned state, gives the
+/// residual, the monodromy and the observables at once (no extra period for the observables,
+/// and no `dx/dZ`, which the steady orbit does not use).
+fn shoot_observed(
+    model: &TappingModel,
+    x0: &[f64],
+    newton: &NewtonSettings,
+    integration: &Settings,
+) -> Result<ObservedShot, AfmError> {
+    let n = x0.len();
+    let evaluate = |x: &[f64]| -> Result<(Vec<f64>, DMatrix<f64>, OrbitObservables), AfmError> {
+        let (flow, observables) =
+            observe_period(model, 0.0, x, Sensitivity::Transition, integration, 1)?;
+        if flow.state.iter().any(|v| !v.is_finite())
+            || flow.transition.iter().any(|v| !v.is_finite())
+        {
+            return Err(ContinuationError::NonFinite {
+                what: "period map",
+                parameter: model.parameter(),
+            }
+            .into());
+        }
+        Ok((flow.state, flow.transition, observables))
+    };
+    let mut x = x0.to_vec();
+    let (mut image, mut monodromy, mut observables) = evaluate(&x)?;
+    let mut iterations = 0;
+    loop {
+        let residual_vector = DVector::from_iterator(n, image.iter().zip(&x).map(|(p, x)| p - x));
+        let residual = residual_vector.norm();
+        if residual <= newton.tolerance || iterations >= newton.max_iterations {
+            return Ok(ObservedShot {
+                state: x,
+                iterations,
+                residual,
+                converged: residual <= newton.tolerance,
+                monodromy,
+                observables,
+            });
+        }
+        let mut jacobian = monodromy.clone();
+        for i in 0..n {
+            jacobian[(i, i)] -= 1.0;
+        }
+        let update =
+            jacobian
+                .lu()
+                .solve(&residual_vector)
+                .ok_or(ContinuationError::SingularMatrix {
+                    what: "shooting Jacobian M - I",
+                    parameter: model.parameter(),
+                })?;
+        let candidate: Vec<f64> = x.iter().zip(update.iter()).map(|(x, u)| x - u).collect();
+        iterations += 1;
+        if !candidate.iter().all(|v| v.is_finite()) {
+            return Err(ContinuationError::NonFinite {
+                what: "Newton iterate",
+                parameter: model.parameter(),
+            }
+            .into());
+        }
+        let next = evaluate(&candidate)?;
+        let next_residual = next
+            .0
+            .iter()
+            .zip(&candidate)
+            .map(|(p, x)| (p - x) * (p - x))
+            .sum::<f64>()
+            .sqrt();
+        if next_residual > newton.divergence_factor * residual {
+            return Ok(ObservedShot {
+                state: x,
+                iterations,
+                residual,
+                converged: false,
+                monodromy,
+                observables,
+            });
+        }
+        x = candidate;
+        (image, monodromy, observables) = next;
+    }
 }
 
 /// Iterate the stroboscopic map `periods` times from `x0` (state only).
