@@ -28,6 +28,7 @@ pub mod fixtures;
 pub mod free_flight;
 pub mod free_flight_fourier;
 pub mod free_response;
+pub mod gauss_legendre;
 pub mod hertz;
 pub mod impact_numbers;
 pub mod lockin;

@@ -19,17 +19,9 @@
 use hybrid::{Direction, ExtremumKind, HybridSystem, Mode, Solver, StepOutcome};
 
 use crate::free_flight_fourier::FreeFlightFourier;
+use crate::gauss_legendre::GAUSS_LEGENDRE_4;
 use crate::model::GAP_SURFACE;
 use crate::TappingModel;
-
-/// Gauss-Legendre nodes on [-1, 1] (positive half) for 4 points, for contact steps (and for
-/// free flight only near critical damping). The rule is exact for polynomials of degree 7, the
-/// degree of DOP853's dense output, so its error comes from the drive factor `cos(w t)`: of
-/// order `6e-10 (w h)^8` relative for a step `h`, about 2e-8 even for a step of a quarter drive
-/// period (contact steps are far shorter).
-const GAUSS_NODES: [f64; 2] = [0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
-/// The matching Gauss-Legendre weights.
-const GAUSS_WEIGHTS: [f64; 2] = [0.652_145_154_862_546_1, 0.347_854_845_137_453_8];
 
 /// What the lock-in reads over one drive cycle `[0, T]` (time from the cycle's start).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -156,23 +148,25 @@ impl CycleLockIn {
     }
 
     /// 4-point Gauss-Legendre quadrature of `u cos(w t)`, `u sin(w t)` over `[a, b]` (inside
-    /// the solver's last step).
+    /// the solver's last step), for contact steps (and for free flight only near critical
+    /// damping). The rule is exact for polynomials of degree 7, the degree of DOP853's dense
+    /// output, so its error comes from the drive factor `cos(w t)`: of order `6e-10 (w h)^8`
+    /// relative for a step `h`, about 2e-8 even for a step of a quarter drive period (contact
+    /// steps are far shorter).
     fn quadrature(&mut self, solver: &Solver<TappingModel>, model: &TappingModel, a: f64, b: f64) {
         let middle = 0.5 * (a + b);
-        let half = 0.5 * (b - a);
         let w = self.angular_frequency;
-        // Drive phase at the nodes by angle addition from the middle (5 sin_cos, not 8).
+        // Drive phase at the nodes by angle addition from the middle (3 sin_cos, not 4).
         let (sin_m, cos_m) = (w * middle).sin_cos();
-        for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
-            let offset = half * node;
+        for (offset, weight) in GAUSS_LEGENDRE_4.pairs(a, b) {
             let (sin_d, cos_d) = (w * offset).sin_cos();
             for (t, sign) in [(middle - offset, -1.0), (middle + offset, 1.0)] {
                 solver.interpolate(t, &mut self.state);
                 let u = model.photodiode(&self.state);
                 let sin = sin_m * cos_d + sign * cos_m * sin_d;
                 let cos = cos_m * cos_d - sign * sin_m * sin_d;
-                self.cosine += weight * half * u * cos;
-                self.sine += weight * half * u * sin;
+                self.cosine += weight * u * cos;
+                self.sine += weight * u * sin;
             }
         }
     }

@@ -14,24 +14,10 @@ use hybrid::{
 
 use serde::Serialize;
 
+use crate::gauss_legendre::GAUSS_LEGENDRE_8;
 use crate::model::{CONTACT, GAP_SURFACE};
 use crate::validation::invalid;
 use crate::{AfmError, TappingModel};
-
-/// Gauss-Legendre nodes on [-1, 1] (positive half) for 8 points.
-const GAUSS_NODES: [f64; 4] = [
-    0.183_434_642_495_649_8,
-    0.525_532_409_916_329,
-    0.796_666_477_413_626_7,
-    0.960_289_856_497_536_3,
-];
-/// The matching Gauss-Legendre weights.
-const GAUSS_WEIGHTS: [f64; 4] = [
-    0.362_683_783_378_362,
-    0.313_706_645_877_887_3,
-    0.222_381_034_453_374_5,
-    0.101_228_536_290_376_3,
-];
 
 /// Minima of the gap closer together than this fraction of a period are one minimum (the same
 /// extremum reported by two adjacent steps).
@@ -155,10 +141,9 @@ impl PeriodObserver {
         let b = step_end.min(self.end);
         if b > a {
             let middle = 0.5 * (a + b);
-            let half = 0.5 * (b - a);
-            for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
-                for t in [middle - half * node, middle + half * node] {
-                    self.accumulate(solver, model, t, weight * half);
+            for (offset, weight) in GAUSS_LEGENDRE_8.pairs(a, b) {
+                for t in [middle - offset, middle + offset] {
+                    self.accumulate(solver, model, t, weight);
                 }
             }
         }

@@ -24,24 +24,10 @@ use hybrid::{
 };
 use serde::Serialize;
 
+use crate::gauss_legendre::GAUSS_LEGENDRE_8;
 use crate::model::GAP_SURFACE;
 use crate::validation::invalid;
 use crate::{AfmError, Separation, SteadyOrbit, TappingModel};
-
-/// Gauss-Legendre nodes on [-1, 1] (positive half) for 8 points.
-const GAUSS_NODES: [f64; 4] = [
-    0.183_434_642_495_649_8,
-    0.525_532_409_916_329,
-    0.796_666_477_413_626_7,
-    0.960_289_856_497_536_3,
-];
-/// The matching Gauss-Legendre weights.
-const GAUSS_WEIGHTS: [f64; 4] = [
-    0.362_683_783_378_362,
-    0.313_706_645_877_887_3,
-    0.222_381_034_453_374_5,
-    0.101_228_536_290_376_3,
-];
 
 /// One impact of the orbit with its impulse (MODEL.md section 5).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -166,11 +152,9 @@ impl Accumulator {
         let b = b.min(self.period);
         if b > a {
             let middle = 0.5 * (a + b);
-            let half = 0.5 * (b - a);
-            for (node, weight) in GAUSS_NODES.iter().zip(GAUSS_WEIGHTS) {
-                for t in [middle - half * node, middle + half * node] {
+            for (offset, w) in GAUSS_LEGENDRE_8.pairs(a, b) {
+                for t in [middle - offset, middle + offset] {
                     solver.interpolate(t, &mut self.state);
-                    let w = weight * half;
                     let (sin, cos) = (self.angular_frequency * t).sin_cos();
                     let q1 = self.state[0];
                     self.q1_fourier[0] += w * q1 * cos;
