@@ -2,28 +2,10 @@
 //! the other commands accept, the built-in fixtures reproduced from their tip mass ratios, and
 //! refusals of bad input.
 
-use assert_cmd::Command;
+mod common;
+use common::{drumroll, json_of, number};
+
 use serde_json::Value;
-
-fn drumroll() -> Command {
-    Command::cargo_bin("drumroll").expect("binary built")
-}
-
-fn json_of(args: &[&str]) -> Value {
-    let output = drumroll().args(args).arg("--json").output().expect("runs");
-    assert!(
-        output.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object")
-}
-
-fn number(value: &Value, key: &str) -> f64 {
-    value[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("`{key}` is not a number in {value}"))
-}
 
 fn second_mode(tip_mass_ratio: &str) -> Value {
     let table = json_of(&[

@@ -1,22 +1,8 @@
 //! `drumroll simulate` run as a user runs it: the real binary, its JSON checked against the
 //! library's independent numbers, and bad input refused with a message that names the problem.
 
-use assert_cmd::Command;
-use serde_json::Value;
-
-fn drumroll() -> Command {
-    Command::cargo_bin("drumroll").expect("binary built")
-}
-
-fn json_of(args: &[&str]) -> Value {
-    let output = drumroll().args(args).arg("--json").output().expect("runs");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object")
-}
+mod common;
+use common::{drumroll, json_of};
 
 #[test]
 fn json_has_the_documented_fields_and_a_double_impact_at_z_8_5() {

@@ -1,29 +1,10 @@
 //! `drumroll theory` run as a user runs it: its JSON against closed forms typed in here, against
 //! `drumroll simulate` (an independent path to the simulated impulse), and its refusals.
 
-use assert_cmd::Command;
-use serde_json::Value;
+mod common;
+use common::{drumroll, json_of, number};
+
 use std::f64::consts::PI;
-
-fn drumroll() -> Command {
-    Command::cargo_bin("drumroll").expect("binary built")
-}
-
-fn json_of(args: &[&str]) -> Value {
-    let output = drumroll().args(args).arg("--json").output().expect("runs");
-    assert!(
-        output.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("one JSON object")
-}
-
-fn number(value: &Value, key: &str) -> f64 {
-    value[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("`{key}` is not a number in {value}"))
-}
 
 #[test]
 fn json_has_the_documented_keys_and_the_papers_closed_forms() {

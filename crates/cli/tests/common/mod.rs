@@ -1,0 +1,29 @@
+//! Shared by the CLI tests: running the real `drumroll` binary and reading its JSON.
+// Each test binary uses its own subset of these helpers.
+#![allow(dead_code)]
+
+use assert_cmd::Command;
+use serde_json::Value;
+
+/// The `drumroll` binary built by cargo for this test run.
+pub fn drumroll() -> Command {
+    Command::cargo_bin("drumroll").expect("binary built")
+}
+
+/// Run `drumroll ARGS --json`, require success, and parse its one JSON object.
+pub fn json_of(args: &[&str]) -> Value {
+    let output = drumroll().args(args).arg("--json").output().expect("runs");
+    assert!(
+        output.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("one JSON object")
+}
+
+/// The number at `key` of a JSON object.
+pub fn number(value: &Value, key: &str) -> f64 {
+    value[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("`{key}` is not a number in {value}"))
+}
