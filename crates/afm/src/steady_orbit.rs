@@ -294,8 +294,8 @@ pub fn steady_orbit(
     Ok(orbit)
 }
 
-/// The outcome of [`shoot_observed`]: Newton's last iterate with the monodromy and the
-/// observables of the period map evaluated there.
+/// The outcome of [`shoot_observed`]: Newton's last iterate with the residual and observables
+/// of the period map evaluated there, and the monodromy (see [`shoot_observed`] for where).
 struct ObservedShot {
     state: Vec<f64>,
     iterations: usize,
@@ -305,11 +305,44 @@ struct ObservedShot {
     observables: OrbitObservables,
 }
 
+/// One period map from `x` with its observables; with `transition`, also the monodromy.
+fn observed_map(
+    model: &TappingModel,
+    x: &[f64],
+    transition: bool,
+    integration: &Settings,
+) -> Result<(Vec<f64>, Option<DMatrix<f64>>, OrbitObservables), AfmError> {
+    let sensitivity = if transition {
+        Sensitivity::Transition
+    } else {
+        Sensitivity::None
+    };
+    let (flow, observables) = observe_period(model, 0.0, x, sensitivity, integration, 1)?;
+    if flow.state.iter().any(|v| !v.is_finite()) || flow.transition.iter().any(|v| !v.is_finite()) {
+        return Err(ContinuationError::NonFinite {
+            what: "period map",
+            parameter: model.parameter(),
+        }
+        .into());
+    }
+    let monodromy = transition.then_some(flow.transition);
+    Ok((flow.state, monodromy, observables))
+}
+
 /// Newton on the period-1 stroboscopic map `P(x) - x = 0` with the exact monodromy (the same
 /// iteration, convergence test and divergence guard as `continuation::shoot`), each period
-/// map integrated with its observables: the last evaluation, at the returned state, gives the
-/// residual, the monodromy and the observables at once (no extra period for the observables,
-/// and no `dx/dZ`, which the steady orbit does not use).
+/// map integrated with its observables, so that the evaluation at the returned state gives
+/// its residual (always measured there) and observables at once, and without `dx/dZ` (unused
+/// here).
+///
+/// The last evaluation skips the monodromy when Newton's quadratic convergence predicts it
+/// final (`C r_k^2 <= tolerance / 10`, `C = r_k / r_{k-1}^2` from the last two residuals) and
+/// the update leading to it is below `0.1 * sensitivity_tolerance.unwrap_or(1e-5) * (1 +
+/// |x|)`: the monodromy returned is then the one at the previous iterate, that close to the
+/// orbit, so its error from the shift is below a tenth of the monodromy's own integration
+/// error (relative ~1e-5 through Hertz contact with the state-only error control, as measured
+/// in `hybrid::Settings::sensitivity_tolerance`). If the prediction fails (residual above the
+/// tolerance), the point is evaluated again with the monodromy and Newton goes on.
 fn shoot_observed(
     model: &TappingModel,
     x0: &[f64],
@@ -317,22 +350,11 @@ fn shoot_observed(
     integration: &Settings,
 ) -> Result<ObservedShot, AfmError> {
     let n = x0.len();
-    let evaluate = |x: &[f64]| -> Result<(Vec<f64>, DMatrix<f64>, OrbitObservables), AfmError> {
-        let (flow, observables) =
-            observe_period(model, 0.0, x, Sensitivity::Transition, integration, 1)?;
-        if flow.state.iter().any(|v| !v.is_finite())
-            || flow.transition.iter().any(|v| !v.is_finite())
-        {
-            return Err(ContinuationError::NonFinite {
-                what: "period map",
-                parameter: model.parameter(),
-            }
-            .into());
-        }
-        Ok((flow.state, flow.transition, observables))
-    };
+    let shift_scale = 0.1 * integration.sensitivity_tolerance.unwrap_or(1e-5);
     let mut x = x0.to_vec();
-    let (mut image, mut monodromy, mut observables) = evaluate(&x)?;
+    let (mut image, first_monodromy, mut observables) = observed_map(model, &x, true, integration)?;
+    let mut monodromy = first_monodromy.unwrap_or_else(|| DMatrix::identity(n, n));
+    let mut previous_residual: Option<f64> = None;
     let mut iterations = 0;
     loop {
         let residual_vector = DVector::from_iterator(n, image.iter().zip(&x).map(|(p, x)| p - x));
@@ -368,9 +390,14 @@ fn shoot_observed(
             }
             .into());
         }
-        let next = evaluate(&candidate)?;
-        let next_residual = next
-            .0
+        let predicted_final = previous_residual.is_some_and(|r_prev| {
+            let constant = residual / (r_prev * r_prev);
+            constant * residual * residual <= 0.1 * newton.tolerance
+        }) && update.norm()
+            <= shift_scale * (1.0 + DVector::from_column_slice(&x).norm());
+        let (mut next_image, mut next_monodromy, mut next_observables) =
+            observed_map(model, &candidate, !predicted_final, integration)?;
+        let next_residual = next_image
             .iter()
             .zip(&candidate)
             .map(|(p, x)| (p - x) * (p - x))
@@ -386,8 +413,18 @@ fn shoot_observed(
                 observables,
             });
         }
+        if next_monodromy.is_none() && next_residual > newton.tolerance {
+            // The prediction failed: Newton goes on and needs the monodromy there.
+            (next_image, next_monodromy, next_observables) =
+                observed_map(model, &candidate, true, integration)?;
+        }
+        previous_residual = Some(residual);
         x = candidate;
-        (image, monodromy, observables) = next;
+        image = next_image;
+        observables = next_observables;
+        if let Some(m) = next_monodromy {
+            monodromy = m;
+        }
     }
 }
 
