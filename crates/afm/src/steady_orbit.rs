@@ -305,13 +305,16 @@ struct ObservedShot {
     observables: OrbitObservables,
 }
 
+/// A period map's image, monodromy (if asked for) and observables.
+type ObservedMap = (Vec<f64>, Option<DMatrix<f64>>, OrbitObservables);
+
 /// One period map from `x` with its observables; with `transition`, also the monodromy.
 fn observed_map(
     model: &TappingModel,
     x: &[f64],
     transition: bool,
     integration: &Settings,
-) -> Result<(Vec<f64>, Option<DMatrix<f64>>, OrbitObservables), AfmError> {
+) -> Result<ObservedMap, AfmError> {
     let sensitivity = if transition {
         Sensitivity::Transition
     } else {
