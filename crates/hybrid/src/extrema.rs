@@ -55,7 +55,10 @@ impl Samples {
         self.points
     }
 
-    /// Sample `h_k` and `dh_k/dt` (in `mode`) at the step's points between `t0` and `t1`.
+    /// Sample `h_k` and `dh_k/dt` (in `mode`) at the step's points between `t0` and `t1`;
+    /// with `grid`, the interior states are read from it (interior point `i` at
+    /// `grid[(i - 1) n .. i n]`, as [`HybridSystem::exact_flow_grid`] writes them) instead of
+    /// `state_at`.
     ///
     /// # Errors
     /// [`HybridError::NonFiniteSwitching`] if a sample is NaN or infinite.
@@ -67,9 +70,11 @@ impl Samples {
         t0: f64,
         t1: f64,
         state_at: &mut StateAt<'_>,
+        grid: Option<&[f64]>,
         x: &mut [f64],
     ) -> Result<(), HybridError> {
         let p = self.points;
+        let n = x.len();
         let last = p - 1;
         for i in 0..p {
             self.times[i] = if i == 0 {
@@ -83,7 +88,12 @@ impl Samples {
         let first = usize::from(self.start_valid);
         for i in first..p {
             let t = self.times[i];
-            state_at(t, x);
+            match grid {
+                Some(states) if i > 0 && i < last => {
+                    x.copy_from_slice(&states[(i - 1) * n..i * n]);
+                }
+                _ => state_at(t, x),
+            }
             for k in 0..self.surfaces {
                 let value = system.switching(k, t, x);
                 let rate = system.switching_rate(k, mode, t, x);

@@ -125,6 +125,7 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     proposed_step: Option<f64>,
     landing_limit: Option<f64>,
     x_ahead: Vec<f64>,
+    grid: Vec<f64>,
     first_same_as_last: bool,
     kind: StepKind,
     step_mode: Mode,
@@ -209,6 +210,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             proposed_step: settings.initial_step,
             landing_limit: None,
             x_ahead: vec![0.0; n],
+            grid: vec![0.0; (settings.samples_per_step + 1) * n],
             first_same_as_last: false,
             kind: StepKind::None,
             step_mode: 0,
@@ -433,8 +435,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let mut state_at = |t: f64, out: &mut [f64]| {
                 state_in_step(system, kind, mode, rk, z_start, z_new, t0, t1, n, t, out);
             };
+            // Exact steps: every interior state from one call (a linear flow reuses its
+            // transition over one spacing).
+            let grid = if kind == StepKind::Exact {
+                let count = self.samples.points() - 1;
+                system.exact_flow_grid(mode, t0, &z_start[..n], t1 - t0, count, &mut self.grid);
+                Some(&self.grid[..])
+            } else {
+                None
+            };
             self.samples
-                .sample(system, mode, t0, t1, &mut state_at, &mut self.x)?;
+                .sample(system, mode, t0, t1, &mut state_at, grid, &mut self.x)?;
             self.samples.locate_extrema(
                 system,
                 mode,

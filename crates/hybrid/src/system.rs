@@ -164,6 +164,37 @@ pub trait HybridSystem {
         f64::INFINITY
     }
 
+    /// The exact flow of mode `mode` from `(t0, x0)` at the equally spaced times
+    /// `t0 + j dt / count`, `j = 1..count` (`count >= 1`): state `j` into
+    /// `states[(j - 1) n .. j n]` (`states.len() >= count n`). The solver samples the
+    /// switching functions inside exact steps with it. The default calls
+    /// [`HybridSystem::exact_flow`] per point; override it when the flow over one spacing can
+    /// be reused (a linear flow: one transition matrix and phase rotation for all points), with
+    /// the same states up to rounding.
+    fn exact_flow_grid(
+        &self,
+        mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        dt: f64,
+        count: usize,
+        states: &mut [f64],
+    ) {
+        let n = x0.len();
+        for j in 1..=count {
+            let fraction = j as f64 / count as f64;
+            self.exact_flow(
+                mode,
+                t0,
+                x0,
+                dt * fraction,
+                &mut states[(j - 1) * n..j * n],
+                None,
+                None,
+            );
+        }
+    }
+
     /// The exact flow of mode `mode` from `(t0, x0)` over a time `dt` (which may be negative
     /// or zero): the state `x(t0 + dt)` into `x`, and optionally the state-transition matrix
     /// `dx(t0 + dt)/dx0` into `transition` and the parameter sensitivity `dx(t0 + dt)/dp`
