@@ -93,22 +93,67 @@ impl VariationalField {
             parameter.then_some(&mut self.dfdp[..]),
         );
         // Phi' = J Phi and s' = J s + df/dp, column by column (column-major storage; the
-        // columns of Phi and s are contiguous): small dense products written out, faster than
-        // a general matrix product for the handful of components of a mechanical model.
-        let j = self.jacobian.as_slice();
+        // columns of Phi and s are contiguous): small dense products written out, with fixed
+        // sizes for the common small systems (unrolled by the compiler).
         let columns = if parameter { n + 1 } else { n };
-        for col in 0..columns {
-            let input = &z[n + col * n..n + col * n + n];
-            let out = &mut dvar[col * n..col * n + n];
-            if col == n {
-                out.copy_from_slice(&self.dfdp);
-            } else {
-                out.fill(0.0);
+        let j = self.jacobian.as_slice();
+        let dfdp = parameter.then_some(&self.dfdp[..]);
+        let input = &z[n..n + columns * n];
+        let out = &mut dvar[..columns * n];
+        match n {
+            2 => products::<2>(j, input, out, dfdp),
+            4 => products::<4>(j, input, out, dfdp),
+            6 => products::<6>(j, input, out, dfdp),
+            8 => products::<8>(j, input, out, dfdp),
+            _ => products_any(n, j, input, out, dfdp),
+        }
+    }
+}
+
+/// `out[:, c] = J input[:, c]` for every column `c` of the column-major `n x m` blocks (`J`
+/// column-major `n x n`), plus `dfdp` on the last column if given; `N = n` fixed.
+#[inline]
+fn products<const N: usize>(j: &[f64], input: &[f64], out: &mut [f64], dfdp: Option<&[f64]>) {
+    let mut matrix = [[0.0; N]; N];
+    for (k, column) in matrix.iter_mut().enumerate() {
+        column.copy_from_slice(&j[k * N..k * N + N]);
+    }
+    let columns = out.len() / N;
+    for (c, (o, v)) in out
+        .chunks_exact_mut(N)
+        .zip(input.chunks_exact(N))
+        .enumerate()
+    {
+        let mut acc = [0.0; N];
+        if let Some(d) = dfdp {
+            if c + 1 == columns {
+                acc.copy_from_slice(&d[..N]);
             }
-            for (k, &v) in input.iter().enumerate() {
-                for (o, &a) in out.iter_mut().zip(&j[k * n..k * n + n]) {
-                    *o += a * v;
-                }
+        }
+        for (column, &vk) in matrix.iter().zip(v) {
+            for (a, &m) in acc.iter_mut().zip(column) {
+                *a += m * vk;
+            }
+        }
+        o.copy_from_slice(&acc);
+    }
+}
+
+/// [`products`] for any `n`.
+fn products_any(n: usize, j: &[f64], input: &[f64], out: &mut [f64], dfdp: Option<&[f64]>) {
+    let columns = out.len() / n;
+    for (c, (o, v)) in out
+        .chunks_exact_mut(n)
+        .zip(input.chunks_exact(n))
+        .enumerate()
+    {
+        match dfdp {
+            Some(d) if c + 1 == columns => o.copy_from_slice(&d[..n]),
+            _ => o.fill(0.0),
+        }
+        for (k, &vk) in v.iter().enumerate() {
+            for (a, &m) in o.iter_mut().zip(&j[k * n..k * n + n]) {
+                *a += m * vk;
             }
         }
     }
