@@ -305,14 +305,17 @@ struct ObservedShot {
     observables: OrbitObservables,
 }
 
-/// A period map's image, monodromy (if asked for) and observables.
-type ObservedMap = (Vec<f64>, Option<DMatrix<f64>>, OrbitObservables);
+/// A period map's image, monodromy (if asked for) and observables (if asked for).
+type ObservedMap = (Vec<f64>, Option<DMatrix<f64>>, Option<OrbitObservables>);
 
-/// One period map from `x` with its observables; with `transition`, also the monodromy.
+/// One period map from `x`; with `transition`, also the monodromy; with `observe`, also the
+/// observables (the quadratures cost about a tenth of a period map: done only where the
+/// evaluation is expected to be the last).
 fn observed_map(
     model: &TappingModel,
     x: &[f64],
     transition: bool,
+    observe: bool,
     integration: &Settings,
 ) -> Result<ObservedMap, AfmError> {
     let sensitivity = if transition {
@@ -320,7 +323,13 @@ fn observed_map(
     } else {
         Sensitivity::None
     };
-    let (flow, observables) = observe_period(model, 0.0, x, sensitivity, integration, 1)?;
+    let (flow, observables) = if observe {
+        let (flow, observables) = observe_period(model, 0.0, x, sensitivity, integration, 1)?;
+        (flow, Some(observables))
+    } else {
+        let flow = flow_map(model, 0.0, x, model.period_us(), sensitivity, integration)?;
+        (flow, None)
+    };
     if flow.state.iter().any(|v| !v.is_finite()) || flow.transition.iter().any(|v| !v.is_finite()) {
         return Err(ContinuationError::NonFinite {
             what: "period map",
@@ -355,7 +364,8 @@ fn shoot_observed(
     let n = x0.len();
     let shift_scale = 0.1 * integration.sensitivity_tolerance.unwrap_or(1e-5);
     let mut x = x0.to_vec();
-    let (mut image, first_monodromy, mut observables) = observed_map(model, &x, true, integration)?;
+    let (mut image, first_monodromy, mut observables) =
+        observed_map(model, &x, true, false, integration)?;
     let mut monodromy = first_monodromy.unwrap_or_else(|| DMatrix::identity(n, n));
     let mut previous_residual: Option<f64> = None;
     let mut iterations = 0;
@@ -363,6 +373,7 @@ fn shoot_observed(
         let residual_vector = DVector::from_iterator(n, image.iter().zip(&x).map(|(p, x)| p - x));
         let residual = residual_vector.norm();
         if residual <= newton.tolerance || iterations >= newton.max_iterations {
+            let observables = observables_at(model, &x, observables, integration)?;
             return Ok(ObservedShot {
                 state: x,
                 iterations,
@@ -398,8 +409,13 @@ fn shoot_observed(
             constant * residual * residual <= 0.1 * newton.tolerance
         }) && update.norm()
             <= shift_scale * (1.0 + DVector::from_column_slice(&x).norm());
-        let (mut next_image, mut next_monodromy, mut next_observables) =
-            observed_map(model, &candidate, !predicted_final, integration)?;
+        let (mut next_image, mut next_monodromy, mut next_observables) = observed_map(
+            model,
+            &candidate,
+            !predicted_final,
+            predicted_final,
+            integration,
+        )?;
         let next_residual = next_image
             .iter()
             .zip(&candidate)
@@ -407,6 +423,7 @@ fn shoot_observed(
             .sum::<f64>()
             .sqrt();
         if next_residual > newton.divergence_factor * residual {
+            let observables = observables_at(model, &x, observables, integration)?;
             return Ok(ObservedShot {
                 state: x,
                 iterations,
@@ -419,7 +436,7 @@ fn shoot_observed(
         if next_monodromy.is_none() && next_residual > newton.tolerance {
             // The prediction failed: Newton goes on and needs the monodromy there.
             (next_image, next_monodromy, next_observables) =
-                observed_map(model, &candidate, true, integration)?;
+                observed_map(model, &candidate, true, false, integration)?;
         }
         previous_residual = Some(residual);
         x = candidate;
@@ -428,6 +445,20 @@ fn shoot_observed(
         if let Some(m) = next_monodromy {
             monodromy = m;
         }
+    }
+}
+
+/// The observables at `x`: `known` if the evaluation there recorded them, else one more
+/// (state-only) period.
+fn observables_at(
+    model: &TappingModel,
+    x: &[f64],
+    known: Option<OrbitObservables>,
+    integration: &Settings,
+) -> Result<OrbitObservables, AfmError> {
+    match known {
+        Some(observables) => Ok(observables),
+        None => Ok(observe_period(model, 0.0, x, Sensitivity::None, integration, 1)?.1),
     }
 }
 
