@@ -124,6 +124,7 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     rk: Dop853,
     proposed_step: Option<f64>,
     landing_limit: Option<f64>,
+    steps_in_mode: usize,
     x_ahead: Vec<f64>,
     grid: Vec<f64>,
     first_same_as_last: bool,
@@ -209,6 +210,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             rk: Dop853::new(dim, n, settings.sensitivity_tolerance),
             proposed_step: settings.initial_step,
             landing_limit: None,
+            steps_in_mode: 0,
             x_ahead: vec![0.0; n],
             grid: vec![0.0; (settings.samples_per_step + 1) * n],
             first_same_as_last: false,
@@ -268,6 +270,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.transition.fill_with_identity();
         self.proposed_step = self.settings.initial_step;
         self.landing_limit = None;
+        self.steps_in_mode = 0;
         self.first_same_as_last = false;
         self.kind = StepKind::None;
         self.step_start = t0;
@@ -600,7 +603,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         // proposed step reaches it, or approach it in steps of a fixed fraction of the distance
         // once a landing from too far has failed.
         let mut landing: Option<f64> = None;
-        if let Some(s) = predict_crossing(
+        let predicted = predict_crossing(
             system,
             &self.rk,
             &mut self.x_ahead,
@@ -609,7 +612,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             self.surfaces,
             t0,
             h,
-        ) {
+        );
+        // In the first step after an event, a crossing closer than the proposed step (a brief
+        // dip through the surface near grazing) is left to that step and the event location.
+        let first = self.steps_in_mode == 0;
+        if let Some(s) = predicted.filter(|&s| !first || s >= h) {
             // Too close to resolve in time (a Zeno accumulation): leave the step to the
             // controller and the event location.
             let resolvable = s > 1024.0 * f64::EPSILON * t0.abs();
@@ -734,6 +741,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
         self.kind = StepKind::RungeKutta;
         self.first_same_as_last = false;
+        self.steps_in_mode += 1;
         self.statistics.steps += 1;
         Ok(t1)
     }
@@ -969,6 +977,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.first_same_as_last = false;
         self.samples.start_valid = false;
         self.landing_limit = None;
+        self.steps_in_mode = 0;
         self.sync_transition();
         Ok(Event {
             t: t_event,
