@@ -768,7 +768,20 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         let (pl, ph) = location.parameters;
         let point = location.point.clone().unwrap_or_else(|| low.clone());
         let n = point.u.len() - 1;
-        let impacts_after = high.map.structure.impacts;
+        let (mut impacts_before, mut impacts_after) =
+            (low.map.structure.impacts, high.map.structure.impacts);
+        // A location converged onto the structure change itself can leave both bracket ends on
+        // one side of it (the extremum a rounding error from zero at both); the counts are then
+        // read at the ends of the step, regular points on either side.
+        if impacts_before == impacts_after
+            && matches!(
+                kind,
+                SpecialPointKind::Grazing | SpecialPointKind::Merge | SpecialPointKind::Split
+            )
+        {
+            impacts_before = segment.get(0).map.structure.impacts;
+            impacts_after = segment.get(1).map.structure.impacts;
+        }
         (
             point.sigma,
             SpecialPoint {
@@ -778,7 +791,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 bracket: (pl.min(ph), pl.max(ph)),
                 precision: (pl - ph).abs(),
                 converged,
-                impacts_before: low.map.structure.impacts,
+                impacts_before,
                 impacts_after,
                 state: point.u.rows(0, n).into_owned(),
                 multipliers: point.multipliers.clone(),
