@@ -74,6 +74,26 @@ impl TappingModel {
         check_separation(&separation)?;
         let frequency_khz =
             drive_frequency_khz.unwrap_or_else(|| cantilever.fundamental_frequency_khz());
+        // Far below f_1 a drive period holds so many free-flight steps (a quarter of the
+        // shortest modal period each) that an orbit is out of reach; far above the last mode
+        // the model (N modes) no longer describes the cantilever.
+        let lowest = 0.01 * cantilever.fundamental_frequency_khz();
+        let highest = 100.0
+            * cantilever
+                .modes
+                .iter()
+                .map(|m| m.frequency_khz)
+                .fold(0.0, f64::max);
+        if !(lowest..=highest).contains(&frequency_khz) {
+            return Err(AfmError::InvalidField {
+                file: String::from("model parameters"),
+                field: String::from("drive_frequency_khz"),
+                value: frequency_khz.to_string(),
+                allowed: format!(
+                    "[{lowest:.6}, {highest:.6}] kHz (from f_1/100 to 100 times the highest modal frequency)"
+                ),
+            });
+        }
         let drive = Drive::for_free_amplitude(&cantilever, free_amplitude_nm, frequency_khz)?;
         let free_response = FreeResponse::new(&cantilever, &drive);
         let grazing_separation_nm = free_response.grazing_separation_nm();

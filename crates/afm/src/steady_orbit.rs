@@ -39,6 +39,10 @@ impl Parametrised for TappingModel {
     }
 }
 
+/// The largest separation a steady orbit is computed at, nm (far above first contact the orbit is
+/// the free one; the bound keeps the gap's rounding meaningful).
+pub const MAX_SEPARATION_NM: f64 = 1e6;
+
 /// How the steady orbit is searched for. Every field is checked by
 /// [`SteadyOrbitSettings::validate`].
 #[derive(Debug, Clone, PartialEq)]
@@ -176,12 +180,15 @@ pub fn steady_orbit(
     settings: &SteadyOrbitSettings,
 ) -> Result<SteadyOrbit, AfmError> {
     settings.validate()?;
-    if !z_nm.is_finite() {
+    let lowest = -model.free_amplitude_nm();
+    if !(lowest..=MAX_SEPARATION_NM).contains(&z_nm) {
         return Err(AfmError::InvalidField {
             file: String::from("steady orbit"),
             field: String::from("z_nm"),
             value: z_nm.to_string(),
-            allowed: String::from("a finite separation in nm"),
+            allowed: format!(
+                "[{lowest}, {MAX_SEPARATION_NM}] nm (from -A0, a rest position one free amplitude inside the sample where Hertz contact is long past its validity, up to far above first contact)"
+            ),
         });
     }
     let mut model = model.clone();

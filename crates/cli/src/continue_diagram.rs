@@ -21,7 +21,7 @@ pub struct ContinueArgs {
     /// The cantilever, sample and drive.
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Lowest separation of the approach, nm (default 0.05 A0).
+    /// Lowest separation of the approach, nm, in [-A0, Z_G1) (default 0.05 A0).
     #[arg(long, allow_negative_numbers = true)]
     pub floor: Option<f64>,
     /// The approach also stops when A/A0 falls below this ratio (default 0.3; 0 disables).
@@ -62,9 +62,10 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .transpose()?;
     let mut settings = DiagramSettings::approach(&model);
     if let Some(floor) = args.floor {
-        if !floor.is_finite() || floor >= model.grazing_separation_nm() {
+        let lowest = -model.free_amplitude_nm();
+        if !(floor >= lowest && floor < model.grazing_separation_nm()) {
             bail!(
-                "--floor {floor}: the floor must be a finite separation below first contact Z_G1 = {:.6} nm",
+                "--floor {floor}: allowed [{lowest}, {:.6}) nm, from -A0 up to just below first contact Z_G1",
                 model.grazing_separation_nm()
             );
         }

@@ -174,7 +174,8 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
             minimum.t_periods, minimum.gap_nm
         );
     }
+    // (+ 0.0 prints a negative zero as 0.)
     let _ = writeln!(s, "peak force {:.6} nN, mean force {:.6e} nN, contact time {:.6} periods, impulse {:.6} nN us",
-        observables.peak_force_nn, observables.mean_force_nn, observables.contact_time_periods, observables.impulse_nn_us);
+        observables.peak_force_nn, observables.mean_force_nn + 0.0, observables.contact_time_periods + 0.0, observables.impulse_nn_us + 0.0);
     s
 }

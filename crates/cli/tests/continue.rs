@@ -229,11 +229,17 @@ fn csv_and_svg_are_written_whole() {
 
 #[test]
 fn bad_options_are_refused_with_a_message_naming_the_option_and_its_range() {
-    let cases: [(&[&str], &[&str]); 4] = [
+    let cases: [(&[&str], &[&str]); 5] = [
         // First contact of the Biolever is 10.0115 nm: a floor above it is refused.
         (
             &["--case", "biolever-mica", "--floor", "12"],
             &["--floor 12", "below first contact"],
+        ),
+        // A floor deeper than -A0 (-10 nm) is refused: Hertz contact is long invalid there and
+        // the branch would run through ever more impacts.
+        (
+            &["--case", "biolever-mica", "--floor", "-11"],
+            &["--floor -11", "allowed [-10,"],
         ),
         (
             &["--case", "biolever-mica", "--min-amplitude-ratio", "2"],
