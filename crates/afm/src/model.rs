@@ -398,6 +398,13 @@ impl HybridSystem for TappingModel {
         }
     }
 
+    /// In contact the Hertz force is `c (-d)^{3/2}`: the gap is the half-power surface of
+    /// the contact mode, and the solver integrates next to contact onset and release in the
+    /// square root of the time from them.
+    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
+        Self::in_contact(mode).then_some(0)
+    }
+
     /// `h_0 = d = Z(t) + sum_i q_i`, nm.
     fn switching(&self, _k: usize, t: f64, x: &[f64]) -> f64 {
         self.gap(t, x)

@@ -123,10 +123,19 @@ impl Dop853 {
         self.evaluate_stage(rhs, 0, t, dim);
     }
 
-    /// Stage 0 (`f(t, z)` at the start of the next attempt) for components `0..out.len()`.
+    /// Stage 0 (the derivative at the start of the next attempt) for components
+    /// `0..out.len()`.
     pub fn first_stage(&self, out: &mut [f64]) {
         for (c, o) in out.iter_mut().enumerate() {
             *o = self.stages[c * STAGES_EXTENDED];
+        }
+    }
+
+    /// Multiply stage 0 by `factor` (a change of the independent variable at the step start:
+    /// `dz/dsigma = (dt/dsigma) dz/dt`).
+    pub fn scale_first_stage(&mut self, factor: f64) {
+        for row in self.stages.chunks_exact_mut(STAGES_EXTENDED) {
+            row[0] *= factor;
         }
     }
 
@@ -270,6 +279,20 @@ impl Dop853 {
             let inner = d(4) + s1 * (d(5) + theta * d(6));
             *o =
                 z0[c] + theta * (d(0) + s1 * (d(1) + theta * (d(2) + s1 * (d(3) + theta * inner))));
+        }
+    }
+
+    /// The dense output of the last step continued to `theta` (beyond 1 an extrapolation of
+    /// its polynomial), from the step's end state `z1` (`z0 = z1 - d0`), for components
+    /// `0..out.len()`.
+    pub fn extrapolate_from_end(&self, z1: &[f64], theta: f64, out: &mut [f64]) {
+        let dim = self.dim;
+        let s1 = 1.0 - theta;
+        for (c, o) in out.iter_mut().enumerate() {
+            let d = |r: usize| self.dense[r * dim + c];
+            let inner = d(4) + s1 * (d(5) + theta * d(6));
+            *o = z1[c] - d(0)
+                + theta * (d(0) + s1 * (d(1) + theta * (d(2) + s1 * (d(3) + theta * inner))));
         }
     }
 

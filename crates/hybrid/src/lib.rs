@@ -20,6 +20,7 @@
 //! steps where the Jacobian is not smooth (Hertz contact); see its documentation.
 #![warn(missing_docs)]
 
+mod clock;
 mod dop853;
 pub mod error;
 pub mod event;

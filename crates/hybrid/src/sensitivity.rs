@@ -65,6 +65,11 @@ impl VariationalField {
         }
     }
 
+    /// Dimension `n` of the state (the leading part of the augmented state).
+    pub fn state_dim(&self) -> usize {
+        self.n
+    }
+
     /// Evaluate `dz/dt` at `(t, z)` in `mode`; with `variational == false` only the state part
     /// `dz[..n]` is written.
     pub fn eval<S: HybridSystem + ?Sized>(

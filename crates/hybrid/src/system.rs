@@ -147,6 +147,18 @@ pub trait HybridSystem {
         dxdp.fill(0.0);
     }
 
+    /// The surface `k`, if any, whose switching function enters the field of mode `mode`
+    /// through half-integer powers of `|h_k|` (Hertz contact: `F = c (-h)^{3/2}`), so that the
+    /// solution is smooth in `sqrt|t - t_c|` but not in `t` next to a transversal crossing
+    /// `t_c` of that surface. The solver then integrates the steps right after entering the
+    /// mode through `k` and those approaching a crossing of `k` in the square root of the time
+    /// from the crossing, keeping the method's order there (see [`crate::solver`]). The
+    /// default is `None` (every field smooth up to its surfaces).
+    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
+        let _ = mode;
+        None
+    }
+
     /// Whether mode `mode` has a closed-form flow ([`HybridSystem::exact_flow`]).
     /// The default is `false`: every mode is integrated numerically.
     fn has_exact_flow(&self, mode: Mode) -> bool {

@@ -11,8 +11,10 @@ mod common;
 use common::{BouncingBall, HertzOscillator};
 use hybrid::{flow_map, Sensitivity, Settings, Statistics};
 
-/// Hertz contact from rest over 3 drive periods, default settings: 5 crossings. The rejected
-/// steps come from the contact force's `(x - d)^{3/2}` singularity at onset and release.
+/// Hertz contact from rest over 3 drive periods, default settings: 5 crossings. The steps next
+/// to onset and release run on the square-root clock (the contact mode declares its
+/// half-power surface); stepping in time there instead, the same run took 210 steps, 29
+/// rejected, 3476 evaluations.
 #[test]
 fn hertz_contact_statistics_are_pinned() {
     let system = HertzOscillator::reference();
@@ -30,10 +32,10 @@ fn hertz_contact_statistics_are_pinned() {
     assert_eq!(
         result.statistics,
         Statistics {
-            steps: 210,
-            rejected_steps: 29,
+            steps: 182,
+            rejected_steps: 19,
             exact_steps: 0,
-            rhs_evaluations: 3476,
+            rhs_evaluations: 2954,
             events: 5,
         }
     );

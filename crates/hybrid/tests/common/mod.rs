@@ -310,6 +310,9 @@ pub struct HertzOscillator {
     pub drive: f64,
     pub obstacle: f64,
     pub contact_stiffness: f64,
+    /// Whether the contact mode declares the gap its half-power surface (the solver then
+    /// steps next to contact onset and release on a square-root clock).
+    pub half_power: bool,
 }
 
 impl HertzOscillator {
@@ -321,6 +324,7 @@ impl HertzOscillator {
             drive: 1.2,
             obstacle: 0.8,
             contact_stiffness: 20.0,
+            half_power: true,
         }
     }
 }
@@ -328,6 +332,9 @@ impl HertzOscillator {
 impl HybridSystem for HertzOscillator {
     fn dim(&self) -> usize {
         2
+    }
+    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
+        (self.half_power && mode & 1 != 0).then_some(0)
     }
     fn surface_count(&self) -> usize {
         1
