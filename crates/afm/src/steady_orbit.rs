@@ -358,10 +358,12 @@ fn observed_map(
 /// final (`C r_k^2 <= tolerance / 10`, `C = r_k / r_{k-1}^2` from the last two residuals) and
 /// the update leading to it is below `0.1 * sensitivity_tolerance.unwrap_or(1e-5) * (1 +
 /// |x|)`: the monodromy returned is then the one at the previous iterate, that close to the
-/// orbit, so its error from the shift is below a tenth of the monodromy's own integration
-/// error (relative ~1e-5 through Hertz contact with the state-only error control, as measured
-/// in `hybrid::Settings::sensitivity_tolerance`). If the prediction fails (residual above the
-/// tolerance), the point is evaluated again with the monodromy and Newton goes on.
+/// orbit, so it differs from the monodromy at the returned state by about that relative
+/// amount (1e-6): more than its integration error with the square-root clock at contact
+/// (2e-9 to 5e-8 relative, `cargo run --release -p afm --example monodromy_error`), far less
+/// than matters for the Floquet multipliers' use here, the orbit's stability. If the
+/// prediction fails (residual above the tolerance), the point is evaluated again with the
+/// monodromy and Newton goes on.
 fn shoot_observed(
     model: &TappingModel,
     x0: &[f64],
