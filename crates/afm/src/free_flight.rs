@@ -159,16 +159,30 @@ impl DrivenOscillator {
         x0: [f64; 2],
         dt: f64,
     ) -> ([f64; 2], [[f64; 2]; 2]) {
-        let start = self.steady_state_at_phase(start_phase.0, start_phase.1);
-        let end = self.steady_state_at_phase(end_phase.0, end_phase.1);
         let phi = self.homogeneous_transition(dt);
-        let y = [x0[0] - start[0], x0[1] - start[1]];
         (
-            [
-                end[0] + phi[0][0] * y[0] + phi[0][1] * y[1],
-                end[1] + phi[1][0] * y[0] + phi[1][1] * y[1],
-            ],
+            self.flow_with_transition(start_phase, end_phase, x0, &phi),
             phi,
         )
+    }
+
+    /// As [`DrivenOscillator::flow_between_phases`], with the homogeneous transition `phi`
+    /// over the step supplied by the caller (kept for a step length used again and again):
+    /// returns the state at the step's end.
+    #[inline]
+    pub fn flow_with_transition(
+        &self,
+        start_phase: (f64, f64),
+        end_phase: (f64, f64),
+        x0: [f64; 2],
+        phi: &[[f64; 2]; 2],
+    ) -> [f64; 2] {
+        let start = self.steady_state_at_phase(start_phase.0, start_phase.1);
+        let end = self.steady_state_at_phase(end_phase.0, end_phase.1);
+        let y = [x0[0] - start[0], x0[1] - start[1]];
+        [
+            end[0] + phi[0][0] * y[0] + phi[0][1] * y[1],
+            end[1] + phi[1][0] * y[0] + phi[1][1] * y[1],
+        ]
     }
 }

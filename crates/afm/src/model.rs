@@ -33,7 +33,16 @@ struct ModalConstants {
     optical_sensitivity: f64,
     /// The free-flight flow of this mode.
     oscillator: DrivenOscillator,
+    /// Its homogeneous transition over the standard exact step (`exact_step_limit`) and over
+    /// that step's grid spacing (`/ STANDARD_GRID`): computed once, the same numbers the
+    /// oscillator gives per call.
+    step_transition: [[f64; 2]; 2],
+    spacing_transition: [[f64; 2]; 2],
 }
+
+/// The grid count the solver asks [`HybridSystem::exact_flow_grid`] for with its default
+/// `samples_per_step` (8 interior samples: 9 intervals), whose spacing's transitions are kept.
+const STANDARD_GRID: usize = 9;
 
 /// The N-mode tapping cantilever of Eq. 1 (MODEL.md section 1) as a [`HybridSystem`].
 ///
@@ -53,6 +62,8 @@ pub struct TappingModel {
     separation: Separation,
     modes: Vec<ModalConstants>,
     exact_step_limit: f64,
+    /// `(sin, cos)` of the drive phase advance over the standard grid spacing.
+    spacing_rotation: (f64, f64),
 }
 
 impl TappingModel {
@@ -115,6 +126,8 @@ impl TappingModel {
                         static_deflection,
                         drive.angular_frequency,
                     ),
+                    step_transition: [[0.0; 2]; 2],
+                    spacing_transition: [[0.0; 2]; 2],
                 }
             })
             .collect();
@@ -125,6 +138,14 @@ impl TappingModel {
             .iter()
             .map(|mode| 2.0 * PI / mode.angular_frequency())
             .fold(drive.period_us(), f64::min);
+        let exact_step_limit = 0.25 * shortest_period;
+        let spacing = exact_step_limit / STANDARD_GRID as f64;
+        let mut modes = modes;
+        for m in &mut modes {
+            m.step_transition = m.oscillator.homogeneous_transition(exact_step_limit);
+            m.spacing_transition = m.oscillator.homogeneous_transition(spacing);
+        }
+        let spacing_rotation = (drive.angular_frequency * spacing).sin_cos();
         Ok(Self {
             hertz: HertzContact::new(&cantilever, &sample),
             cantilever,
@@ -135,7 +156,8 @@ impl TappingModel {
             grazing_separation_nm,
             separation,
             modes,
-            exact_step_limit: 0.25 * shortest_period,
+            exact_step_limit,
+            spacing_rotation,
         })
     }
 
@@ -462,10 +484,19 @@ impl HybridSystem for TappingModel {
         let n = self.dim();
         let spacing = dt / count as f64;
         let w = self.drive.angular_frequency;
+        let standard = dt == self.exact_step_limit && count == STANDARD_GRID;
         let (sin0, cos0) = (w * t0).sin_cos();
-        let (sin_step, cos_step) = (w * spacing).sin_cos();
+        let (sin_step, cos_step) = if standard {
+            self.spacing_rotation
+        } else {
+            (w * spacing).sin_cos()
+        };
         for (i, m) in self.modes.iter().enumerate() {
-            let phi = m.oscillator.homogeneous_transition(spacing);
+            let phi = if standard {
+                m.spacing_transition
+            } else {
+                m.oscillator.homogeneous_transition(spacing)
+            };
             let start = m.oscillator.steady_state_at_phase(sin0, cos0);
             let mut y = [x0[2 * i] - start[0], x0[2 * i + 1] - start[1]];
             let (mut sin, mut cos) = (sin0, cos0);
@@ -502,12 +533,18 @@ impl HybridSystem for TappingModel {
         }
         let start_phase = (self.drive.angular_frequency * t0).sin_cos();
         let end_phase = (self.drive.angular_frequency * (t0 + dt)).sin_cos();
+        let standard = dt == self.exact_step_limit;
         for (i, m) in self.modes.iter().enumerate() {
-            let (state, phi) = m.oscillator.flow_between_phases(
+            let phi = if standard {
+                m.step_transition
+            } else {
+                m.oscillator.homogeneous_transition(dt)
+            };
+            let state = m.oscillator.flow_with_transition(
                 start_phase,
                 end_phase,
                 [x0[2 * i], x0[2 * i + 1]],
-                dt,
+                &phi,
             );
             x[2 * i] = state[0];
             x[2 * i + 1] = state[1];
@@ -560,6 +597,47 @@ mod tests {
             assert_eq!(f1, f2, "field, mode {mode}, gap {shift}");
             assert_eq!(j1, j2, "Jacobian, mode {mode}, gap {shift}");
             assert_eq!(p1, p2, "df/dZ, mode {mode}, gap {shift}");
+        }
+    }
+
+    /// The transitions kept for the standard exact step and its grid spacing are the numbers
+    /// the oscillators compute per call: the flow and grid over the standard step are bit for
+    /// bit those over a step computed afresh (the same expressions on the same inputs).
+    #[test]
+    fn kept_standard_step_transitions_equal_fresh_ones() {
+        for name in ["biolever-mica", "maclever-soft"] {
+            let case = builtin_case(name).expect("built-in case");
+            let model = TappingModel::from_case(&case).expect("model");
+            let n = model.dim();
+            let dt = model.exact_step_limit(FREE_FLIGHT);
+            let spacing = dt / STANDARD_GRID as f64;
+            let x0: Vec<f64> = (0..n).map(|i| 3.0 - 0.7 * i as f64).collect();
+            let t0 = 5.678;
+            let mut kept = vec![0.0; n];
+            let mut transition = DMatrix::zeros(n, n);
+            model.exact_flow(
+                FREE_FLIGHT,
+                t0,
+                &x0,
+                dt,
+                &mut kept,
+                Some(&mut transition),
+                None,
+            );
+            let mut grid = vec![0.0; STANDARD_GRID * n];
+            model.exact_flow_grid(FREE_FLIGHT, t0, &x0, dt, STANDARD_GRID, &mut grid);
+            let w = model.drive.angular_frequency;
+            assert_eq!(model.spacing_rotation, (w * spacing).sin_cos(), "{name}");
+            for (i, m) in model.modes.iter().enumerate() {
+                assert_eq!(m.step_transition, m.oscillator.homogeneous_transition(dt));
+                assert_eq!(
+                    m.spacing_transition,
+                    m.oscillator.homogeneous_transition(spacing)
+                );
+                let (fresh, phi) = m.oscillator.flow(t0, [x0[2 * i], x0[2 * i + 1]], dt);
+                assert_eq!([kept[2 * i], kept[2 * i + 1]], fresh, "{name} mode {i}");
+                assert_eq!(transition[(2 * i, 2 * i + 1)], phi[0][1], "{name} mode {i}");
+            }
         }
     }
 
