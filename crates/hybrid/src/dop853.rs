@@ -272,13 +272,8 @@ impl Dop853 {
     /// `z0 + theta (d0 + (1-theta) (d1 + theta (d2 + (1-theta) (d3 + theta (d4 + (1-theta)
     /// (d5 + theta d6))))))` (Hairer's `contd8`).
     pub fn interpolate(&self, z0: &[f64], theta: f64, out: &mut [f64]) {
-        let dim = self.dim;
-        let s1 = 1.0 - theta;
         for (c, o) in out.iter_mut().enumerate() {
-            let d = |r: usize| self.dense[r * dim + c];
-            let inner = d(4) + s1 * (d(5) + theta * d(6));
-            *o =
-                z0[c] + theta * (d(0) + s1 * (d(1) + theta * (d(2) + s1 * (d(3) + theta * inner))));
+            *o = z0[c] + self.dense_increment(c, theta);
         }
     }
 
@@ -286,14 +281,20 @@ impl Dop853 {
     /// its polynomial), from the step's end state `z1` (`z0 = z1 - d0`), for components
     /// `0..out.len()`.
     pub fn extrapolate_from_end(&self, z1: &[f64], theta: f64, out: &mut [f64]) {
-        let dim = self.dim;
-        let s1 = 1.0 - theta;
         for (c, o) in out.iter_mut().enumerate() {
-            let d = |r: usize| self.dense[r * dim + c];
-            let inner = d(4) + s1 * (d(5) + theta * d(6));
-            *o = z1[c] - d(0)
-                + theta * (d(0) + s1 * (d(1) + theta * (d(2) + s1 * (d(3) + theta * inner))));
+            // Row 0 of the coefficients is `d0 = z1 - z0`.
+            *o = z1[c] - self.dense[c] + self.dense_increment(c, theta);
         }
+    }
+
+    /// The dense-output polynomial of component `c` at `theta`, less its value at 0.
+    #[inline]
+    fn dense_increment(&self, c: usize, theta: f64) -> f64 {
+        let dim = self.dim;
+        let d = |r: usize| self.dense[r * dim + c];
+        let s1 = 1.0 - theta;
+        let inner = d(4) + s1 * (d(5) + theta * d(6));
+        theta * (d(0) + s1 * (d(1) + theta * (d(2) + s1 * (d(3) + theta * inner))))
     }
 
     /// Hairer's starting step (`hinit`, order 8): balances `0.01 / max(|f'|, |f|)^(1/8)` against

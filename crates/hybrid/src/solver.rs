@@ -634,14 +634,28 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let atol = self.settings.absolute_tolerance;
         let max_step = self.settings.max_step;
         let half_power = system.half_power_surface(mode);
-        // The rate stage 0 holds the derivative with, if it holds one.
-        let mut stage0 = self.first_same_as_last.then_some(self.stage0_rate);
+        // Stage 0: the derivative at the step start times the rate `dt/dsigma` it was
+        // computed with (reused from the last step's end), or evaluated afresh in time units
+        // if it holds nothing usable; f(t0, x) from it for the prediction.
+        let rate = match self.first_same_as_last.then_some(self.stage0_rate) {
+            Some(rate) if rate != 0.0 => rate,
+            _ => {
+                let mut rhs = clocked_field(&mut self.field, system, mode, Clock::Time, true);
+                self.rk.evaluate_first_stage(&mut rhs, t0, &self.z);
+                1.0
+            }
+        };
+        let mut stage0 = Some(rate);
+        self.rk.first_stage(&mut self.velocity);
+        for v in &mut self.velocity {
+            *v /= rate;
+        }
+        // Without a proposed step (the first step of a solver, whose stage 0 was just
+        // evaluated in time units), Hairer's starting step.
         let mut h = match self.proposed_step {
             Some(h) => h,
             None => {
                 let mut rhs = clocked_field(&mut self.field, system, mode, Clock::Time, true);
-                self.rk.evaluate_first_stage(&mut rhs, t0, &self.z);
-                stage0 = Some(1.0);
                 self.rk
                     .initial_step(&mut rhs, t0, &self.z, rtol, atol, max_step)
             }
@@ -657,21 +671,6 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
             _ => Clock::Time,
         };
-        // Stage 0 in time units if it holds nothing usable, and f(t0, x) from it for the
-        // prediction.
-        let rate = match stage0 {
-            Some(rate) if rate != 0.0 => rate,
-            _ => {
-                let mut rhs = clocked_field(&mut self.field, system, mode, Clock::Time, true);
-                self.rk.evaluate_first_stage(&mut rhs, t0, &self.z);
-                stage0 = Some(1.0);
-                1.0
-            }
-        };
-        self.rk.first_stage(&mut self.velocity);
-        for v in &mut self.velocity {
-            *v /= rate;
-        }
         // Aim at the predicted crossing (see the module docs): land just past it when the
         // proposed step reaches it (on a square-root clock centred there if it is a crossing
         // of the half-power surface), or approach it in steps of a fixed fraction of the
@@ -945,7 +944,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let (clock, sigma0, dsigma) = (self.clock, self.sigma_start, self.rk.h);
         let t0 = self.t;
         let t1 = t0 + reach;
-        let side = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
+        let side = side_sign(mode, k);
         let rk = &self.rk;
         let z_end = &self.z;
         let x = &mut self.x;
@@ -982,7 +981,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 .dense_coefficients(&mut rhs, sigma0, &self.z, &self.z_new, n);
         }
         let system = self.system;
-        let side = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
+        let side = side_sign(mode, k);
         let g1 = side * system.switching(k, t1, &self.z_new[..n]);
         if g1.is_nan() || g1 >= 0.0 {
             return None;
@@ -1048,14 +1047,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let p = self.samples.points();
         let mut best: Option<(usize, Bracket)> = None;
         for k in 0..self.surfaces {
-            let sigma = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
+            let side = side_sign(mode, k);
             // At the step start the side is the mode's, whatever the computed value.
-            let mut prev = (t0, (sigma * self.samples.values[k * p]).abs());
+            let mut prev = (t0, (side * self.samples.values[k * p]).abs());
             let mut candidate = None;
             for i in 0..p - 1 {
                 let te = self.samples.extremum_time[k * (p - 1) + i];
                 if !te.is_nan() && te > prev.0 {
-                    let ge = sigma * self.samples.extremum_value[k * (p - 1) + i];
+                    let ge = side * self.samples.extremum_value[k * (p - 1) + i];
                     if ge < 0.0 {
                         candidate = Some((prev, (te, ge)));
                         break;
@@ -1063,7 +1062,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     prev = (te, ge);
                 }
                 let tb = self.samples.times[i + 1];
-                let gb = sigma * self.samples.values[k * p + i + 1];
+                let gb = side * self.samples.values[k * p + i + 1];
                 if gb < 0.0 {
                     candidate = Some((prev, (tb, gb)));
                     break;
@@ -1092,7 +1091,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 state_in_step(
                     system, kind, mode, rk, clock, z_start, z_new, t0, t1, n, t, x,
                 );
-                sigma * system.switching(k, t, x)
+                side * system.switching(k, t, x)
             };
             let bracket = locate_sign_change(
                 a,
@@ -1381,14 +1380,14 @@ fn crossing_fraction<S: HybridSystem + ?Sized>(
     let scale1 = clock.rate(sigma0 + dsigma) * dsigma;
     let mut earliest: Option<(f64, usize)> = None;
     for k in 0..surfaces {
-        let sigma = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
-        let g1 = sigma * system.switching(k, t1, &z1[..n]);
+        let side = side_sign(mode, k);
+        let g1 = side * system.switching(k, t1, &z1[..n]);
         if g1.is_nan() || g1 >= 0.0 {
             continue;
         }
-        let g0 = (sigma * system.switching(k, t0, &z0[..n])).abs();
-        let r0 = sigma * system.switching_rate(k, mode, t0, &z0[..n]) * scale0;
-        let r1 = sigma * system.switching_rate(k, mode, t1, &z1[..n]) * scale1;
+        let g0 = (side * system.switching(k, t0, &z0[..n])).abs();
+        let r0 = side * system.switching_rate(k, mode, t0, &z0[..n]) * scale0;
+        let r1 = side * system.switching_rate(k, mode, t1, &z1[..n]) * scale1;
         if !(g0.is_finite() && r0.is_finite() && r1.is_finite()) {
             continue;
         }
@@ -1433,10 +1432,10 @@ fn predict_crossing<S: HybridSystem + ?Sized>(
     }
     let mut earliest: Option<(f64, usize)> = None;
     for k in 0..surfaces {
-        let sigma = if mode & (1 << k) != 0 { -1.0 } else { 1.0 };
-        let g = (sigma * system.switching(k, t0, x)).max(0.0);
-        let r = sigma * system.switching_rate(k, mode, t0, x);
-        let r_ahead = sigma * system.switching_rate(k, mode, t0 + delta, x_ahead);
+        let side = side_sign(mode, k);
+        let g = (side * system.switching(k, t0, x)).max(0.0);
+        let r = side * system.switching_rate(k, mode, t0, x);
+        let r_ahead = side * system.switching_rate(k, mode, t0 + delta, x_ahead);
         let a = (r_ahead - r) / delta;
         if let Some(s) = first_positive_root(0.5 * a, r, g) {
             if earliest.is_none_or(|(e, _)| s < e) {
@@ -1445,6 +1444,16 @@ fn predict_crossing<S: HybridSystem + ?Sized>(
         }
     }
     earliest
+}
+
+/// `+1` if `mode` has `h_k` on its positive side, `-1` if on its negative side (bit `k` set):
+/// `side_sign * h_k` is positive on the current side of surface `k`.
+fn side_sign(mode: Mode, k: usize) -> f64 {
+    if mode & (1 << k) != 0 {
+        -1.0
+    } else {
+        1.0
+    }
 }
 
 /// The smallest positive root of `a s^2 + b s + c` (`c >= 0`), if any (finite values only).
