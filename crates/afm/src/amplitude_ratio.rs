@@ -8,6 +8,7 @@ use crate::bifurcation_diagram::{approach_diagram, DiagramSettings};
 use crate::error::AfmError;
 use crate::model::TappingModel;
 use crate::steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};
+use crate::validation::invalid;
 
 /// What [`find_amplitude_ratio`] looks for, and how. Built by [`AmplitudeRatioSearch::new`],
 /// which checks the ranges.
@@ -26,14 +27,12 @@ impl AmplitudeRatioSearch {
     /// A search for `A/A0 = ratio` with the default step, floor and tolerance.
     pub fn new(ratio: f64) -> Result<Self, AfmError> {
         if !(ratio > 0.0 && ratio < 1.0) {
-            return Err(AfmError::InvalidField {
-                file: String::from("amplitude-ratio search"),
-                field: String::from("amplitude_ratio"),
-                value: ratio.to_string(),
-                allowed: String::from(
-                    "0 < R < 1 (A/A0 is 1 at first contact and falls as Z decreases)",
-                ),
-            });
+            return Err(invalid(
+                "amplitude-ratio search",
+                "amplitude_ratio",
+                ratio,
+                String::from("0 < R < 1 (A/A0 is 1 at first contact and falls as Z decreases)"),
+            ));
         }
         Ok(Self {
             ratio,

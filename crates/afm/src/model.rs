@@ -96,41 +96,18 @@ impl TappingModel {
                 .map(|m| m.frequency_khz)
                 .fold(0.0, f64::max);
         if !(lowest..=highest).contains(&frequency_khz) {
-            return Err(AfmError::InvalidField {
-                file: String::from("model parameters"),
-                field: String::from("drive_frequency_khz"),
-                value: frequency_khz.to_string(),
-                allowed: format!(
+            return Err(invalid(
+                "model parameters",
+                "drive_frequency_khz",
+                frequency_khz,
+                format!(
                     "[{lowest:.6}, {highest:.6}] kHz (from f_1/100 to 100 times the highest modal frequency)"
                 ),
-            });
+            ));
         }
         let drive = Drive::for_free_amplitude(&cantilever, free_amplitude_nm, frequency_khz)?;
         let free_response = FreeResponse::new(&cantilever, &drive);
         let grazing_separation_nm = free_response.grazing_separation_nm();
-        let modes: Vec<ModalConstants> = cantilever
-            .modes
-            .iter()
-            .map(|mode| {
-                let omega = mode.angular_frequency();
-                let static_deflection = mode.force_ratio * drive.force_nn / mode.stiffness_n_per_m;
-                ModalConstants {
-                    omega_squared: omega * omega,
-                    omega_squared_over_stiffness: omega * omega / mode.stiffness_n_per_m,
-                    damping: omega / mode.quality_factor,
-                    drive_acceleration: omega * omega * static_deflection,
-                    optical_sensitivity: mode.optical_sensitivity,
-                    oscillator: DrivenOscillator::new(
-                        omega,
-                        mode.quality_factor,
-                        static_deflection,
-                        drive.angular_frequency,
-                    ),
-                    step_transition: [[0.0; 2]; 2],
-                    spacing_transition: [[0.0; 2]; 2],
-                }
-            })
-            .collect();
         // A quarter of the shortest period present: the undamped modal periods (each no longer
         // than the damped one) and the drive period.
         let shortest_period = cantilever
@@ -140,11 +117,30 @@ impl TappingModel {
             .fold(drive.period_us(), f64::min);
         let exact_step_limit = 0.25 * shortest_period;
         let spacing = exact_step_limit / STANDARD_GRID as f64;
-        let mut modes = modes;
-        for m in &mut modes {
-            m.step_transition = m.oscillator.homogeneous_transition(exact_step_limit);
-            m.spacing_transition = m.oscillator.homogeneous_transition(spacing);
-        }
+        let modes: Vec<ModalConstants> = cantilever
+            .modes
+            .iter()
+            .map(|mode| {
+                let omega = mode.angular_frequency();
+                let static_deflection = mode.force_ratio * drive.force_nn / mode.stiffness_n_per_m;
+                let oscillator = DrivenOscillator::new(
+                    omega,
+                    mode.quality_factor,
+                    static_deflection,
+                    drive.angular_frequency,
+                );
+                ModalConstants {
+                    omega_squared: omega * omega,
+                    omega_squared_over_stiffness: omega * omega / mode.stiffness_n_per_m,
+                    damping: omega / mode.quality_factor,
+                    drive_acceleration: omega * omega * static_deflection,
+                    optical_sensitivity: mode.optical_sensitivity,
+                    step_transition: oscillator.homogeneous_transition(exact_step_limit),
+                    spacing_transition: oscillator.homogeneous_transition(spacing),
+                    oscillator,
+                }
+            })
+            .collect();
         let spacing_rotation = (drive.angular_frequency * spacing).sin_cos();
         Ok(Self {
             hertz: HertzContact::new(&cantilever, &sample),

@@ -19,6 +19,7 @@ use crate::error::AfmError;
 use crate::model::TappingModel;
 use crate::observables::{observe_period, OrbitObservables};
 use crate::separation::Separation;
+use crate::validation::invalid;
 
 /// `TappingModel` as a parametrised periodic system for shooting and continuation: the
 /// parameter is the separation `Z` (nm), the period is the drive period `T` (us), and the
@@ -182,14 +183,14 @@ pub fn steady_orbit(
     settings.validate()?;
     let lowest = -model.free_amplitude_nm();
     if !(lowest..=MAX_SEPARATION_NM).contains(&z_nm) {
-        return Err(AfmError::InvalidField {
-            file: String::from("steady orbit"),
-            field: String::from("z_nm"),
-            value: z_nm.to_string(),
-            allowed: format!(
+        return Err(invalid(
+            "steady orbit",
+            "z_nm",
+            z_nm,
+            format!(
                 "[{lowest}, {MAX_SEPARATION_NM}] nm (from -A0, a rest position one free amplitude inside the sample where Hertz contact is long past its validity, up to far above first contact)"
             ),
-        });
+        ));
     }
     let mut model = model.clone();
     model.set_separation(Separation::Constant(z_nm))?;
