@@ -7,7 +7,7 @@ use std::cell::Cell;
 use std::time::Instant;
 
 use continuation::{
-    Continuation, ContinuationError, ContinuationSettings, HybridPeriodicProblem,
+    Branch, Continuation, ContinuationError, ContinuationSettings, HybridPeriodicProblem,
     ParameterDirection, Parametrised, PeriodMap, PeriodicProblem, SpecialPointKind, StopReason,
 };
 use hybrid::{HybridSystem, Mode, Settings, SwitchingPartials};
@@ -116,6 +116,34 @@ impl<P: PeriodicProblem> PeriodicProblem for Counted<P> {
 /// (Newton residual 1e-10 amplified by `1/(1 - |mu|) = 1.5`, `|mu| = exp(-c T / 2) = 0.35`),
 /// which moves the root one to one (`dh/dZ = 1`); the branch goes on in contact with one impact per period, minimum gap
 /// negative, down to the floor, and never fails.
+/// Continue from the orbit at `(0, 0)` and wall position `wall` with `settings`; the branch
+/// must end at its parameter bound.
+fn run_to_parameter_bound<P: PeriodicProblem>(
+    problem: &P,
+    wall: f64,
+    settings: ContinuationSettings,
+) -> Branch {
+    let branch = Continuation::new(problem, &[0.0, 0.0], wall, settings)
+        .expect("start")
+        .run();
+    assert_eq!(
+        branch.stop,
+        StopReason::ParameterBound,
+        "{:?}",
+        branch.error
+    );
+    branch
+}
+
+/// The labels of a branch's special points, in order.
+fn labels(branch: &Branch) -> Vec<&str> {
+    branch
+        .special_points
+        .iter()
+        .map(|s| s.label.as_str())
+        .collect()
+}
+
 #[test]
 fn first_contact_of_a_soft_wall_at_the_free_amplitude() {
     let system = SoftWall {
@@ -141,16 +169,8 @@ fn first_contact_of_a_soft_wall_at_the_free_amplitude() {
         ..ContinuationSettings::default()
     };
     let started = Instant::now();
-    let branch = Continuation::new(&problem, &[0.0, 0.0], start.wall, settings)
-        .expect("start")
-        .run();
+    let branch = run_to_parameter_bound(&problem, start.wall, settings);
     let elapsed = started.elapsed();
-    assert_eq!(
-        branch.stop,
-        StopReason::ParameterBound,
-        "{:?}",
-        branch.error
-    );
     let calls = problem.calls.get();
     eprintln!(
         "{} points, {} period maps ({:.1} per point), {:.3} ms per point",
@@ -219,20 +239,8 @@ fn fold_after_first_contact_on_a_stiff_wall() {
         parameter_max: 2.0 * z_g,
         ..ContinuationSettings::default()
     };
-    let branch = Continuation::new(&problem, &[0.0, 0.0], start.wall, settings)
-        .expect("start")
-        .run();
-    assert_eq!(
-        branch.stop,
-        StopReason::ParameterBound,
-        "{:?}",
-        branch.error
-    );
-    let labels: Vec<&str> = branch
-        .special_points
-        .iter()
-        .map(|s| s.label.as_str())
-        .collect();
+    let branch = run_to_parameter_bound(&problem, start.wall, settings);
+    let labels = labels(&branch);
     assert_eq!(labels, ["G1", "fold"], "{:?}", branch.special_points);
     let (g1, fold) = (&branch.special_points[0], &branch.special_points[1]);
     // Location tolerance plus the state error (Newton residual 1e-10 amplified by at most
@@ -287,20 +295,8 @@ fn period_doubling_after_first_contact_far_above_resonance() {
         parameter_min: 0.1,
         ..ContinuationSettings::default()
     };
-    let branch = Continuation::new(&problem, &[0.0, 0.0], start.wall, settings)
-        .expect("start")
-        .run();
-    assert_eq!(
-        branch.stop,
-        StopReason::ParameterBound,
-        "{:?}",
-        branch.error
-    );
-    let labels: Vec<&str> = branch
-        .special_points
-        .iter()
-        .map(|s| s.label.as_str())
-        .collect();
+    let branch = run_to_parameter_bound(&problem, start.wall, settings);
+    let labels = labels(&branch);
     assert_eq!(
         labels,
         ["G1", "period-doubling"],
