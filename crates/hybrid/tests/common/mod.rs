@@ -292,10 +292,7 @@ impl HybridSystem for BouncingBall {
         jacobian: &mut DMatrix<f64>,
         dxdp: &mut [f64],
     ) {
-        x[1] *= -self.restitution;
-        jacobian.fill_with_identity();
-        jacobian[(1, 1)] = -self.restitution;
-        dxdp.fill(0.0);
+        restitution_reset(self.restitution, x, jacobian, dxdp);
     }
 }
 
@@ -464,10 +461,7 @@ impl HybridSystem for ImpactOscillator {
         jacobian: &mut DMatrix<f64>,
         dxdp: &mut [f64],
     ) {
-        x[1] *= -self.restitution;
-        jacobian.fill_with_identity();
-        jacobian[(1, 1)] = -self.restitution;
-        dxdp.fill(0.0);
+        restitution_reset(self.restitution, x, jacobian, dxdp);
     }
 }
 
@@ -522,4 +516,19 @@ impl HybridSystem for ThreeSurfaces {
         }
         SwitchingPartials::default()
     }
+}
+
+/// The impact law `v+ = -e v-` on the velocity `x[1]` of a state `(x, v)`, with its Jacobian
+/// `diag(1, -e)` and no parameter dependence (the reset of the bouncing ball and of the impact
+/// oscillator).
+fn restitution_reset(
+    restitution: f64,
+    x: &mut [f64],
+    jacobian: &mut DMatrix<f64>,
+    dxdp: &mut [f64],
+) {
+    x[1] *= -restitution;
+    jacobian.fill_with_identity();
+    jacobian[(1, 1)] = -restitution;
+    dxdp.fill(0.0);
 }
