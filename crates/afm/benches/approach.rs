@@ -6,7 +6,8 @@
 //!
 //! Run with `cargo bench -p afm --bench approach` (release build, one core). Pass `--quick`
 //! after `--` to sweep only 11 nm -> 8 nm, `--samples N` to change the solver's samples per
-//! step (default 8).
+//! step (default 8), `--all-extrema` to search every free-flight step for extrema
+//! (`extremum_height` infinite, as before the sweep skipped steps proven clear of the sample).
 
 use afm::{builtin_case, Sweep, SweepSettings, TappingModel};
 use std::time::Instant;
@@ -43,6 +44,10 @@ fn main() {
             "samples per step: {}",
             settings.integration.samples_per_step
         );
+    }
+    if arguments.iter().any(|a| a == "--all-extrema") {
+        settings.integration.extremum_height = f64::INFINITY;
+        println!("every free-flight step searched for extrema");
     }
     let mut sweep = Sweep::new(&model, settings).expect("sweep");
     let cycles = sweep.total_cycles();

@@ -126,7 +126,9 @@ pub struct SweepSettings {
     pub every: usize,
     /// Settings of the hybrid solver. Default: `hybrid::Settings::default()` with relative and
     /// absolute tolerances [`DEFAULT_TOLERANCE`] (the lock-in's targets, 1e-3 in `A/A0` and 0.1
-    /// deg, are six orders above the error this leaves; the free flight is exact regardless).
+    /// deg, are six orders above the error this leaves; the free flight is exact regardless),
+    /// and `extremum_height` 0: the lock-in reads gap minima only in contact, so free flight
+    /// that the model proves clear of the sample is not searched for extrema.
     pub integration: Settings,
 }
 
@@ -145,6 +147,9 @@ impl SweepSettings {
             integration: Settings {
                 relative_tolerance: DEFAULT_TOLERANCE,
                 absolute_tolerance: DEFAULT_TOLERANCE,
+                // The lock-in reads only gap minima in contact, which are always sampled: free
+                // flight proven clear of the sample is not searched for extrema.
+                extremum_height: 0.0,
                 ..Settings::default()
             },
         }

@@ -107,6 +107,57 @@ impl Samples {
         Ok(())
     }
 
+    /// Sample `h_k` and `dh_k/dt` at the step's two ends only (the start from `x0` unless
+    /// carried over, the end from `x1`), for a step proven clear of every surface: the
+    /// interior points are put at the end (`times[i] = t1`, the end's values), so that the step
+    /// reads as one monotone interval with no extrema. [`Samples::locate_extrema`] is not to be
+    /// called after it; the extrema of the step are cleared here.
+    ///
+    /// # Errors
+    /// [`HybridError::NonFiniteSwitching`] if a sample is NaN or infinite.
+    #[allow(clippy::too_many_arguments)]
+    pub fn sample_ends<S: HybridSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        mode: Mode,
+        t0: f64,
+        t1: f64,
+        x0: &[f64],
+        x1: &[f64],
+    ) -> Result<(), HybridError> {
+        let p = self.points;
+        self.times[0] = t0;
+        for time in &mut self.times[1..] {
+            *time = t1;
+        }
+        let ends: &[(usize, f64, &[f64])] = if self.start_valid {
+            &[(p - 1, t1, x1)]
+        } else {
+            &[(0, t0, x0), (p - 1, t1, x1)]
+        };
+        for &(i, t, x) in ends {
+            for k in 0..self.surfaces {
+                let value = system.switching(k, t, x);
+                let rate = system.switching_rate(k, mode, t, x);
+                if !value.is_finite() || !rate.is_finite() {
+                    return Err(HybridError::NonFiniteSwitching { t, surface: k });
+                }
+                self.values[k * p + i] = value;
+                self.rates[k * p + i] = rate;
+            }
+        }
+        for k in 0..self.surfaces {
+            for i in 1..p - 1 {
+                self.values[k * p + i] = self.values[k * p + p - 1];
+                self.rates[k * p + i] = self.rates[k * p + p - 1];
+            }
+        }
+        self.start_valid = true;
+        self.extremum_time.fill(f64::NAN);
+        self.extremum_value.fill(f64::NAN);
+        Ok(())
+    }
+
     /// Make the end samples of this step the start samples of the next one.
     pub fn carry_over(&mut self) {
         let p = self.points;

@@ -51,6 +51,15 @@ pub struct Settings {
     /// evaluations than stepping in time (see [`crate::solver`]).
     /// Allowed: `1e-16 ..= 1`. Default `None`.
     pub sensitivity_tolerance: Option<f64>,
+    /// How far from a surface extrema must still be found, in switching-function units.
+    /// Every step is sampled inside and its extrema located, except a step that the system
+    /// proves farther than this from every surface throughout (by
+    /// [`crate::HybridSystem::switching_curvature_bound`]): such a step is sampled at its ends
+    /// only and reports no extrema. Crossings are found either way. `INFINITY` (the default)
+    /// reports every extremum, as observables of an orbit need; a time-domain sweep or a
+    /// Newton iteration that only needs the crossings sets it to 0. Allowed: `>= 0` (infinity
+    /// allowed).
+    pub extremum_height: f64,
 }
 
 impl Default for Settings {
@@ -67,6 +76,7 @@ impl Default for Settings {
             samples_per_step: 8,
             grazing_rate: 1e-6,
             sensitivity_tolerance: None,
+            extremum_height: f64::INFINITY,
         }
     }
 }
@@ -149,6 +159,8 @@ impl Settings {
         }
         let g = self.grazing_rate;
         check(g.is_finite() && g >= 0.0, "grazing_rate", g, ">= 0, finite")?;
+        let e = self.extremum_height;
+        check(e >= 0.0, "extremum_height", e, ">= 0 (infinity allowed)")?;
         Ok(())
     }
 }
@@ -164,7 +176,7 @@ mod tests {
 
     #[test]
     fn bad_fields_are_named() {
-        let cases: [(Settings, &str); 6] = [
+        let cases: [(Settings, &str); 7] = [
             (
                 Settings {
                     relative_tolerance: f64::NAN,
@@ -206,6 +218,13 @@ mod tests {
                     ..Settings::default()
                 },
                 "sensitivity_tolerance",
+            ),
+            (
+                Settings {
+                    extremum_height: f64::NAN,
+                    ..Settings::default()
+                },
+                "extremum_height",
             ),
         ];
         for (settings, name) in cases {

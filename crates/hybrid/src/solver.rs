@@ -166,6 +166,9 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     step_start: f64,
     step_end: f64,
     full_dense: bool,
+    /// Whether the last step was proven clear of every surface before it was taken (an exact
+    /// step stretched by [`Solver::clear_exact_span`]).
+    proven_clear: bool,
     samples: Samples,
     extrema: Vec<Extremum>,
     x: Vec<f64>,
@@ -257,6 +260,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             step_start: t0,
             step_end: t0,
             full_dense: false,
+            proven_clear: false,
             samples,
             extrema: Vec::with_capacity(extrema_capacity),
             x: vec![0.0; n],
@@ -455,6 +459,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let t0 = self.t;
         let mode = self.mode;
         self.z_start.copy_from_slice(&self.z);
+        self.proven_clear = false;
         let t1 = if self.system.has_exact_flow(mode) {
             self.exact_step(t_end)?
         } else {
@@ -468,7 +473,18 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         // Sample h and dh/dt, locate extrema, then the earliest crossing.
         let time_tolerance =
             self.settings.event_time_tolerance * t0.abs().max(t1.abs()).max(t1 - t0);
-        {
+        let clear = self.settings.extremum_height.is_finite() && {
+            self.samples.sample_ends(
+                self.system,
+                mode,
+                t0,
+                t1,
+                &self.z_start[..self.n],
+                &self.z_new[..self.n],
+            )?;
+            self.proven_clear || self.clear_of_surfaces(mode, t0, t1)
+        };
+        if !clear {
             let system = self.system;
             let n = self.n;
             let kind = self.kind;
@@ -530,6 +546,73 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
     }
 
+    /// The longest span from `t0` (at most `longest`) over which the exact flow of `mode` is
+    /// proven farther than `extremum_height` from every surface before it is taken: with the
+    /// start samples `g0 = side h_k(t0)`, `g0' = side dh_k/dt(t0)` and the system's curvature
+    /// bound `M` over `[t0, t0 + longest]`, `g(t0 + s) >= g0 + g0' s - M s^2 / 2`, which stays
+    /// above the height up to the positive root of that parabola. `None` if the start samples
+    /// are not at hand (first step after an event), the height is infinite, the system gives
+    /// no bound, or a surface is already within the height.
+    fn clear_exact_span(&self, mode: Mode, t0: f64, longest: f64) -> Option<f64> {
+        let height = self.settings.extremum_height;
+        if !height.is_finite() || !self.samples.start_valid {
+            return None;
+        }
+        let p = self.samples.points();
+        let mut span = longest;
+        for k in 0..self.surfaces {
+            let side = side_sign(mode, k);
+            let margin = side * self.samples.values[k * p] - height;
+            let rate = side * self.samples.rates[k * p];
+            let bound = self.system.switching_curvature_bound(
+                k,
+                mode,
+                t0,
+                &self.z_start[..self.n],
+                longest,
+            )?;
+            if !(margin > 0.0 && bound >= 0.0 && bound.is_finite() && rate.is_finite()) {
+                return None;
+            }
+            // The positive root of margin + rate s - bound s^2 / 2, in the form without
+            // cancellation for either sign of the rate.
+            let root = (rate * rate + 2.0 * bound * margin).sqrt();
+            let clear = if rate < 0.0 {
+                2.0 * margin / (root - rate)
+            } else if bound > 0.0 {
+                (rate + root) / bound
+            } else {
+                f64::INFINITY
+            };
+            // A margin for the rounding of the root.
+            span = span.min(clear * (1.0 - 1e-9));
+        }
+        Some(span)
+    }
+
+    /// Whether the step `[t0, t1]` just sampled at its ends ([`Samples::sample_ends`]) stays
+    /// farther than `extremum_height` from every surface throughout: for each surface, the
+    /// smaller end value on the mode's side less `M (t1 - t0)^2 / 8`, with `M` the system's
+    /// bound on `|h''|` ([`HybridSystem::switching_curvature_bound`]), must exceed the height
+    /// (and zero). `false` when the system gives no bound.
+    fn clear_of_surfaces(&self, mode: Mode, t0: f64, t1: f64) -> bool {
+        let p = self.samples.points();
+        let dt = t1 - t0;
+        let height = self.settings.extremum_height;
+        (0..self.surfaces).all(|k| {
+            let side = side_sign(mode, k);
+            let ends =
+                (side * self.samples.values[k * p]).min(side * self.samples.values[k * p + p - 1]);
+            self.system
+                .switching_curvature_bound(k, mode, t0, &self.z_start[..self.n], dt)
+                .is_some_and(|bound| {
+                    let lowest = ends - bound * dt * dt / 8.0;
+                    // False for a NaN bound: such a step is sampled in full.
+                    lowest > height && lowest > 0.0
+                })
+        })
+    }
+
     /// An exact-flow step of length `min(exact_step_limit, max_step, t_end - t)`; returns the
     /// end time. Writes `z_new`.
     fn exact_step(&mut self, t_end: f64) -> Result<f64, HybridError> {
@@ -548,10 +631,19 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
         let t0 = self.t;
         let remaining = t_end - t0;
-        let (dt, t1) = if limit >= remaining {
+        let longest = remaining.min(self.settings.max_step);
+        let span = if limit < longest {
+            self.clear_exact_span(mode, t0, longest)
+                .filter(|&span| span > limit)
+        } else {
+            None
+        };
+        self.proven_clear = span.is_some();
+        let step = span.unwrap_or(limit);
+        let (dt, t1) = if step >= remaining {
             (remaining, t_end)
         } else {
-            (limit, t0 + limit)
+            (step, t0 + step)
         };
         self.exact_advance(mode, t0, dt);
         if self.z_new.iter().any(|v| !v.is_finite()) {

@@ -176,6 +176,28 @@ pub trait HybridSystem {
         f64::INFINITY
     }
 
+    /// A rigorous upper bound of `|d^2 h_k / dt^2|` along the flow of mode `mode` from
+    /// `(t0, x0)` over `[t0, t0 + dt]`, in switching-function units per time unit squared, or
+    /// `None` if the system cannot bound it (the default).
+    ///
+    /// With the bound `M`, `h_k` stays within `M dt^2 / 8` of the chord between its values at
+    /// the step's ends, so a step whose ends both lie farther than that from surface `k` cannot
+    /// cross it. The solver uses this to skip the interior sampling of steps proven clear of
+    /// every surface by more than [`crate::Settings::extremum_height`] (their extrema are then
+    /// not reported). A bound that is too small makes the solver miss contacts: it must hold
+    /// for every time in the interval, not only at `t0`.
+    fn switching_curvature_bound(
+        &self,
+        k: usize,
+        mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        dt: f64,
+    ) -> Option<f64> {
+        let _ = (k, mode, t0, x0, dt);
+        None
+    }
+
     /// The exact flow of mode `mode` from `(t0, x0)` at the equally spaced times
     /// `t0 + j dt / count`, `j = 1..count` (`count >= 1`): state `j` into
     /// `states[(j - 1) n .. j n]` (`states.len() >= count n`). The solver samples the

@@ -22,6 +22,7 @@ fn brief_dip_found_through_its_minimum_exact_flow() {
         c: 1.0 - 1e-6,
         t_c: 1.05,
         exact_flow_limit: Some(1.5),
+        curvature_bound: false,
     };
     check_dip(&system, 1e-11, 1e-15);
 }
@@ -35,6 +36,7 @@ fn brief_dip_found_through_its_minimum_runge_kutta() {
         c: 1.0 - 1e-6,
         t_c: 1.05,
         exact_flow_limit: None,
+        curvature_bound: false,
     };
     check_dip(&system, 1e-8, 1e-11);
 }
@@ -94,6 +96,7 @@ fn events_and_extrema_fire_exactly_once() {
             c: 0.3,
             t_c: 0.0,
             exact_flow_limit: limit,
+            curvature_bound: false,
         };
         let result = flow_map(
             &system,
@@ -204,6 +207,7 @@ fn extrema_on_step_boundaries_are_reported_once() {
         c: 2.0,
         t_c: 0.0,
         exact_flow_limit: Some(PI / 4.0),
+        curvature_bound: false,
     };
     let result = flow_map(
         &exact,
@@ -219,6 +223,7 @@ fn extrema_on_step_boundaries_are_reported_once() {
 
     let rk = Rotation {
         exact_flow_limit: None,
+        curvature_bound: false,
         ..exact
     };
     let mut solver = Solver::new(
@@ -281,6 +286,7 @@ fn exact_grazing_never_loops() {
             c: 1.0,
             t_c,
             exact_flow_limit: limit,
+            curvature_bound: false,
         };
         let result = flow_map(
             &system,
@@ -334,6 +340,7 @@ fn step_to_current_time_reports_nothing() {
         c: -0.3,
         t_c: 0.0,
         exact_flow_limit: Some(3.0),
+        curvature_bound: false,
     };
     let mut solver = Solver::new(
         &system,
@@ -427,4 +434,67 @@ fn several_surfaces_and_simultaneous_crossings() {
     let (sn, cs) = t_end.sin_cos();
     assert!((result.transition[(0, 0)] - cs).abs() < 1e-10);
     assert!((result.transition[(0, 1)] - sn).abs() < 1e-10);
+}
+
+/// Steps proven clear of the surface (`extremum_height = 0` and a curvature bound) go
+/// unsampled (and exact-flow steps are stretched across them), yet every crossing is found as
+/// with full sampling: `h = c - cos(t - t_c)` with `c = 1 - 1e-6` dips below zero for 2.8e-3
+/// time units once per period, six periods, exact-flow steps of at most 0.5 where not proven
+/// clear, and Runge-Kutta steps. The events must match those of the fully sampled run to
+/// rounding (the exact flow composed of other steps: crossing times to 1e-11, as in the
+/// brief-dip tests, states to 1e-11 as `|dx/dt| = 1` moves them; the final state to 1e-13);
+/// the dips' minima (value `c - 1`) are still reported, the
+/// maxima of `h` (value `c + 1`, farther than any bound allows) no longer are.
+#[test]
+fn steps_clear_of_the_surface_skip_sampling_but_no_crossing() {
+    for limit in [Some(0.5), None] {
+        let system = Rotation {
+            c: 1.0 - 1e-6,
+            t_c: 1.05,
+            exact_flow_limit: limit,
+            curvature_bound: true,
+        };
+        let run = |height: f64| {
+            let settings = Settings {
+                extremum_height: height,
+                ..Settings::default()
+            };
+            flow_map(
+                &system,
+                0.0,
+                &system.initial_state(),
+                12.0 * PI,
+                Sensitivity::None,
+                &settings,
+            )
+            .expect("integration succeeds")
+        };
+        let full = run(f64::INFINITY);
+        let skipping = run(0.0);
+        assert_eq!(full.events.len(), 12, "{:?}", full.events);
+        assert_eq!(skipping.events.len(), full.events.len());
+        for (a, b) in full.events.iter().zip(&skipping.events) {
+            assert!((a.t - b.t).abs() < 1e-11, "{a:?} {b:?}");
+            assert_eq!(a.direction, b.direction);
+            for (x, y) in a.state.iter().zip(&b.state) {
+                assert!((x - y).abs() < 1e-11, "{a:?} {b:?}");
+            }
+        }
+        for (x, y) in skipping.state.iter().zip(&full.state) {
+            assert!((x - y).abs() < 1e-13);
+        }
+        let count = |result: &hybrid::FlowMap, kind: ExtremumKind| {
+            result.extrema.iter().filter(|e| e.kind == kind).count()
+        };
+        assert_eq!(count(&full, ExtremumKind::Minimum), 6);
+        assert_eq!(count(&full, ExtremumKind::Maximum), 6);
+        assert_eq!(count(&skipping, ExtremumKind::Minimum), 6);
+        assert_eq!(count(&skipping, ExtremumKind::Maximum), 0);
+        for minimum in skipping.extrema.iter() {
+            assert!((minimum.value - (system.c - 1.0)).abs() < 1e-11);
+        }
+        // A height above the maxima's value reports them again.
+        let high = run(2.5);
+        assert_eq!(count(&high, ExtremumKind::Maximum), 6);
+    }
 }

@@ -100,6 +100,7 @@ fn steps_do_not_allocate() {
             c: 0.3,
             t_c: 0.0,
             exact_flow_limit: Some(0.5),
+            curvature_bound: false,
         };
         assert_eq!(
             allocations_beyond_events(&rotation, &rotation.initial_state(), s),

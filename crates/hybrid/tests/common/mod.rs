@@ -144,12 +144,15 @@ impl HybridSystem for ForcedOscillator {
 /// Harmonic rotation `u' = v, v' = -u` from `(cos(-t_c), sin(t_c))`, so `u = cos(t - t_c)`;
 /// switching function `h = c - u` (a surface crossed twice per period when `|c| < 1`, a dip of
 /// depth `1 - c` around `t_c + 2 pi k` when `c` is just below 1). The field is the same in both
-/// modes. With `exact_flow_limit = Some(l)` the rotation is used as an exact flow.
+/// modes. With `exact_flow_limit = Some(l)` the rotation is used as an exact flow. With
+/// `curvature_bound`, the system bounds `|h''| = |u| <= sqrt(u^2 + v^2)` (the radius, constant
+/// along the flow), so that steps clear of the surface may go unsampled.
 #[derive(Clone, Copy, Debug)]
 pub struct Rotation {
     pub c: f64,
     pub t_c: f64,
     pub exact_flow_limit: Option<f64>,
+    pub curvature_bound: bool,
 }
 
 impl Rotation {
@@ -197,6 +200,16 @@ impl HybridSystem for Rotation {
     }
     fn exact_step_limit(&self, _mode: Mode) -> f64 {
         self.exact_flow_limit.unwrap_or(f64::INFINITY)
+    }
+    fn switching_curvature_bound(
+        &self,
+        _k: usize,
+        _mode: Mode,
+        _t0: f64,
+        x0: &[f64],
+        _dt: f64,
+    ) -> Option<f64> {
+        self.curvature_bound.then(|| x0[0].hypot(x0[1]))
     }
     fn exact_flow(
         &self,
