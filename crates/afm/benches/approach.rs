@@ -6,7 +6,8 @@
 //!
 //! Run with `cargo bench -p afm --bench approach` (release build, one core). Pass `--quick`
 //! after `--` to sweep only 11 nm -> 8 nm, `--samples N` to change the solver's samples per
-//! step (default 8), `--all-extrema` to search every free-flight step for extrema
+//! step (default 8), `--tolerance X` for the contact integration's tolerance (default
+//! `afm::sweep::DEFAULT_TOLERANCE`), `--all-extrema` to search every free-flight step for extrema
 //! (`extremum_height` infinite, as before the sweep skipped steps proven clear of the sample).
 
 use afm::{builtin_case, Sweep, SweepSettings, TappingModel};
@@ -44,6 +45,16 @@ fn main() {
             "samples per step: {}",
             settings.integration.samples_per_step
         );
+    }
+    // `--tolerance X`: the contact integration's relative and absolute tolerance.
+    if let Some(index) = arguments.iter().position(|a| a == "--tolerance") {
+        let tolerance: f64 = arguments
+            .get(index + 1)
+            .and_then(|x| x.parse().ok())
+            .expect("--tolerance X");
+        settings.integration.relative_tolerance = tolerance;
+        settings.integration.absolute_tolerance = tolerance;
+        println!("tolerance: {tolerance:e}");
     }
     if arguments.iter().any(|a| a == "--all-extrema") {
         settings.integration.extremum_height = f64::INFINITY;

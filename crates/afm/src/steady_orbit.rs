@@ -235,6 +235,7 @@ pub fn steady_orbit(
     // The best non-converged attempt: (multiplicity, state, iterations, residual, multipliers).
     #[allow(clippy::type_complexity)]
     let mut best: Option<(usize, Vec<f64>, usize, f64, Vec<Complex<f64>>)> = None;
+    let recurrence_settings = crossings_only(&settings.integration);
     for _ in 0..settings.recurrence_periods {
         x = flow_map(
             &model,
@@ -242,7 +243,7 @@ pub fn steady_orbit(
             &x,
             period,
             Sensitivity::None,
-            &settings.integration,
+            &recurrence_settings,
         )?
         .state;
         states.push(x.clone());
@@ -335,7 +336,8 @@ fn observed_map(
         let (flow, observables) = observe_period(model, 0.0, x, sensitivity, integration, 1)?;
         (flow, Some(observables))
     } else {
-        let flow = flow_map(model, 0.0, x, model.period_us(), sensitivity, integration)?;
+        let settings = crossings_only(integration);
+        let flow = flow_map(model, 0.0, x, model.period_us(), sensitivity, &settings)?;
         (flow, None)
     };
     if flow.state.iter().any(|v| !v.is_finite()) || flow.transition.iter().any(|v| !v.is_finite()) {
@@ -472,13 +474,25 @@ fn observables_at(
     }
 }
 
-/// Iterate the stroboscopic map `periods` times from `x0` (state only).
+/// `settings` for a period map whose extrema nobody reads (a Newton iterate not expected to
+/// be the last, a transient period): `extremum_height` 0, so that free flight the model proves
+/// clear of the sample is neither sampled nor cut into short steps. Contacts are found all the
+/// same; the state differs from a fully sampled map by rounding only.
+fn crossings_only(settings: &Settings) -> Settings {
+    Settings {
+        extremum_height: 0.0,
+        ..settings.clone()
+    }
+}
+
+/// Iterate the stroboscopic map `periods` times from `x0` (state only, no extrema).
 fn iterate(
     model: &TappingModel,
     x0: &[f64],
     periods: usize,
     settings: &Settings,
 ) -> Result<Vec<f64>, AfmError> {
+    let settings = &crossings_only(settings);
     let mut x = x0.to_vec();
     for _ in 0..periods {
         x = flow_map(
