@@ -363,7 +363,7 @@ fn observed_map(
 /// |x|)`: the monodromy returned is then the one at the previous iterate, that close to the
 /// orbit, so it differs from the monodromy at the returned state by about that relative
 /// amount (1e-6): more than its integration error with the square-root clock at contact
-/// (2e-9 to 5e-8 relative, `cargo run --release -p afm --example monodromy_error`), far less
+/// (4e-8 to 1.1e-7 relative, `cargo run --release -p afm --example monodromy_error`), far less
 /// than matters for the Floquet multipliers' use here, the orbit's stability. If the
 /// prediction fails (residual above the tolerance), the point is evaluated again with the
 /// monodromy and Newton goes on.

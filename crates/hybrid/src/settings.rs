@@ -47,7 +47,7 @@ pub struct Settings {
     /// `None`; 6e-7 / 2.5e-6 with `Some(1e-8)` (+19% / +16% RHS evaluations); 5e-9 / 4e-8 with
     /// `Some(1e-10)` (+70% / +56%). A system that declares its contact as a half-power surface
     /// ([`crate::HybridSystem::half_power_surface`], as the AFM model does) is stepped there on
-    /// a square-root clock where the Jacobian is smooth: 2.1e-9 / 5.1e-8 with `None`, and fewer
+    /// a square-root clock where the Jacobian is smooth: 4.2e-8 / 1.1e-7 with `None`, and fewer
     /// evaluations than stepping in time (see [`crate::solver`]).
     /// Allowed: `1e-16 ..= 1`. Default `None`.
     pub sensitivity_tolerance: Option<f64>,

@@ -14,7 +14,8 @@ use hybrid::{flow_map, Sensitivity, Settings, Statistics};
 /// Hertz contact from rest over 3 drive periods, default settings: 5 crossings. The steps next
 /// to onset and release run on the square-root clock (the contact mode declares its
 /// half-power surface); stepping in time there instead, the same run took 210 steps, 29
-/// rejected, 3476 evaluations.
+/// rejected, 3476 evaluations (and with the clock kept for up to 4 proposed steps after onset
+/// instead of 1, 182 steps, 19 rejected, 2954 evaluations).
 #[test]
 fn hertz_contact_statistics_are_pinned() {
     let system = HertzOscillator::reference();
@@ -32,10 +33,10 @@ fn hertz_contact_statistics_are_pinned() {
     assert_eq!(
         result.statistics,
         Statistics {
-            steps: 182,
-            rejected_steps: 19,
+            steps: 180,
+            rejected_steps: 20,
             exact_steps: 0,
-            rhs_evaluations: 2954,
+            rhs_evaluations: 2935,
             events: 5,
         }
     );
