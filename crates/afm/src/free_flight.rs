@@ -9,6 +9,8 @@
 
 use nalgebra::Complex;
 
+use crate::phase;
+
 /// The dimensionless frequency response `1 / (1 - r^2 + i r / Q)`, `r = w / w_i`, of a mode of
 /// Eq. 1: the steady response to `(F_i/k_i) e^{i w t}` is `(F_i/k_i)` times this.
 pub fn dimensionless_response(
@@ -80,7 +82,7 @@ impl DrivenOscillator {
     /// The steady (periodic, particular) solution `[q_p(t), q_p'(t)]` (nm, nm/us).
     #[inline]
     pub fn steady_state(&self, t: f64) -> [f64; 2] {
-        let (sin, cos) = (self.drive_angular_frequency * t).sin_cos();
+        let (sin, cos) = phase::sin_cos(self.drive_angular_frequency * t);
         self.steady_state_at_phase(sin, cos)
     }
 
@@ -123,7 +125,7 @@ impl DrivenOscillator {
         } else if self.delta_squared < 0.0 {
             let delta = (-self.delta_squared).sqrt();
             let decay = (mu * dt).exp();
-            let (sin, cos) = (delta * dt).sin_cos();
+            let (sin, cos) = phase::sin_cos(delta * dt);
             (decay * cos, decay * sin / delta)
         } else {
             let delta = self.delta_squared.sqrt();
@@ -144,8 +146,8 @@ impl DrivenOscillator {
     /// transition matrix `d x(t0 + dt) / d x(t0)`.
     #[inline]
     pub fn flow(&self, t0: f64, x0: [f64; 2], dt: f64) -> ([f64; 2], [[f64; 2]; 2]) {
-        let start = (self.drive_angular_frequency * t0).sin_cos();
-        let end = (self.drive_angular_frequency * (t0 + dt)).sin_cos();
+        let start = phase::sin_cos(self.drive_angular_frequency * t0);
+        let end = phase::sin_cos(self.drive_angular_frequency * (t0 + dt));
         self.flow_between_phases(start, end, x0, dt)
     }
 

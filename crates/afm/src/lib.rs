@@ -34,6 +34,7 @@ pub mod impact_numbers;
 pub mod lockin;
 pub mod model;
 pub mod observables;
+pub mod phase;
 pub mod sample;
 pub mod separation;
 pub mod steady_orbit;

@@ -21,6 +21,7 @@ use hybrid::{Direction, ExtremumKind, HybridSystem, Mode, Solver, StepOutcome};
 use crate::free_flight_fourier::FreeFlightFourier;
 use crate::gauss_legendre::GAUSS_LEGENDRE_4;
 use crate::model::GAP_SURFACE;
+use crate::phase;
 use crate::TappingModel;
 
 /// What the lock-in reads over one drive cycle `[0, T]` (time from the cycle's start).
@@ -157,9 +158,9 @@ impl CycleLockIn {
         let middle = 0.5 * (a + b);
         let w = self.angular_frequency;
         // Drive phase at the nodes by angle addition from the middle (3 sin_cos, not 4).
-        let (sin_m, cos_m) = (w * middle).sin_cos();
+        let (sin_m, cos_m) = phase::sin_cos(w * middle);
         for (offset, weight) in GAUSS_LEGENDRE_4.pairs(a, b) {
-            let (sin_d, cos_d) = (w * offset).sin_cos();
+            let (sin_d, cos_d) = phase::sin_cos(w * offset);
             for (t, sign) in [(middle - offset, -1.0), (middle + offset, 1.0)] {
                 solver.interpolate(t, &mut self.state);
                 let u = model.photodiode(&self.state);

@@ -8,6 +8,7 @@ use nalgebra::DMatrix;
 
 use crate::case::check_case_numbers;
 use crate::free_flight::DrivenOscillator;
+use crate::phase;
 use crate::validation::invalid;
 use crate::{AfmError, Cantilever, Case, Drive, FreeResponse, HertzContact, Sample, Separation};
 
@@ -141,7 +142,7 @@ impl TappingModel {
                 }
             })
             .collect();
-        let spacing_rotation = (drive.angular_frequency * spacing).sin_cos();
+        let spacing_rotation = phase::sin_cos(drive.angular_frequency * spacing);
         Ok(Self {
             hertz: HertzContact::new(&cantilever, &sample),
             cantilever,
@@ -314,7 +315,7 @@ impl HybridSystem for TappingModel {
     /// `q_i'' = w_i^2 [(F_i/k_i) cos(w t) + F_ts(d)/k_i - q_i] - (w_i/Q_i) q_i'`, with
     /// `F_ts = 0` in free flight and the Hertz force (finite on both sides) in contact.
     fn vector_field(&self, mode: Mode, t: f64, x: &[f64], dxdt: &mut [f64]) {
-        let drive = (self.drive.angular_frequency * t).cos();
+        let drive = phase::cos(self.drive.angular_frequency * t);
         let force = if Self::in_contact(mode) {
             self.hertz.force(self.gap(t, x))
         } else {
@@ -376,7 +377,7 @@ impl HybridSystem for TappingModel {
         jacobian: &mut DMatrix<f64>,
         dfdp: Option<&mut [f64]>,
     ) {
-        let drive = (self.drive.angular_frequency * t).cos();
+        let drive = phase::cos(self.drive.angular_frequency * t);
         let (force, slope) = if Self::in_contact(mode) {
             let indentation = (-self.gap(t, x)).max(0.0);
             let root = indentation.sqrt();
@@ -482,7 +483,7 @@ impl HybridSystem for TappingModel {
             return None;
         }
         let w = self.drive.angular_frequency;
-        let (sin, cos) = (w * t0).sin_cos();
+        let (sin, cos) = phase::sin_cos(w * t0);
         let bound = self
             .modes
             .iter()
@@ -519,11 +520,11 @@ impl HybridSystem for TappingModel {
         let spacing = dt / count as f64;
         let w = self.drive.angular_frequency;
         let standard = dt == self.exact_step_limit && count == STANDARD_GRID;
-        let (sin0, cos0) = (w * t0).sin_cos();
+        let (sin0, cos0) = phase::sin_cos(w * t0);
         let (sin_step, cos_step) = if standard {
             self.spacing_rotation
         } else {
-            (w * spacing).sin_cos()
+            phase::sin_cos(w * spacing)
         };
         for (i, m) in self.modes.iter().enumerate() {
             let phi = if standard {
@@ -565,8 +566,8 @@ impl HybridSystem for TappingModel {
         if let Some(matrix) = transition.as_deref_mut() {
             matrix.fill(0.0);
         }
-        let start_phase = (self.drive.angular_frequency * t0).sin_cos();
-        let end_phase = (self.drive.angular_frequency * (t0 + dt)).sin_cos();
+        let start_phase = phase::sin_cos(self.drive.angular_frequency * t0);
+        let end_phase = phase::sin_cos(self.drive.angular_frequency * (t0 + dt));
         let standard = dt == self.exact_step_limit;
         for (i, m) in self.modes.iter().enumerate() {
             let phi = if standard {
@@ -661,7 +662,11 @@ mod tests {
             let mut grid = vec![0.0; STANDARD_GRID * n];
             model.exact_flow_grid(FREE_FLIGHT, t0, &x0, dt, STANDARD_GRID, &mut grid);
             let w = model.drive.angular_frequency;
-            assert_eq!(model.spacing_rotation, (w * spacing).sin_cos(), "{name}");
+            assert_eq!(
+                model.spacing_rotation,
+                phase::sin_cos(w * spacing),
+                "{name}"
+            );
             for (i, m) in model.modes.iter().enumerate() {
                 assert_eq!(m.step_transition, m.oscillator.homogeneous_transition(dt));
                 assert_eq!(
