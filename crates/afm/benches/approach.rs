@@ -6,7 +6,7 @@
 //!
 //! Run with `cargo bench -p afm --bench approach` (release build, one core). Pass `--quick`
 //! after `--` to sweep only 11 nm -> 8 nm, `--samples N` to change the solver's samples per
-//! step (default 8), `--tolerance X` for the contact integration's tolerance (default
+//! step (default `afm::sweep::SAMPLES_PER_STEP`), `--tolerance X` for the contact integration's tolerance (default
 //! `afm::sweep::DEFAULT_TOLERANCE`), `--all-extrema` to search every free-flight step for extrema
 //! (`extremum_height` infinite, as before the sweep skipped steps proven clear of the sample).
 

@@ -46,6 +46,15 @@ pub const DEFAULT_START_MARGIN_NM: f64 = 0.2;
 /// readings differ from a run at 1e-13 by ~1e-8 in `A/A0` (see the tests).
 pub const DEFAULT_TOLERANCE: f64 = 1e-8;
 
+/// The solver's interior samples per step in a sweep (its default is 8). What is left to
+/// sample are contact steps (a few per cent of the ~0.6 us contact of the paper's cantilevers,
+/// with one gap minimum per contact) and free flight near the sample (exact steps of a quarter
+/// of the second mode's period, whose gap extrema are half a period apart): four points per
+/// step resolve both with room to spare, and the test against a brute-force sweep with 64
+/// samples per step finds the same impacts in every cycle. It saves 8% of the instructions of
+/// the quick approach benchmark (callgrind, `--samples 4` against 8).
+pub const SAMPLES_PER_STEP: usize = 4;
+
 /// Which way the separation moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -127,8 +136,9 @@ pub struct SweepSettings {
     /// Settings of the hybrid solver. Default: `hybrid::Settings::default()` with relative and
     /// absolute tolerances [`DEFAULT_TOLERANCE`] (the lock-in's targets, 1e-3 in `A/A0` and 0.1
     /// deg, are six orders above the error this leaves; the free flight is exact regardless),
-    /// and `extremum_height` 0: the lock-in reads gap minima only in contact, so free flight
-    /// that the model proves clear of the sample is not searched for extrema.
+    /// `extremum_height` 0 (the lock-in reads gap minima only in contact, so free flight that
+    /// the model proves clear of the sample is not searched for extrema) and
+    /// [`SAMPLES_PER_STEP`] samples per step.
     pub integration: Settings,
 }
 
@@ -150,6 +160,7 @@ impl SweepSettings {
                 // The lock-in reads only gap minima in contact, which are always sampled: free
                 // flight proven clear of the sample is not searched for extrema.
                 extremum_height: 0.0,
+                samples_per_step: SAMPLES_PER_STEP,
                 ..Settings::default()
             },
         }

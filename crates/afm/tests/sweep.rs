@@ -124,9 +124,9 @@ fn retract_mirrors_the_approach() {
     }
 }
 
-/// The sweep at its default settings (tolerance 1e-8, 8 samples per step, free flight proven
+/// The sweep at its default settings (tolerance 1e-8, 4 samples per step, free flight proven
 /// clear of the sample left unsampled) against a brute-force run of the same sweep (tolerance
-/// 1e-13, 64 samples in every step, extrema and events searched 8 times more finely): the
+/// 1e-13, 64 samples in every step, extrema and events searched 16 times more finely): the
 /// same impacts in every cycle (none missed), and readings
 /// that agree far inside the lock-in's targets (1e-3, 0.1 deg). Windows with two and three
 /// impacts per cycle, away from the grazing points.
