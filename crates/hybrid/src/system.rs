@@ -170,7 +170,11 @@ pub trait HybridSystem {
     ///
     /// The flow has no truncation error; the bound exists so that the extrema of every
     /// switching function can be found by sampling inside each step. It should be a fraction
-    /// (at most a quarter) of the shortest oscillation period present in that mode.
+    /// (at most a quarter) of the shortest oscillation period present in that mode. Where the
+    /// solver may skip extrema (finite [`crate::Settings::extremum_height`]) and the system
+    /// bounds the switching functions' curvature
+    /// ([`HybridSystem::switching_curvature_bound`]), steps proven clear of every surface
+    /// are stretched beyond it.
     fn exact_step_limit(&self, mode: Mode) -> f64 {
         let _ = mode;
         f64::INFINITY
