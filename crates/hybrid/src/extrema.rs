@@ -94,15 +94,29 @@ impl Samples {
                 }
                 _ => state_at(t, x),
             }
-            for k in 0..self.surfaces {
-                let value = system.switching(k, t, x);
-                let rate = system.switching_rate(k, mode, t, x);
-                if !value.is_finite() || !rate.is_finite() {
-                    return Err(HybridError::NonFiniteSwitching { t, surface: k });
-                }
-                self.values[k * p + i] = value;
-                self.rates[k * p + i] = rate;
+            self.record(system, mode, i, t, x)?;
+        }
+        Ok(())
+    }
+
+    /// Record `h_k` and `dh_k/dt` of every surface at sample point `i` (time `t`, state `x`).
+    fn record<S: HybridSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        mode: Mode,
+        i: usize,
+        t: f64,
+        x: &[f64],
+    ) -> Result<(), HybridError> {
+        let p = self.points;
+        for k in 0..self.surfaces {
+            let value = system.switching(k, t, x);
+            let rate = system.switching_rate(k, mode, t, x);
+            if !value.is_finite() || !rate.is_finite() {
+                return Err(HybridError::NonFiniteSwitching { t, surface: k });
             }
+            self.values[k * p + i] = value;
+            self.rates[k * p + i] = rate;
         }
         Ok(())
     }
@@ -136,15 +150,7 @@ impl Samples {
             &[(0, t0, x0), (p - 1, t1, x1)]
         };
         for &(i, t, x) in ends {
-            for k in 0..self.surfaces {
-                let value = system.switching(k, t, x);
-                let rate = system.switching_rate(k, mode, t, x);
-                if !value.is_finite() || !rate.is_finite() {
-                    return Err(HybridError::NonFiniteSwitching { t, surface: k });
-                }
-                self.values[k * p + i] = value;
-                self.rates[k * p + i] = rate;
-            }
+            self.record(system, mode, i, t, x)?;
         }
         for k in 0..self.surfaces {
             for i in 1..p - 1 {
