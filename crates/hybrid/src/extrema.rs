@@ -100,6 +100,7 @@ impl Samples {
     }
 
     /// Record `h_k` and `dh_k/dt` of every surface at sample point `i` (time `t`, state `x`).
+    #[inline]
     fn record<S: HybridSystem + ?Sized>(
         &mut self,
         system: &S,
