@@ -173,7 +173,7 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     step_end: f64,
     full_dense: bool,
     /// Whether the last step was proven clear of every surface before it was taken (an exact
-    /// step stretched by [`Solver::clear_exact_span`]).
+    /// step inside the span of [`Solver::clear_exact_span`], stretched or not).
     proven_clear: bool,
     samples: Samples,
     extrema: Vec<Extremum>,
@@ -638,19 +638,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let t0 = self.t;
         let remaining = t_end - t0;
         let longest = remaining.min(self.settings.max_step);
-        let span = if limit < longest {
-            self.clear_exact_span(mode, t0, longest)
-                .filter(|&span| span > limit)
-        } else {
-            None
-        };
-        self.proven_clear = span.is_some();
-        let step = span.unwrap_or(limit);
+        let span = self.clear_exact_span(mode, t0, longest);
+        let step = span.filter(|&span| span > limit).unwrap_or(limit);
         let (dt, t1) = if step >= remaining {
             (remaining, t_end)
         } else {
             (step, t0 + step)
         };
+        // A step inside the span is clear before it is taken: no second look at its ends.
+        self.proven_clear = span.is_some_and(|span| span >= dt);
         self.exact_advance(mode, t0, dt);
         if self.z_new.iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t1 });
