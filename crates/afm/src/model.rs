@@ -256,6 +256,52 @@ impl TappingModel {
         Ok(())
     }
 
+    /// Eq. 1's field given the drive factor `cos(w t)` and the Hertz force `F_ts` (nN):
+    /// `q_i' = v_i`, `q_i'' = (w_i^2/k_i) (F_i cos(w t) + F_ts) - w_i^2 q_i - (w_i/Q_i) v_i`
+    /// (nm/us, nm/us^2), written into `dxdt`.
+    #[inline]
+    fn modal_field(&self, drive: f64, force: f64, x: &[f64], dxdt: &mut [f64]) {
+        for (i, m) in self.modes.iter().enumerate() {
+            let q = x[2 * i];
+            let v = x[2 * i + 1];
+            dxdt[2 * i] = v;
+            dxdt[2 * i + 1] = m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
+                - m.omega_squared * q
+                - m.damping * v;
+        }
+    }
+
+    /// The field's Jacobian `df/dx` given the Hertz force's slope `F_ts'(d)` (nN/nm; 0 in free
+    /// flight), into the column-major `2N x 2N` `matrix` (entry `(r, c)` at `r + 2N c`).
+    #[inline]
+    fn modal_jacobian(&self, slope: f64, matrix: &mut [f64]) {
+        let n = 2 * self.modes.len();
+        matrix.fill(0.0);
+        for (i, m) in self.modes.iter().enumerate() {
+            matrix[2 * i + n * (2 * i + 1)] = 1.0;
+            matrix[2 * i + 1 + n * (2 * i)] = -m.omega_squared;
+            matrix[2 * i + 1 + n * (2 * i + 1)] = -m.damping;
+            if slope != 0.0 {
+                let coupling = m.omega_squared_over_stiffness * slope;
+                for j in 0..self.modes.len() {
+                    matrix[2 * i + 1 + n * (2 * j)] += coupling;
+                }
+            }
+        }
+    }
+
+    /// The field's derivative with respect to the separation, `df/dZ = (w_i^2/k_i) F_ts'(d)`
+    /// on every acceleration component, given the slope `F_ts'(d)` (nN/nm), into `dfdp`.
+    #[inline]
+    fn separation_derivative(&self, slope: f64, dfdp: &mut [f64]) {
+        dfdp.fill(0.0);
+        if slope != 0.0 {
+            for (i, m) in self.modes.iter().enumerate() {
+                dfdp[2 * i + 1] = m.omega_squared_over_stiffness * slope;
+            }
+        }
+    }
+
     /// The tip-sample gap `d = Z(t) + sum_i q_i`, nm.
     #[inline]
     pub fn gap(&self, t: f64, x: &[f64]) -> f64 {
@@ -321,48 +367,29 @@ impl HybridSystem for TappingModel {
         } else {
             0.0
         };
-        for (i, m) in self.modes.iter().enumerate() {
-            let q = x[2 * i];
-            let v = x[2 * i + 1];
-            dxdt[2 * i] = v;
-            dxdt[2 * i + 1] = m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
-                - m.omega_squared * q
-                - m.damping * v;
-        }
+        self.modal_field(drive, force, x, dxdt);
     }
 
     /// `df/dx`: the modal blocks `[[0, 1], [-w_i^2, -w_i/Q_i]]`, plus in contact
     /// `d q_i'' / d q_j = (w_i^2 / k_i) F_ts'(d)` for every `i, j`.
     fn jacobian(&self, mode: Mode, t: f64, x: &[f64], jacobian: &mut DMatrix<f64>) {
-        jacobian.fill(0.0);
         let slope = if Self::in_contact(mode) {
             self.hertz.force_derivative(self.gap(t, x))
         } else {
             0.0
         };
-        for (i, m) in self.modes.iter().enumerate() {
-            jacobian[(2 * i, 2 * i + 1)] = 1.0;
-            jacobian[(2 * i + 1, 2 * i)] = -m.omega_squared;
-            jacobian[(2 * i + 1, 2 * i + 1)] = -m.damping;
-            if slope != 0.0 {
-                let coupling = m.omega_squared_over_stiffness * slope;
-                for j in 0..self.modes.len() {
-                    jacobian[(2 * i + 1, 2 * j)] += coupling;
-                }
-            }
-        }
+        self.modal_jacobian(slope, jacobian.as_mut_slice());
     }
 
     /// `df/dZ`: `(w_i^2 / k_i) F_ts'(d)` on every acceleration component in contact, 0 in
     /// free flight.
     fn parameter_derivative(&self, mode: Mode, t: f64, x: &[f64], dfdp: &mut [f64]) {
-        dfdp.fill(0.0);
-        if Self::in_contact(mode) {
-            let slope = self.hertz.force_derivative(self.gap(t, x));
-            for (i, m) in self.modes.iter().enumerate() {
-                dfdp[2 * i + 1] = m.omega_squared_over_stiffness * slope;
-            }
-        }
+        let slope = if Self::in_contact(mode) {
+            self.hertz.force_derivative(self.gap(t, x))
+        } else {
+            0.0
+        };
+        self.separation_derivative(slope, dfdp);
     }
 
     /// The field, Jacobian and `df/dZ` above from one evaluation of the gap, the drive and
@@ -386,34 +413,10 @@ impl HybridSystem for TappingModel {
         } else {
             (0.0, 0.0)
         };
-        let n = 2 * self.modes.len();
-        let matrix = jacobian.as_mut_slice();
-        matrix.fill(0.0);
-        for (i, m) in self.modes.iter().enumerate() {
-            let q = x[2 * i];
-            let v = x[2 * i + 1];
-            dxdt[2 * i] = v;
-            dxdt[2 * i + 1] = m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
-                - m.omega_squared * q
-                - m.damping * v;
-            // Column-major: entry (r, c) at r + n c.
-            matrix[2 * i + n * (2 * i + 1)] = 1.0;
-            matrix[2 * i + 1 + n * (2 * i)] = -m.omega_squared;
-            matrix[2 * i + 1 + n * (2 * i + 1)] = -m.damping;
-            if slope != 0.0 {
-                let coupling = m.omega_squared_over_stiffness * slope;
-                for j in 0..self.modes.len() {
-                    matrix[2 * i + 1 + n * (2 * j)] += coupling;
-                }
-            }
-        }
+        self.modal_field(drive, force, x, dxdt);
+        self.modal_jacobian(slope, jacobian.as_mut_slice());
         if let Some(dfdp) = dfdp {
-            dfdp.fill(0.0);
-            if slope != 0.0 {
-                for (i, m) in self.modes.iter().enumerate() {
-                    dfdp[2 * i + 1] = m.omega_squared_over_stiffness * slope;
-                }
-            }
+            self.separation_derivative(slope, dfdp);
         }
     }
 
