@@ -8,7 +8,7 @@
 //! settles on none within the budget is reported as not converged, never dressed up as one.
 
 use continuation::{
-    floquet_multipliers, is_stable, shoot, ContinuationError, HybridPeriodicProblem,
+    floquet_multipliers, is_stable, newton_update, shoot, ContinuationError, HybridPeriodicProblem,
     NewtonSettings, Parametrised,
 };
 use hybrid::{flow_map, Sensitivity, Settings};
@@ -395,18 +395,7 @@ fn shoot_observed(
                 observables,
             });
         }
-        let mut jacobian = monodromy.clone();
-        for i in 0..n {
-            jacobian[(i, i)] -= 1.0;
-        }
-        let update =
-            jacobian
-                .lu()
-                .solve(&residual_vector)
-                .ok_or(ContinuationError::SingularMatrix {
-                    what: "shooting Jacobian M - I",
-                    parameter: model.parameter(),
-                })?;
+        let update = newton_update(&monodromy, &residual_vector, model.parameter())?;
         let candidate: Vec<f64> = x.iter().zip(update.iter()).map(|(x, u)| x - u).collect();
         iterations += 1;
         if !candidate.iter().all(|v| v.is_finite()) {

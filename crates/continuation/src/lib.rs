@@ -68,6 +68,6 @@ pub use floquet::{floquet_multipliers, is_stable, spectral_radius};
 pub use hybrid_problem::{HybridPeriodicProblem, Parametrised};
 pub use problem::{OrbitStructure, PeriodMap, PeriodicProblem};
 pub use settings::{ContinuationSettings, ParameterDirection};
-pub use shooting::{shoot, NewtonSettings, ShootingResult};
+pub use shooting::{newton_update, shoot, NewtonSettings, ShootingResult};
 pub use special_point::{SpecialPoint, SpecialPointKind};
 pub use test_function::{neimark_sacker_test, period_doubling_test, TestValues};

@@ -1,7 +1,7 @@
 //! Single shooting: Newton's method on `P(x; p) - x = 0` at fixed `p`, with the exact
 //! monodromy `dP/dx` as Jacobian (quadratic convergence).
 
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 use crate::error::ContinuationError;
 use crate::problem::{check_period_map, PeriodMap, PeriodicProblem};
@@ -109,6 +109,29 @@ pub fn shoot<P: PeriodicProblem + ?Sized>(
     newton_continue(problem, x, map, p, 0, settings)
 }
 
+/// The Newton update of shooting, `(M - I)^{-1} F`, for the monodromy `M` and the residual
+/// `F = P(x; p) - x` (state units) at parameter `p`: the next iterate is `x` minus it.
+///
+/// # Errors
+/// [`ContinuationError::SingularMatrix`] if `M - I` is singular (a multiplier equal to 1).
+pub fn newton_update(
+    monodromy: &DMatrix<f64>,
+    residual: &DVector<f64>,
+    p: f64,
+) -> Result<DVector<f64>, ContinuationError> {
+    let mut jacobian = monodromy.clone();
+    for i in 0..jacobian.nrows().min(jacobian.ncols()) {
+        jacobian[(i, i)] -= 1.0;
+    }
+    jacobian
+        .lu()
+        .solve(residual)
+        .ok_or(ContinuationError::SingularMatrix {
+            what: "shooting Jacobian M - I",
+            parameter: p,
+        })
+}
+
 /// Newton iterations from an iterate whose period map is already evaluated.
 fn newton_continue<P: PeriodicProblem + ?Sized>(
     problem: &P,
@@ -131,19 +154,7 @@ fn newton_continue<P: PeriodicProblem + ?Sized>(
                 period_map: map,
             });
         }
-        let mut jacobian = map.monodromy.clone();
-        for i in 0..n {
-            jacobian[(i, i)] -= 1.0;
-        }
-        let update =
-            jacobian
-                .lu()
-                .solve(&residual_vector)
-                .ok_or(ContinuationError::SingularMatrix {
-                    what: "shooting Jacobian M - I",
-                    parameter: p,
-                })?;
-        let candidate = &x - update;
+        let candidate = &x - newton_update(&map.monodromy, &residual_vector, p)?;
         iterations += 1;
         if !candidate.iter().all(|v| v.is_finite()) {
             return Err(ContinuationError::NonFinite {
