@@ -22,7 +22,7 @@
 //! `every`-th record is returned. A block never spans the turn from approach to retract: the
 //! unfinished block at the floor is discarded.
 
-use hybrid::{HybridSystem, Sensitivity, Settings, Solver, StepOutcome};
+use hybrid::{HybridSystem, Sensitivity, Settings, Solver, SolverWorkspace, StepOutcome};
 use serde::Serialize;
 
 use crate::lockin::{BlockAverage, BlockReading, CycleLockIn, CycleReading};
@@ -226,6 +226,9 @@ pub struct Sweep {
     /// `Z` at the end of the approach (the retract's start), nm.
     floor_nm: f64,
     state: Vec<f64>,
+    /// The solver's buffers between cycles (each cycle's solver takes them and gives them
+    /// back, so that cycles allocate nothing).
+    workspace: SolverWorkspace,
     lockin: CycleLockIn,
     average: BlockAverage,
     /// Cycles done since the start of the approach.
@@ -276,6 +279,7 @@ impl Sweep {
         model.set_separation(Separation::Constant(settings.from_nm))?;
         Ok(Self {
             state: model.free_state(),
+            workspace: SolverWorkspace::default(),
             lockin: CycleLockIn::new(&model),
             average: BlockAverage::new(settings.lockin_cycles, model.free_amplitude_nm()),
             floor_nm: settings.from_nm - cycles_per_leg as f64 * z_step_nm,
@@ -423,12 +427,13 @@ impl Sweep {
     /// state, and return the lock-in's reading of it.
     fn run_cycle(&mut self, separation: Separation) -> Result<CycleReading, AfmError> {
         self.model.set_separation(separation)?;
-        let mut solver = Solver::new(
+        let mut solver = Solver::with_workspace(
             &self.model,
             0.0,
             &self.state,
             Sensitivity::None,
             self.settings.integration.clone(),
+            std::mem::take(&mut self.workspace),
         )?;
         self.lockin.begin(&self.model, &self.state);
         loop {
@@ -440,6 +445,7 @@ impl Sweep {
         }
         let reading = self.lockin.finish(&self.model, solver.state());
         self.state.copy_from_slice(solver.state());
+        self.workspace = solver.into_workspace();
         debug_assert_eq!(self.state.len(), self.model.dim());
         Ok(reading)
     }

@@ -33,6 +33,7 @@ pub mod settings;
 pub mod solver;
 pub mod system;
 mod tableau;
+pub mod workspace;
 
 pub use error::HybridError;
 pub use event::{Event, Extremum, ExtremumKind};
@@ -41,3 +42,4 @@ pub use sensitivity::Sensitivity;
 pub use settings::Settings;
 pub use solver::{Solver, Statistics, StepOutcome};
 pub use system::{Direction, HybridSystem, Mode, SwitchingPartials, MAX_SURFACES};
+pub use workspace::SolverWorkspace;

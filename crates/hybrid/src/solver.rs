@@ -94,6 +94,7 @@ use crate::saltation::Saltation;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
 use crate::system::{Direction, HybridSystem, Mode, MAX_SURFACES};
+use crate::workspace::{Buffers, SolverWorkspace};
 
 /// Why [`Solver::step`] returned.
 #[derive(Debug, Clone, PartialEq)]
@@ -207,14 +208,34 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         sensitivity: Sensitivity,
         settings: Settings,
     ) -> Result<Self, HybridError> {
+        Self::with_workspace(
+            system,
+            t0,
+            x0,
+            sensitivity,
+            settings,
+            SolverWorkspace::default(),
+        )
+    }
+
+    /// A solver like [`Solver::new`] that takes its buffers from `workspace` (released by
+    /// [`Solver::into_workspace`] of an earlier solver) instead of allocating them, if they fit
+    /// (the same state dimension, surface count, sensitivity, samples per step and sensitivity
+    /// tolerance; otherwise it allocates). The run is identical to one from a new solver.
+    ///
+    /// # Errors
+    /// As [`Solver::new`].
+    pub fn with_workspace(
+        system: &'a S,
+        t0: f64,
+        x0: &[f64],
+        sensitivity: Sensitivity,
+        settings: Settings,
+        workspace: SolverWorkspace,
+    ) -> Result<Self, HybridError> {
         settings.validate()?;
         let n = system.dim();
-        if x0.len() != n {
-            return Err(HybridError::DimensionMismatch {
-                expected: n,
-                found: x0.len(),
-            });
-        }
+        check_start(n, t0, x0)?;
         let surfaces = system.surface_count();
         if surfaces > MAX_SURFACES {
             return Err(HybridError::TooManySurfaces {
@@ -222,45 +243,69 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 max: MAX_SURFACES,
             });
         }
-        if !t0.is_finite() || x0.iter().any(|v| !v.is_finite()) {
-            return Err(HybridError::NonFiniteState { t: t0 });
-        }
-        let dim = sensitivity.augmented_dim(n);
-        let mut z = vec![0.0; dim];
-        z[..n].copy_from_slice(x0);
-        if sensitivity.transition() {
-            for i in 0..n {
-                z[n + i * n + i] = 1.0;
-            }
-        }
-        let samples = Samples::new(surfaces, settings.samples_per_step);
-        let extrema_capacity = surfaces * (samples.points() - 1);
-        Ok(Self {
+        let buffers = match workspace.buffers {
+            Some(buffers) if buffers.fits(n, surfaces, sensitivity, &settings) => buffers,
+            _ => Buffers::allocate(n, surfaces, sensitivity, &settings),
+        };
+        let Buffers {
+            z,
+            z_start,
+            z_new,
+            transition,
+            zero_parameter,
+            field,
+            rk,
+            x_ahead,
+            grid,
+            velocity,
+            samples,
+            extrema,
+            x,
+            x_after,
+            f_minus,
+            f_plus,
+            gradient,
+            mut reset_jacobian,
+            mut reset_dxdp,
+            identity,
+            saltation,
+            mut flow_transition,
+            mut flow_dxdp,
+            product,
+            ..
+        } = buffers;
+        // What a system's reset map or exact flow may only partly overwrite starts as it does
+        // in fresh buffers.
+        reset_jacobian.fill_with_identity();
+        flow_transition.fill_with_identity();
+        reset_dxdp.fill(0.0);
+        flow_dxdp.fill(0.0);
+        let mut solver = Self {
             system,
             sensitivity,
             n,
             surfaces,
-            dim,
+            dim: sensitivity.augmented_dim(n),
             t: t0,
-            mode: system.mode_of(t0, x0),
-            z_start: z.clone(),
-            z_new: z.clone(),
+            mode: 0,
+            z_start,
+            z_new,
             z,
-            transition: DMatrix::identity(n, n),
-            zero_parameter: vec![0.0; n],
-            field: VariationalField::new(n, sensitivity),
-            rk: Dop853::new(dim, n, settings.sensitivity_tolerance),
+            transition,
+            zero_parameter,
+            field,
+            rk,
             proposed_step: settings.initial_step,
             landing_limit: None,
             steps_in_mode: 0,
-            x_ahead: vec![0.0; n],
-            grid: vec![0.0; (settings.samples_per_step + 1) * n],
+            x_ahead,
+            grid,
             first_same_as_last: false,
             stage0_rate: 1.0,
             entered: None,
             clock: Clock::Time,
             sigma_start: t0,
-            velocity: vec![0.0; n],
+            velocity,
             kind: StepKind::None,
             step_mode: 0,
             step_start: t0,
@@ -268,22 +313,93 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             full_dense: false,
             proven_clear: false,
             samples,
-            extrema: Vec::with_capacity(extrema_capacity),
-            x: vec![0.0; n],
-            x_after: vec![0.0; n],
-            f_minus: vec![0.0; n],
-            f_plus: vec![0.0; n],
-            gradient: vec![0.0; n],
-            reset_jacobian: DMatrix::identity(n, n),
-            reset_dxdp: vec![0.0; n],
-            identity: DMatrix::identity(n, n),
-            saltation: Saltation::new(n),
-            flow_transition: DMatrix::identity(n, n),
-            flow_dxdp: vec![0.0; n],
-            product: DMatrix::zeros(n, n),
+            extrema,
+            x,
+            x_after,
+            f_minus,
+            f_plus,
+            gradient,
+            reset_jacobian,
+            reset_dxdp,
+            identity,
+            saltation,
+            flow_transition,
+            flow_dxdp,
+            product,
             statistics: Statistics::default(),
             settings,
-        })
+        };
+        solver.restart(t0, x0)?;
+        Ok(solver)
+    }
+
+    /// Release the solver's buffers for [`Solver::with_workspace`] (the next run of the same
+    /// shape then allocates nothing).
+    pub fn into_workspace(self) -> SolverWorkspace {
+        let Self {
+            n,
+            surfaces,
+            sensitivity,
+            settings,
+            z,
+            z_start,
+            z_new,
+            transition,
+            zero_parameter,
+            field,
+            rk,
+            x_ahead,
+            grid,
+            velocity,
+            samples,
+            extrema,
+            x,
+            x_after,
+            f_minus,
+            f_plus,
+            gradient,
+            reset_jacobian,
+            reset_dxdp,
+            identity,
+            saltation,
+            flow_transition,
+            flow_dxdp,
+            product,
+            ..
+        } = self;
+        SolverWorkspace {
+            buffers: Some(Buffers {
+                n,
+                surfaces,
+                sensitivity,
+                samples_per_step: settings.samples_per_step,
+                sensitivity_tolerance: settings.sensitivity_tolerance,
+                z,
+                z_start,
+                z_new,
+                transition,
+                zero_parameter,
+                field,
+                rk,
+                x_ahead,
+                grid,
+                velocity,
+                samples,
+                extrema,
+                x,
+                x_after,
+                f_minus,
+                f_plus,
+                gradient,
+                reset_jacobian,
+                reset_dxdp,
+                identity,
+                saltation,
+                flow_transition,
+                flow_dxdp,
+                product,
+            }),
+        }
     }
 
     /// Restart from `(t0, x0)` reusing every buffer (no allocation): the mode from
@@ -295,15 +411,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// [`HybridError::DimensionMismatch`], [`HybridError::NonFiniteState`].
     pub fn restart(&mut self, t0: f64, x0: &[f64]) -> Result<(), HybridError> {
         let n = self.n;
-        if x0.len() != n {
-            return Err(HybridError::DimensionMismatch {
-                expected: n,
-                found: x0.len(),
-            });
-        }
-        if !t0.is_finite() || x0.iter().any(|v| !v.is_finite()) {
-            return Err(HybridError::NonFiniteState { t: t0 });
-        }
+        check_start(n, t0, x0)?;
         self.z.fill(0.0);
         self.z[..n].copy_from_slice(x0);
         if self.sensitivity.transition() {
@@ -1580,6 +1688,20 @@ fn first_positive_root(a: f64, b: f64, c: f64) -> Option<f64> {
             .min_by(f64::total_cmp)?
     };
     (root > 0.0 && root.is_finite()).then_some(root)
+}
+
+/// A start `(t0, x0)` for a state of dimension `n`: the right length and finite.
+fn check_start(n: usize, t0: f64, x0: &[f64]) -> Result<(), HybridError> {
+    if x0.len() != n {
+        return Err(HybridError::DimensionMismatch {
+            expected: n,
+            found: x0.len(),
+        });
+    }
+    if !t0.is_finite() || x0.iter().any(|v| !v.is_finite()) {
+        return Err(HybridError::NonFiniteState { t: t0 });
+    }
+    Ok(())
 }
 
 /// The state at `t` in the current (not yet accepted) step: dense output or exact flow.

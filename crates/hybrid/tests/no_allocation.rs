@@ -44,8 +44,9 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 /// Allocations during the steps of a run, minus one per event (its `state` vector). The run
-/// is made twice, the second time after `Solver::restart` (which must not allocate either),
-/// and both runs must give the same final state and statistics.
+/// is made three times: after `Solver::restart`, and by a solver built by
+/// `Solver::with_workspace` on the buffers of the first (neither may allocate), and every run
+/// must give the same final state and statistics.
 fn allocations_beyond_events<S: HybridSystem>(system: &S, x0: &[f64], s: Sensitivity) -> usize {
     let mut solver = Solver::new(system, 0.0, x0, s, Settings::default()).expect("valid");
     let first = run_counting(&mut solver);
@@ -57,7 +58,16 @@ fn allocations_beyond_events<S: HybridSystem>(system: &S, x0: &[f64], s: Sensiti
     let second = run_counting(&mut solver);
     assert_eq!(solver.state(), &final_state[..]);
     assert_eq!(*solver.statistics(), statistics);
-    first + restart + second
+    // A new solver on the first one's buffers: no allocation, and the same run again.
+    let workspace = solver.into_workspace();
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let mut solver =
+        Solver::with_workspace(system, 0.0, x0, s, Settings::default(), workspace).expect("valid");
+    let reuse = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    let third = run_counting(&mut solver);
+    assert_eq!(solver.state(), &final_state[..]);
+    assert_eq!(*solver.statistics(), statistics);
+    first + restart + second + reuse + third
 }
 
 fn run_counting<S: HybridSystem>(solver: &mut Solver<S>) -> usize {
@@ -107,4 +117,36 @@ fn steps_do_not_allocate() {
             0
         );
     }
+}
+
+/// Buffers of another shape (here sized for sensitivities) are replaced, not misused: the run
+/// on them equals a run from `Solver::new`.
+#[test]
+fn a_workspace_of_another_shape_is_replaced() {
+    let system = HertzOscillator::reference();
+    let x0 = [0.0, 0.0];
+    let mut reference =
+        Solver::new(&system, 0.0, &x0, Sensitivity::None, Settings::default()).expect("valid");
+    run_counting(&mut reference);
+    let sized_for_sensitivities = Solver::new(
+        &system,
+        0.0,
+        &x0,
+        Sensitivity::TransitionAndParameter,
+        Settings::default(),
+    )
+    .expect("valid")
+    .into_workspace();
+    let mut solver = Solver::with_workspace(
+        &system,
+        0.0,
+        &x0,
+        Sensitivity::None,
+        Settings::default(),
+        sized_for_sensitivities,
+    )
+    .expect("valid");
+    run_counting(&mut solver);
+    assert_eq!(solver.state(), reference.state());
+    assert_eq!(solver.statistics(), reference.statistics());
 }

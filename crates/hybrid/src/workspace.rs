@@ -1,0 +1,139 @@
+//! The heap buffers of a [`crate::Solver`], kept from one run to the next.
+//!
+//! A time-domain sweep integrates one drive cycle at a time, each under its own separation law
+//! (a new system value), so it cannot keep one solver and [`crate::Solver::restart`] it: the
+//! solver borrows its system. Instead the spent solver hands its buffers back
+//! ([`crate::Solver::into_workspace`]) and the next one takes them
+//! ([`crate::Solver::with_workspace`]), so that after the first cycle no run allocates.
+
+use nalgebra::DMatrix;
+
+use crate::dop853::Dop853;
+use crate::event::Extremum;
+use crate::extrema::Samples;
+use crate::saltation::Saltation;
+use crate::sensitivity::{Sensitivity, VariationalField};
+use crate::settings::Settings;
+
+/// The buffers a [`crate::Solver`] allocates for a state of dimension `n`, a number of switching
+/// surfaces, a [`Sensitivity`] and the sampling and error-control settings that size them.
+/// Obtained from [`crate::Solver::into_workspace`] (or empty from [`SolverWorkspace::default`]);
+/// it holds no results, only storage.
+#[derive(Default)]
+pub struct SolverWorkspace {
+    pub(crate) buffers: Option<Buffers>,
+}
+
+/// A clone is an empty workspace: the buffers hold no results, so a copy of the storage would
+/// serve nothing that a fresh allocation by the next solver does not.
+impl Clone for SolverWorkspace {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl std::fmt::Debug for SolverWorkspace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.buffers {
+            Some(b) => write!(
+                f,
+                "SolverWorkspace {{ n: {}, surfaces: {}, sensitivity: {:?} }}",
+                b.n, b.surfaces, b.sensitivity
+            ),
+            None => write!(f, "SolverWorkspace {{ empty }}"),
+        }
+    }
+}
+
+/// The buffers themselves, with what sized them.
+pub(crate) struct Buffers {
+    pub n: usize,
+    pub surfaces: usize,
+    pub sensitivity: Sensitivity,
+    pub samples_per_step: usize,
+    pub sensitivity_tolerance: Option<f64>,
+    pub z: Vec<f64>,
+    pub z_start: Vec<f64>,
+    pub z_new: Vec<f64>,
+    pub transition: DMatrix<f64>,
+    pub zero_parameter: Vec<f64>,
+    pub field: VariationalField,
+    pub rk: Dop853,
+    pub x_ahead: Vec<f64>,
+    pub grid: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub samples: Samples,
+    pub extrema: Vec<Extremum>,
+    pub x: Vec<f64>,
+    pub x_after: Vec<f64>,
+    pub f_minus: Vec<f64>,
+    pub f_plus: Vec<f64>,
+    pub gradient: Vec<f64>,
+    pub reset_jacobian: DMatrix<f64>,
+    pub reset_dxdp: Vec<f64>,
+    pub identity: DMatrix<f64>,
+    pub saltation: Saltation,
+    pub flow_transition: DMatrix<f64>,
+    pub flow_dxdp: Vec<f64>,
+    pub product: DMatrix<f64>,
+}
+
+impl Buffers {
+    /// Fresh buffers for a state of dimension `n` with `surfaces` switching surfaces.
+    pub fn allocate(
+        n: usize,
+        surfaces: usize,
+        sensitivity: Sensitivity,
+        settings: &Settings,
+    ) -> Self {
+        let dim = sensitivity.augmented_dim(n);
+        let samples = Samples::new(surfaces, settings.samples_per_step);
+        let extrema_capacity = surfaces * (samples.points() - 1);
+        Self {
+            n,
+            surfaces,
+            sensitivity,
+            samples_per_step: settings.samples_per_step,
+            sensitivity_tolerance: settings.sensitivity_tolerance,
+            z: vec![0.0; dim],
+            z_start: vec![0.0; dim],
+            z_new: vec![0.0; dim],
+            transition: DMatrix::identity(n, n),
+            zero_parameter: vec![0.0; n],
+            field: VariationalField::new(n, sensitivity),
+            rk: Dop853::new(dim, n, settings.sensitivity_tolerance),
+            x_ahead: vec![0.0; n],
+            grid: vec![0.0; (settings.samples_per_step + 1) * n],
+            velocity: vec![0.0; n],
+            samples,
+            extrema: Vec::with_capacity(extrema_capacity),
+            x: vec![0.0; n],
+            x_after: vec![0.0; n],
+            f_minus: vec![0.0; n],
+            f_plus: vec![0.0; n],
+            gradient: vec![0.0; n],
+            reset_jacobian: DMatrix::identity(n, n),
+            reset_dxdp: vec![0.0; n],
+            identity: DMatrix::identity(n, n),
+            saltation: Saltation::new(n),
+            flow_transition: DMatrix::identity(n, n),
+            flow_dxdp: vec![0.0; n],
+            product: DMatrix::zeros(n, n),
+        }
+    }
+
+    /// Whether these buffers serve a solver of this shape and these settings.
+    pub fn fits(
+        &self,
+        n: usize,
+        surfaces: usize,
+        sensitivity: Sensitivity,
+        settings: &Settings,
+    ) -> bool {
+        self.n == n
+            && self.surfaces == surfaces
+            && self.sensitivity == sensitivity
+            && self.samples_per_step == settings.samples_per_step
+            && self.sensitivity_tolerance == settings.sensitivity_tolerance
+    }
+}
