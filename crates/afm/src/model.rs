@@ -261,11 +261,15 @@ impl TappingModel {
     /// (nm/us, nm/us^2), written into `dxdt`.
     #[inline]
     fn modal_field(&self, drive: f64, force: f64, x: &[f64], dxdt: &mut [f64]) {
-        for (i, m) in self.modes.iter().enumerate() {
-            let q = x[2 * i];
-            let v = x[2 * i + 1];
-            dxdt[2 * i] = v;
-            dxdt[2 * i + 1] = m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
+        for ((m, state), rate) in self
+            .modes
+            .iter()
+            .zip(x.chunks_exact(2))
+            .zip(dxdt.chunks_exact_mut(2))
+        {
+            let (q, v) = (state[0], state[1]);
+            rate[0] = v;
+            rate[1] = m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
                 - m.omega_squared * q
                 - m.damping * v;
         }
@@ -305,13 +309,21 @@ impl TappingModel {
     /// The tip-sample gap `d = Z(t) + sum_i q_i`, nm.
     #[inline]
     pub fn gap(&self, t: f64, x: &[f64]) -> f64 {
-        self.separation.at(t) + (0..self.modes.len()).map(|i| x[2 * i]).sum::<f64>()
+        self.separation.at(t)
+            + x[..2 * self.modes.len()]
+                .chunks_exact(2)
+                .map(|mode| mode[0])
+                .sum::<f64>()
     }
 
     /// The gap's rate `d' = Z'(t) + sum_i q_i'`, nm/us.
     #[inline]
     pub fn gap_rate(&self, x: &[f64]) -> f64 {
-        self.separation.rate() + (0..self.modes.len()).map(|i| x[2 * i + 1]).sum::<f64>()
+        self.separation.rate()
+            + x[..2 * self.modes.len()]
+                .chunks_exact(2)
+                .map(|mode| mode[1])
+                .sum::<f64>()
     }
 
     /// The tip-sample force `F_ts(d)`, nN (repulsive positive).
@@ -325,8 +337,8 @@ impl TappingModel {
     pub fn photodiode(&self, x: &[f64]) -> f64 {
         self.modes
             .iter()
-            .enumerate()
-            .map(|(i, mode)| mode.optical_sensitivity * x[2 * i])
+            .zip(x.chunks_exact(2))
+            .map(|(mode, state)| mode.optical_sensitivity * state[0])
             .sum()
     }
 
