@@ -13,6 +13,9 @@ use crate::tableau::{A, BHH, C, D, E5, STAGES, STAGES_EXTENDED};
 /// An augmented right-hand side `rhs(t, z, dz)`.
 pub(crate) type Rhs<'a> = dyn FnMut(f64, &[f64], &mut [f64]) + 'a;
 
+/// Coefficients of the dense-output polynomial of one component (degree 7, value at 0 apart).
+const DENSE_COEFFICIENTS: usize = 7;
+
 /// Safety factor of the step-size controller (Hairer's `safe`).
 const SAFETY: f64 = 0.9;
 /// Smallest ratio new step / old step (Hairer's `fac1`).
@@ -39,7 +42,8 @@ pub(crate) struct Dop853 {
     argument: Vec<f64>,
     /// Scratch derivative written by the right-hand side.
     derivative: Vec<f64>,
-    /// Dense-output coefficients, 7 rows of length `dim`.
+    /// Dense-output coefficients, component-major: `dense[c * 7 + r]` is coefficient `r` of
+    /// component `c`.
     dense: Vec<f64>,
     /// Step size of the last attempted step.
     pub h: f64,
@@ -49,6 +53,43 @@ pub(crate) struct Dop853 {
 #[inline]
 fn dot(a: &[f64], k: &[f64]) -> f64 {
     a.iter().zip(k).map(|(a, k)| a * k).sum()
+}
+
+/// `sum_{j < N} a_j k_j`, summed in order of `j` as [`dot`] does, with the length known at
+/// compile time (unrolled, no bounds checks inside). `a` and `k` have at least `N` entries.
+#[inline(always)]
+fn dot_fixed<const N: usize>(a: &[f64], k: &[f64]) -> f64 {
+    let a: &[f64; N] = a[..N].try_into().expect("N weights");
+    let k: &[f64; N] = k[..N].try_into().expect("N stages");
+    let mut sum = -0.0;
+    for j in 0..N {
+        sum += a[j] * k[j];
+    }
+    sum
+}
+
+/// [`dot`] over the first `len` entries (the weights of a stage argument: `len` is the stage
+/// index, 1 to 15), dispatched to [`dot_fixed`].
+#[inline]
+fn dot_prefix(len: usize, a: &[f64], k: &[f64]) -> f64 {
+    match len {
+        1 => dot_fixed::<1>(a, k),
+        2 => dot_fixed::<2>(a, k),
+        3 => dot_fixed::<3>(a, k),
+        4 => dot_fixed::<4>(a, k),
+        5 => dot_fixed::<5>(a, k),
+        6 => dot_fixed::<6>(a, k),
+        7 => dot_fixed::<7>(a, k),
+        8 => dot_fixed::<8>(a, k),
+        9 => dot_fixed::<9>(a, k),
+        10 => dot_fixed::<10>(a, k),
+        11 => dot_fixed::<11>(a, k),
+        12 => dot_fixed::<12>(a, k),
+        13 => dot_fixed::<13>(a, k),
+        14 => dot_fixed::<14>(a, k),
+        15 => dot_fixed::<15>(a, k),
+        _ => dot(&a[..len], &k[..len]),
+    }
 }
 
 /// `out[c] += h sum_j w_j k_j[c]` over the non-zero weights, for every component `c` of `out`
@@ -78,12 +119,13 @@ fn combine(out: &mut [f64], z: &[f64], stages: &[f64], weights: &[f64], h: f64) 
         out.copy_from_slice(&z[..out.len()]);
         accumulate(out, stages, weights, h);
     } else {
+        let len = weights.len();
         for ((y, &zc), k) in out
             .iter_mut()
             .zip(z)
             .zip(stages.chunks_exact(STAGES_EXTENDED))
         {
-            *y = zc + h * dot(weights, k);
+            *y = zc + h * dot_prefix(len, weights, k);
         }
     }
 }
@@ -97,7 +139,7 @@ impl Dop853 {
             stages: vec![0.0; STAGES_EXTENDED * dim],
             argument: vec![0.0; dim],
             derivative: vec![0.0; dim],
-            dense: vec![0.0; 7 * dim],
+            dense: vec![0.0; DENSE_COEFFICIENTS * dim],
             h: 0.0,
         }
     }
@@ -202,9 +244,9 @@ impl Dop853 {
         let mut err3 = 0.0;
         for c in components {
             let scale = atol + rtol * z[c].abs().max(z_new[c].abs());
-            let k = &self.component(c)[..STAGES];
-            let e5 = dot(&E5, k);
-            let e3 = dot(b, k) - dot(&BHH, k);
+            let k = self.component(c);
+            let e5 = dot_fixed::<STAGES>(&E5, k);
+            let e3 = dot_fixed::<STAGES>(b, k) - dot_fixed::<STAGES>(&BHH, k);
             err5 += (e5 / scale) * (e5 / scale);
             err3 += (e3 / scale) * (e3 / scale);
         }
@@ -246,7 +288,6 @@ impl Dop853 {
         z_new: &[f64],
         m: usize,
     ) {
-        let dim = self.dim;
         let h = self.h;
         for i in 13..STAGES_EXTENDED {
             // The remaining components of the argument are left as they are: for m < dim the
@@ -254,16 +295,21 @@ impl Dop853 {
             self.stage_argument(i, z, h, m);
             self.evaluate_stage(rhs, i, t + C[i] * h, m);
         }
-        for c in 0..m {
-            let k = &self.stages[c * STAGES_EXTENDED..(c + 1) * STAGES_EXTENDED];
+        for ((c, k), coefficients) in self
+            .stages
+            .chunks_exact(STAGES_EXTENDED)
+            .enumerate()
+            .zip(self.dense.chunks_exact_mut(DENSE_COEFFICIENTS))
+            .take(m)
+        {
             let delta = z_new[c] - z[c];
             let f0 = k[0];
             let f1 = k[12];
-            self.dense[c] = delta;
-            self.dense[dim + c] = h * f0 - delta;
-            self.dense[2 * dim + c] = 2.0 * delta - h * (f1 + f0);
-            for (row, d) in D.iter().enumerate() {
-                self.dense[(3 + row) * dim + c] = h * dot(d, k);
+            coefficients[0] = delta;
+            coefficients[1] = h * f0 - delta;
+            coefficients[2] = 2.0 * delta - h * (f1 + f0);
+            for (coefficient, d) in coefficients[3..].iter_mut().zip(&D) {
+                *coefficient = h * dot_fixed::<STAGES_EXTENDED>(d, k);
             }
         }
     }
@@ -282,19 +328,21 @@ impl Dop853 {
     /// `0..out.len()`.
     pub fn extrapolate_from_end(&self, z1: &[f64], theta: f64, out: &mut [f64]) {
         for (c, o) in out.iter_mut().enumerate() {
-            // Row 0 of the coefficients is `d0 = z1 - z0`.
-            *o = z1[c] - self.dense[c] + self.dense_increment(c, theta);
+            // Coefficient 0 is `d0 = z1 - z0`.
+            *o = z1[c] - self.dense[c * DENSE_COEFFICIENTS] + self.dense_increment(c, theta);
         }
     }
 
     /// The dense-output polynomial of component `c` at `theta`, less its value at 0.
     #[inline]
     fn dense_increment(&self, c: usize, theta: f64) -> f64 {
-        let dim = self.dim;
-        let d = |r: usize| self.dense[r * dim + c];
+        let start = c * DENSE_COEFFICIENTS;
+        let d: &[f64; DENSE_COEFFICIENTS] = self.dense[start..start + DENSE_COEFFICIENTS]
+            .try_into()
+            .expect("7 coefficients per component");
         let s1 = 1.0 - theta;
-        let inner = d(4) + s1 * (d(5) + theta * d(6));
-        theta * (d(0) + s1 * (d(1) + theta * (d(2) + s1 * (d(3) + theta * inner))))
+        let inner = d[4] + s1 * (d[5] + theta * d[6]);
+        theta * (d[0] + s1 * (d[1] + theta * (d[2] + s1 * (d[3] + theta * inner))))
     }
 
     /// Hairer's starting step (`hinit`, order 8): balances `0.01 / max(|f'|, |f|)^(1/8)` against
