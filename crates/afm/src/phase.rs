@@ -21,6 +21,9 @@ const FRAC_PI_2_HIGH: f64 = 1.570_796_326_734_125_614_17e0;
 const FRAC_PI_2_LOW: f64 = 6.077_100_506_506_192_249_32e-11;
 /// Arguments up to this magnitude are reduced here (`|k| < 2^19`).
 const REDUCTION_LIMIT: f64 = 823_549.6;
+/// `1.5 * 2^52`: adding it to a number of magnitude below `2^51` rounds that number to an
+/// integer (ties to even); subtracting it again leaves the integer.
+const ROUNDING_SHIFT: f64 = 6_755_399_441_055_744.0;
 
 /// Kernel coefficients of `sin r = r + r^3 (S1 + r^2 S2 + ...)` on `[-pi/4, pi/4]`.
 const S1: f64 = -1.666_666_666_666_663_243_48e-1;
@@ -56,7 +59,10 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if x.is_nan() || x.abs() > REDUCTION_LIMIT {
         return x.sin_cos();
     }
-    let k = (x * std::f64::consts::FRAC_2_PI).round();
+    // The nearest integer to `x / (pi/2)` (ties to even), by adding and subtracting
+    // `1.5 * 2^52`: exact for quotients below 2^51, far above the reduction limit, and an
+    // addition where `f64::round` is a library call on the baseline x86-64 target.
+    let k = (x * std::f64::consts::FRAC_2_PI + ROUNDING_SHIFT) - ROUNDING_SHIFT;
     let r = (x - k * FRAC_PI_2_HIGH) - k * FRAC_PI_2_LOW;
     let (s, c) = kernel(r);
     match (k as i64).rem_euclid(4) {

@@ -68,27 +68,22 @@ fn dot_fixed<const N: usize>(a: &[f64], k: &[f64]) -> f64 {
     sum
 }
 
-/// [`dot`] over the first `len` entries (the weights of a stage argument: `len` is the stage
-/// index, 1 to 15), dispatched to [`dot_fixed`].
-#[inline]
-fn dot_prefix(len: usize, a: &[f64], k: &[f64]) -> f64 {
-    match len {
-        1 => dot_fixed::<1>(a, k),
-        2 => dot_fixed::<2>(a, k),
-        3 => dot_fixed::<3>(a, k),
-        4 => dot_fixed::<4>(a, k),
-        5 => dot_fixed::<5>(a, k),
-        6 => dot_fixed::<6>(a, k),
-        7 => dot_fixed::<7>(a, k),
-        8 => dot_fixed::<8>(a, k),
-        9 => dot_fixed::<9>(a, k),
-        10 => dot_fixed::<10>(a, k),
-        11 => dot_fixed::<11>(a, k),
-        12 => dot_fixed::<12>(a, k),
-        13 => dot_fixed::<13>(a, k),
-        14 => dot_fixed::<14>(a, k),
-        15 => dot_fixed::<15>(a, k),
-        _ => dot(&a[..len], &k[..len]),
+/// `out[c] = z[c] + h sum_{j < N} w_j k_j[c]` for every component `c` of `out`, one
+/// [`dot_fixed`] per component.
+#[inline(always)]
+fn combine_fixed<const N: usize>(
+    out: &mut [f64],
+    z: &[f64],
+    stages: &[f64],
+    weights: &[f64],
+    h: f64,
+) {
+    for ((y, &zc), k) in out
+        .iter_mut()
+        .zip(z)
+        .zip(stages.chunks_exact(STAGES_EXTENDED))
+    {
+        *y = zc + h * dot_fixed::<N>(weights, k);
     }
 }
 
@@ -119,13 +114,32 @@ fn combine(out: &mut [f64], z: &[f64], stages: &[f64], weights: &[f64], h: f64) 
         out.copy_from_slice(&z[..out.len()]);
         accumulate(out, stages, weights, h);
     } else {
-        let len = weights.len();
-        for ((y, &zc), k) in out
-            .iter_mut()
-            .zip(z)
-            .zip(stages.chunks_exact(STAGES_EXTENDED))
-        {
-            *y = zc + h * dot_prefix(len, weights, k);
+        // The number of weights is the stage index (1 to 15), or 12 for the solution.
+        match weights.len() {
+            1 => combine_fixed::<1>(out, z, stages, weights, h),
+            2 => combine_fixed::<2>(out, z, stages, weights, h),
+            3 => combine_fixed::<3>(out, z, stages, weights, h),
+            4 => combine_fixed::<4>(out, z, stages, weights, h),
+            5 => combine_fixed::<5>(out, z, stages, weights, h),
+            6 => combine_fixed::<6>(out, z, stages, weights, h),
+            7 => combine_fixed::<7>(out, z, stages, weights, h),
+            8 => combine_fixed::<8>(out, z, stages, weights, h),
+            9 => combine_fixed::<9>(out, z, stages, weights, h),
+            10 => combine_fixed::<10>(out, z, stages, weights, h),
+            11 => combine_fixed::<11>(out, z, stages, weights, h),
+            12 => combine_fixed::<12>(out, z, stages, weights, h),
+            13 => combine_fixed::<13>(out, z, stages, weights, h),
+            14 => combine_fixed::<14>(out, z, stages, weights, h),
+            15 => combine_fixed::<15>(out, z, stages, weights, h),
+            _ => {
+                for ((y, &zc), k) in out
+                    .iter_mut()
+                    .zip(z)
+                    .zip(stages.chunks_exact(STAGES_EXTENDED))
+                {
+                    *y = zc + h * dot(weights, k);
+                }
+            }
         }
     }
 }
