@@ -372,6 +372,7 @@ impl HybridSystem for TappingModel {
     /// Eq. 1 solved for the accelerations:
     /// `q_i'' = w_i^2 [(F_i/k_i) cos(w t) + F_ts(d)/k_i - q_i] - (w_i/Q_i) q_i'`, with
     /// `F_ts = 0` in free flight and the Hertz force (finite on both sides) in contact.
+    #[inline(always)]
     fn vector_field(&self, mode: Mode, t: f64, x: &[f64], dxdt: &mut [f64]) {
         let drive = phase::cos(self.drive.angular_frequency * t);
         let force = if Self::in_contact(mode) {

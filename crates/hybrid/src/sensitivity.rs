@@ -72,6 +72,7 @@ impl VariationalField {
 
     /// Evaluate `dz/dt` at `(t, z)` in `mode`; with `variational == false` only the state part
     /// `dz[..n]` is written.
+    #[inline(always)]
     pub fn eval<S: HybridSystem + ?Sized>(
         &mut self,
         system: &S,
