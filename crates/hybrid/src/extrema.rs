@@ -9,7 +9,7 @@
 
 use crate::error::HybridError;
 use crate::event::{Extremum, ExtremumKind};
-use crate::event_location::locate_sign_change;
+use crate::event_location::{extremum_guess, locate_sign_change};
 use crate::system::{HybridSystem, Mode};
 
 /// The state at time `t` inside the current step, written into the slice.
@@ -214,7 +214,21 @@ impl Samples {
                         state_at(t, x);
                         sign * system.switching_rate(k, mode, t, x)
                     };
-                    locate_sign_change(a, sign * ra, b, sign * rb, &mut g, time_tolerance, 0.0)
+                    let guess = extremum_guess(
+                        (a, self.values[k * p + i], ra),
+                        (b, self.values[k * p + i + 1], rb),
+                        sign,
+                    );
+                    locate_sign_change(
+                        a,
+                        sign * ra,
+                        b,
+                        sign * rb,
+                        &mut g,
+                        time_tolerance,
+                        0.0,
+                        guess,
+                    )
                 };
                 let t = bracket.far;
                 let value = if t == b {

@@ -88,7 +88,7 @@ use crate::clock::Clock;
 use crate::dop853::Dop853;
 use crate::error::HybridError;
 use crate::event::{Event, Extremum};
-use crate::event_location::{locate_sign_change, Bracket};
+use crate::event_location::{crossing_guess, locate_sign_change, Bracket};
 use crate::extrema::Samples;
 use crate::saltation::Saltation;
 use crate::sensitivity::{Sensitivity, VariationalField};
@@ -1160,7 +1160,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             return None;
         }
         let tolerance = self.settings.event_time_tolerance * t0.abs().max(t1.abs());
-        Some(locate_sign_change(t0, g0, t1, g1, &mut g, tolerance, 0.0).far)
+        Some(locate_sign_change(t0, g0, t1, g1, &mut g, tolerance, 0.0, None).far)
     }
 
     /// The time at which surface `k` is crossed inside the rejected trial on `clock` from
@@ -1209,8 +1209,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             before = (t, value);
         }
         let tolerance = self.settings.event_time_tolerance * t0.abs().max(t1.abs());
-        let bracket =
-            locate_sign_change(before.0, before.1, after.0, after.1, &mut g, tolerance, 0.0);
+        let bracket = locate_sign_change(
+            before.0, before.1, after.0, after.1, &mut g, tolerance, 0.0, None,
+        );
         Some(bracket.far)
     }
 
@@ -1251,31 +1252,40 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         for k in 0..self.surfaces {
             let side = side_sign(mode, k);
             // At the step start the side is the mode's, whatever the computed value.
-            let mut prev = (t0, (side * self.samples.values[k * p]).abs());
+            // Each point: time, g = side h_k, and h_k and its rate (for the first guess).
+            let h0 = self.samples.values[k * p];
+            let mut prev = (t0, (side * h0).abs(), h0, self.samples.rates[k * p]);
             let mut candidate = None;
             for i in 0..p - 1 {
                 let te = self.samples.extremum_time[k * (p - 1) + i];
                 if !te.is_nan() && te > prev.0 {
-                    let ge = side * self.samples.extremum_value[k * (p - 1) + i];
-                    if ge < 0.0 {
-                        candidate = Some((prev, (te, ge)));
+                    let he = self.samples.extremum_value[k * (p - 1) + i];
+                    let point = (te, side * he, he, 0.0);
+                    if point.1 < 0.0 {
+                        candidate = Some((prev, point));
                         break;
                     }
-                    prev = (te, ge);
+                    prev = point;
                 }
-                let tb = self.samples.times[i + 1];
-                let gb = side * self.samples.values[k * p + i + 1];
-                if gb < 0.0 {
-                    candidate = Some((prev, (tb, gb)));
+                let hb = self.samples.values[k * p + i + 1];
+                let point = (
+                    self.samples.times[i + 1],
+                    side * hb,
+                    hb,
+                    self.samples.rates[k * p + i + 1],
+                );
+                if point.1 < 0.0 {
+                    candidate = Some((prev, point));
                     break;
                 }
-                if tb > prev.0 {
-                    prev = (tb, gb);
+                if point.0 > prev.0 {
+                    prev = point;
                 }
             }
-            let Some(((a, ga), (b, gb))) = candidate else {
+            let Some(((a, ga, ha, ra), (b, gb, hb, rb))) = candidate else {
                 continue;
             };
+            let guess = crossing_guess((a, ha, ra), (b, hb, rb), side);
             if let Some((_, found)) = &best {
                 if a >= found.far {
                     continue;
@@ -1303,6 +1313,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 &mut g,
                 time_tolerance,
                 self.settings.event_value_tolerance,
+                guess,
             );
             let better = match &best {
                 None => true,
@@ -1607,7 +1618,7 @@ fn crossing_fraction<S: HybridSystem + ?Sized>(
                 + g1 * (-2.0 * s3 + 3.0 * s2)
                 + r1 * (s3 - s2)
         };
-        let bracket = locate_sign_change(0.0, g0, 1.0, g1, &mut hermite, 1e-9, 0.0);
+        let bracket = locate_sign_change(0.0, g0, 1.0, g1, &mut hermite, 1e-9, 0.0, None);
         let theta = bracket.far;
         if earliest.is_none_or(|(e, _)| theta < e) {
             earliest = Some((theta, k));
