@@ -321,7 +321,9 @@ mod tests {
         // Crossing of cos: g = cos (positive at 1, negative at 2), root pi/2.
         let guess = crossing_guess(end(1.5), end(1.6), 1.0);
         let root = std::f64::consts::FRAC_PI_2;
-        let cases: [(f64, f64, &dyn Fn(f64) -> f64, Option<RootGuess>, f64); 2] = [
+        /// Interval, function, guess and root.
+        type Case<'a> = (f64, f64, &'a dyn Fn(f64) -> f64, Option<RootGuess>, f64);
+        let cases: [Case; 2] = [
             (1.5, 1.6, &|t: f64| t.cos(), guess, root),
             // Minimum of cos at pi: g = -(rate) = sin t, positive before pi.
             (
@@ -343,7 +345,10 @@ mod tests {
                 assert!(bracket.near_value > 0.0 && bracket.far_value <= 0.0);
             }
             eprintln!("[{a}, {b}]: {plain_count} evaluations plain, {guided_count} guided");
-            assert!(guided_count <= plain_count, "{guided_count} > {plain_count}");
+            assert!(
+                guided_count <= plain_count,
+                "{guided_count} > {plain_count}"
+            );
             totals = (totals.0 + plain_count, totals.1 + guided_count);
         }
         // Measured: 5 -> 3 for the crossing, 4 -> 4 for the extremum.
