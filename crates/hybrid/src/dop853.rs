@@ -87,58 +87,36 @@ fn combine_fixed<const N: usize>(
     }
 }
 
-/// `out[c] += h sum_j w_j k_j[c]` over the non-zero weights, for every component `c` of `out`
-/// (stages stored component-major). The stage loop is outside so that the components
-/// accumulate independently (no chain of dependent additions per component).
-#[inline]
-fn accumulate(out: &mut [f64], stages: &[f64], weights: &[f64], h: f64) {
-    for (j, &w) in weights.iter().enumerate() {
-        if w != 0.0 {
-            let hw = h * w;
-            for (y, k) in out.iter_mut().zip(stages.chunks_exact(STAGES_EXTENDED)) {
-                *y += hw * k[j];
-            }
-        }
-    }
-}
-
-/// Components from which [`combine`] accumulates stage by stage rather than component by
-/// component (measured: the per-component dot products are faster for a handful of
-/// components, the stage-outer loop for the augmented systems of sensitivities).
-const WIDE: usize = 8;
-
-/// `out[c] = z[c] + h sum_j w_j k_j[c]` for every component `c` of `out`.
+/// `out[c] = z[c] + h sum_j w_j k_j[c]` for every component `c` of `out`: a fixed-length sum
+/// per component, dispatched once on the number of weights (measured faster than accumulating
+/// stage by stage even for the 24 components of a state with its sensitivities: 7% fewer
+/// instructions per steady orbit at `A/A0 = 0.95`, 8% at 0.5).
 #[inline]
 fn combine(out: &mut [f64], z: &[f64], stages: &[f64], weights: &[f64], h: f64) {
-    if out.len() >= WIDE {
-        out.copy_from_slice(&z[..out.len()]);
-        accumulate(out, stages, weights, h);
-    } else {
-        // The number of weights is the stage index (1 to 15), or 12 for the solution.
-        match weights.len() {
-            1 => combine_fixed::<1>(out, z, stages, weights, h),
-            2 => combine_fixed::<2>(out, z, stages, weights, h),
-            3 => combine_fixed::<3>(out, z, stages, weights, h),
-            4 => combine_fixed::<4>(out, z, stages, weights, h),
-            5 => combine_fixed::<5>(out, z, stages, weights, h),
-            6 => combine_fixed::<6>(out, z, stages, weights, h),
-            7 => combine_fixed::<7>(out, z, stages, weights, h),
-            8 => combine_fixed::<8>(out, z, stages, weights, h),
-            9 => combine_fixed::<9>(out, z, stages, weights, h),
-            10 => combine_fixed::<10>(out, z, stages, weights, h),
-            11 => combine_fixed::<11>(out, z, stages, weights, h),
-            12 => combine_fixed::<12>(out, z, stages, weights, h),
-            13 => combine_fixed::<13>(out, z, stages, weights, h),
-            14 => combine_fixed::<14>(out, z, stages, weights, h),
-            15 => combine_fixed::<15>(out, z, stages, weights, h),
-            _ => {
-                for ((y, &zc), k) in out
-                    .iter_mut()
-                    .zip(z)
-                    .zip(stages.chunks_exact(STAGES_EXTENDED))
-                {
-                    *y = zc + h * dot(weights, k);
-                }
+    // The number of weights is the stage index (1 to 15), or 12 for the solution.
+    match weights.len() {
+        1 => combine_fixed::<1>(out, z, stages, weights, h),
+        2 => combine_fixed::<2>(out, z, stages, weights, h),
+        3 => combine_fixed::<3>(out, z, stages, weights, h),
+        4 => combine_fixed::<4>(out, z, stages, weights, h),
+        5 => combine_fixed::<5>(out, z, stages, weights, h),
+        6 => combine_fixed::<6>(out, z, stages, weights, h),
+        7 => combine_fixed::<7>(out, z, stages, weights, h),
+        8 => combine_fixed::<8>(out, z, stages, weights, h),
+        9 => combine_fixed::<9>(out, z, stages, weights, h),
+        10 => combine_fixed::<10>(out, z, stages, weights, h),
+        11 => combine_fixed::<11>(out, z, stages, weights, h),
+        12 => combine_fixed::<12>(out, z, stages, weights, h),
+        13 => combine_fixed::<13>(out, z, stages, weights, h),
+        14 => combine_fixed::<14>(out, z, stages, weights, h),
+        15 => combine_fixed::<15>(out, z, stages, weights, h),
+        _ => {
+            for ((y, &zc), k) in out
+                .iter_mut()
+                .zip(z)
+                .zip(stages.chunks_exact(STAGES_EXTENDED))
+            {
+                *y = zc + h * dot(weights, k);
             }
         }
     }
