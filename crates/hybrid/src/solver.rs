@@ -89,8 +89,6 @@ use crate::dop853::Dop853;
 use crate::error::HybridError;
 use crate::event::{Event, Extremum};
 use crate::event_location::{crossing_guess, locate_sign_change, Bracket};
-use crate::extrema::Samples;
-use crate::saltation::Saltation;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
 use crate::system::{Direction, HybridSystem, Mode, MAX_SURFACES};
@@ -146,18 +144,13 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     dim: usize,
     t: f64,
     mode: Mode,
-    z: Vec<f64>,
-    z_start: Vec<f64>,
-    z_new: Vec<f64>,
-    transition: DMatrix<f64>,
-    zero_parameter: Vec<f64>,
-    field: VariationalField,
-    rk: Dop853,
+    /// Every heap buffer (the state and its sensitivities, the stepper's workspace, samples,
+    /// scratch vectors and matrices): handed from one solver to the next by
+    /// [`Solver::into_workspace`] and [`Solver::with_workspace`].
+    buffers: Buffers,
     proposed_step: Option<f64>,
     landing_limit: Option<f64>,
     steps_in_mode: usize,
-    x_ahead: Vec<f64>,
-    grid: Vec<f64>,
     first_same_as_last: bool,
     /// `dt/dsigma` with which stage 0 holds the derivative when `first_same_as_last`.
     stage0_rate: f64,
@@ -166,8 +159,6 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// The clock of the last Runge-Kutta step and its reading at the step start.
     clock: Clock,
     sigma_start: f64,
-    /// `f(t, x)` at the start of a step, in time units (for the crossing prediction).
-    velocity: Vec<f64>,
     kind: StepKind,
     step_mode: Mode,
     step_start: f64,
@@ -176,20 +167,6 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// Whether the last step was proven clear of every surface before it was taken (an exact
     /// step inside the span of [`Solver::clear_exact_span`], stretched or not).
     proven_clear: bool,
-    samples: Samples,
-    extrema: Vec<Extremum>,
-    x: Vec<f64>,
-    x_after: Vec<f64>,
-    f_minus: Vec<f64>,
-    f_plus: Vec<f64>,
-    gradient: Vec<f64>,
-    reset_jacobian: DMatrix<f64>,
-    reset_dxdp: Vec<f64>,
-    identity: DMatrix<f64>,
-    saltation: Saltation,
-    flow_transition: DMatrix<f64>,
-    flow_dxdp: Vec<f64>,
-    product: DMatrix<f64>,
     statistics: Statistics,
 }
 
@@ -243,43 +220,16 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 max: MAX_SURFACES,
             });
         }
-        let buffers = match workspace.buffers {
+        let mut buffers = match workspace.buffers {
             Some(buffers) if buffers.fits(n, surfaces, sensitivity, &settings) => buffers,
             _ => Buffers::allocate(n, surfaces, sensitivity, &settings),
         };
-        let Buffers {
-            z,
-            z_start,
-            z_new,
-            transition,
-            zero_parameter,
-            field,
-            rk,
-            x_ahead,
-            grid,
-            velocity,
-            samples,
-            extrema,
-            x,
-            x_after,
-            f_minus,
-            f_plus,
-            gradient,
-            mut reset_jacobian,
-            mut reset_dxdp,
-            identity,
-            saltation,
-            mut flow_transition,
-            mut flow_dxdp,
-            product,
-            ..
-        } = buffers;
         // What a system's reset map or exact flow may only partly overwrite starts as it does
         // in fresh buffers.
-        reset_jacobian.fill_with_identity();
-        flow_transition.fill_with_identity();
-        reset_dxdp.fill(0.0);
-        flow_dxdp.fill(0.0);
+        buffers.reset_jacobian.fill_with_identity();
+        buffers.flow_transition.fill_with_identity();
+        buffers.reset_dxdp.fill(0.0);
+        buffers.flow_dxdp.fill(0.0);
         let mut solver = Self {
             system,
             sensitivity,
@@ -288,44 +238,21 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             dim: sensitivity.augmented_dim(n),
             t: t0,
             mode: 0,
-            z_start,
-            z_new,
-            z,
-            transition,
-            zero_parameter,
-            field,
-            rk,
+            buffers,
             proposed_step: settings.initial_step,
             landing_limit: None,
             steps_in_mode: 0,
-            x_ahead,
-            grid,
             first_same_as_last: false,
             stage0_rate: 1.0,
             entered: None,
             clock: Clock::Time,
             sigma_start: t0,
-            velocity,
             kind: StepKind::None,
             step_mode: 0,
             step_start: t0,
             step_end: t0,
             full_dense: false,
             proven_clear: false,
-            samples,
-            extrema,
-            x,
-            x_after,
-            f_minus,
-            f_plus,
-            gradient,
-            reset_jacobian,
-            reset_dxdp,
-            identity,
-            saltation,
-            flow_transition,
-            flow_dxdp,
-            product,
             statistics: Statistics::default(),
             settings,
         };
@@ -336,69 +263,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// Release the solver's buffers for [`Solver::with_workspace`] (the next run of the same
     /// shape then allocates nothing).
     pub fn into_workspace(self) -> SolverWorkspace {
-        let Self {
-            n,
-            surfaces,
-            sensitivity,
-            settings,
-            z,
-            z_start,
-            z_new,
-            transition,
-            zero_parameter,
-            field,
-            rk,
-            x_ahead,
-            grid,
-            velocity,
-            samples,
-            extrema,
-            x,
-            x_after,
-            f_minus,
-            f_plus,
-            gradient,
-            reset_jacobian,
-            reset_dxdp,
-            identity,
-            saltation,
-            flow_transition,
-            flow_dxdp,
-            product,
-            ..
-        } = self;
         SolverWorkspace {
-            buffers: Some(Buffers {
-                n,
-                surfaces,
-                sensitivity,
-                samples_per_step: settings.samples_per_step,
-                sensitivity_tolerance: settings.sensitivity_tolerance,
-                z,
-                z_start,
-                z_new,
-                transition,
-                zero_parameter,
-                field,
-                rk,
-                x_ahead,
-                grid,
-                velocity,
-                samples,
-                extrema,
-                x,
-                x_after,
-                f_minus,
-                f_plus,
-                gradient,
-                reset_jacobian,
-                reset_dxdp,
-                identity,
-                saltation,
-                flow_transition,
-                flow_dxdp,
-                product,
-            }),
+            buffers: Some(self.buffers),
         }
     }
 
@@ -412,18 +278,18 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     pub fn restart(&mut self, t0: f64, x0: &[f64]) -> Result<(), HybridError> {
         let n = self.n;
         check_start(n, t0, x0)?;
-        self.z.fill(0.0);
-        self.z[..n].copy_from_slice(x0);
+        self.buffers.z.fill(0.0);
+        self.buffers.z[..n].copy_from_slice(x0);
         if self.sensitivity.transition() {
             for i in 0..n {
-                self.z[n + i * n + i] = 1.0;
+                self.buffers.z[n + i * n + i] = 1.0;
             }
         }
-        self.z_start.copy_from_slice(&self.z);
-        self.z_new.copy_from_slice(&self.z);
+        self.buffers.z_start.copy_from_slice(&self.buffers.z);
+        self.buffers.z_new.copy_from_slice(&self.buffers.z);
         self.t = t0;
         self.mode = self.system.mode_of(t0, x0);
-        self.transition.fill_with_identity();
+        self.buffers.transition.fill_with_identity();
         self.proposed_step = self.settings.initial_step;
         self.landing_limit = None;
         self.steps_in_mode = 0;
@@ -434,9 +300,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.step_start = t0;
         self.step_end = t0;
         self.full_dense = false;
-        self.samples.start_valid = false;
-        self.extrema.clear();
-        self.field.evaluations = 0;
+        self.buffers.samples.start_valid = false;
+        self.buffers.extrema.clear();
+        self.buffers.field.evaluations = 0;
         self.statistics = Statistics::default();
         Ok(())
     }
@@ -448,7 +314,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
 
     /// Current state `x(t)`.
     pub fn state(&self) -> &[f64] {
-        &self.z[..self.n]
+        &self.buffers.z[..self.n]
     }
 
     /// Current mode (bit `k` set when the state is on the negative side of surface `k`).
@@ -459,16 +325,16 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// The state-transition matrix `dx(t)/dx(t0)` through all events so far (saltation
     /// included); the identity if the transition is not tracked.
     pub fn transition(&self) -> &DMatrix<f64> {
-        &self.transition
+        &self.buffers.transition
     }
 
     /// The parameter sensitivity `dx(t)/dp` (for fixed `x(t0)`); zeros if not tracked.
     pub fn parameter_sensitivity(&self) -> &[f64] {
         if self.sensitivity.parameter() {
             let offset = self.n + self.n * self.n;
-            &self.z[offset..offset + self.n]
+            &self.buffers.z[offset..offset + self.n]
         } else {
-            &self.zero_parameter
+            &self.buffers.zero_parameter
         }
     }
 
@@ -484,17 +350,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let m = x.len().min(self.n);
         let x = &mut x[..m];
         match self.kind {
-            StepKind::None => x.copy_from_slice(&self.z[..m]),
+            StepKind::None => x.copy_from_slice(&self.buffers.z[..m]),
             StepKind::RungeKutta => {
-                let theta = (self.clock.sigma(t) - self.sigma_start) / self.rk.h;
-                self.rk.interpolate(&self.z_start, theta, x);
+                let theta = (self.clock.sigma(t) - self.sigma_start) / self.buffers.rk.h;
+                self.buffers.rk.interpolate(&self.buffers.z_start, theta, x);
             }
             StepKind::Exact => {
                 if m == self.n {
                     self.system.exact_flow(
                         self.step_mode,
                         self.step_start,
-                        &self.z_start[..self.n],
+                        &self.buffers.z_start[..self.n],
                         t - self.step_start,
                         x,
                         None,
@@ -505,7 +371,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     self.system.exact_flow(
                         self.step_mode,
                         self.step_start,
-                        &self.z_start[..self.n],
+                        &self.buffers.z_start[..self.n],
                         t - self.step_start,
                         &mut full,
                         None,
@@ -520,7 +386,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// Extrema of the switching functions found in the last step (up to its end or its event),
     /// sorted by time.
     pub fn step_extrema(&self) -> &[Extremum] {
-        &self.extrema
+        &self.buffers.extrema
     }
 
     /// Work counters since [`Solver::new`].
@@ -566,13 +432,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         if !t_end.is_finite() || t_end < self.t {
             return Err(HybridError::InvalidEndTime { t: self.t, t_end });
         }
-        self.extrema.clear();
+        self.buffers.extrema.clear();
         if t_end == self.t {
             return Ok(StepOutcome::EndTime);
         }
         let t0 = self.t;
         let mode = self.mode;
-        self.z_start.copy_from_slice(&self.z);
+        self.buffers.z_start.copy_from_slice(&self.buffers.z);
         self.proven_clear = false;
         let t1 = if self.system.has_exact_flow(mode) {
             self.exact_step(t_end)?
@@ -588,13 +454,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let time_tolerance =
             self.settings.event_time_tolerance * t0.abs().max(t1.abs()).max(t1 - t0);
         let clear = self.settings.extremum_height.is_finite() && {
-            self.samples.sample_ends(
+            self.buffers.samples.sample_ends(
                 self.system,
                 mode,
                 t0,
                 t1,
-                &self.z_start[..self.n],
-                &self.z_new[..self.n],
+                &self.buffers.z_start[..self.n],
+                &self.buffers.z_new[..self.n],
             )?;
             self.proven_clear || self.clear_of_surfaces(mode, t0, t1)
         };
@@ -602,9 +468,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let system = self.system;
             let n = self.n;
             let kind = self.kind;
-            let rk = &self.rk;
-            let z_start = &self.z_start;
-            let z_new = &self.z_new;
+            let rk = &self.buffers.rk;
+            let z_start = &self.buffers.z_start;
+            let z_new = &self.buffers.z_new;
             let clock = (self.clock, self.sigma_start);
             let mut state_at = |t: f64, out: &mut [f64]| {
                 state_in_step(
@@ -614,35 +480,50 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             // Exact steps: every interior state from one call (a linear flow reuses its
             // transition over one spacing).
             let grid = if kind == StepKind::Exact {
-                let count = self.samples.points() - 1;
-                system.exact_flow_grid(mode, t0, &z_start[..n], t1 - t0, count, &mut self.grid);
-                Some(&self.grid[..])
+                let count = self.buffers.samples.points() - 1;
+                system.exact_flow_grid(
+                    mode,
+                    t0,
+                    &z_start[..n],
+                    t1 - t0,
+                    count,
+                    &mut self.buffers.grid,
+                );
+                Some(&self.buffers.grid[..])
             } else {
                 None
             };
-            self.samples
-                .sample(system, mode, t0, t1, &mut state_at, grid, &mut self.x)?;
-            self.samples.locate_extrema(
+            self.buffers.samples.sample(
+                system,
+                mode,
+                t0,
+                t1,
+                &mut state_at,
+                grid,
+                &mut self.buffers.x,
+            )?;
+            self.buffers.samples.locate_extrema(
                 system,
                 mode,
                 &mut state_at,
-                &mut self.x,
+                &mut self.buffers.x,
                 time_tolerance,
-                &mut self.extrema,
+                &mut self.buffers.extrema,
             );
         }
         let crossing = self.earliest_crossing(mode, t0, t1, time_tolerance);
         match crossing {
             None => {
-                self.z.copy_from_slice(&self.z_new);
+                self.buffers.z.copy_from_slice(&self.buffers.z_new);
                 self.t = t1;
                 self.sync_transition();
-                self.samples.carry_over();
+                self.buffers.samples.carry_over();
                 if self.kind == StepKind::RungeKutta {
-                    self.rk.reuse_last_derivative();
+                    self.buffers.rk.reuse_last_derivative();
                     self.first_same_as_last = true;
                 }
-                self.extrema
+                self.buffers
+                    .extrema
                     .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
                 Ok(if t1 == t_end {
                     StepOutcome::EndTime
@@ -652,8 +533,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
             Some((k, bracket)) => {
                 let event = self.fire(k, bracket, time_tolerance)?;
-                self.extrema.retain(|e| e.t <= event.t);
-                self.extrema
+                self.buffers.extrema.retain(|e| e.t <= event.t);
+                self.buffers
+                    .extrema
                     .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
                 Ok(StepOutcome::Event(event))
             }
@@ -669,20 +551,20 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// no bound, or a surface is already within the height.
     fn clear_exact_span(&self, mode: Mode, t0: f64, longest: f64) -> Option<f64> {
         let height = self.settings.extremum_height;
-        if !height.is_finite() || !self.samples.start_valid {
+        if !height.is_finite() || !self.buffers.samples.start_valid {
             return None;
         }
-        let p = self.samples.points();
+        let p = self.buffers.samples.points();
         let mut span = longest;
         for k in 0..self.surfaces {
             let side = side_sign(mode, k);
-            let margin = side * self.samples.values[k * p] - height;
-            let rate = side * self.samples.rates[k * p];
+            let margin = side * self.buffers.samples.values[k * p] - height;
+            let rate = side * self.buffers.samples.rates[k * p];
             let bound = self.system.switching_curvature_bound(
                 k,
                 mode,
                 t0,
-                &self.z_start[..self.n],
+                &self.buffers.z_start[..self.n],
                 longest,
             )?;
             if !(margin > 0.0 && bound >= 0.0 && bound.is_finite() && rate.is_finite()) {
@@ -710,15 +592,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// bound on `|h''|` ([`HybridSystem::switching_curvature_bound`]), must exceed the height
     /// (and zero). `false` when the system gives no bound.
     fn clear_of_surfaces(&self, mode: Mode, t0: f64, t1: f64) -> bool {
-        let p = self.samples.points();
+        let p = self.buffers.samples.points();
         let dt = t1 - t0;
         let height = self.settings.extremum_height;
         (0..self.surfaces).all(|k| {
             let side = side_sign(mode, k);
-            let ends =
-                (side * self.samples.values[k * p]).min(side * self.samples.values[k * p + p - 1]);
+            let ends = (side * self.buffers.samples.values[k * p])
+                .min(side * self.buffers.samples.values[k * p + p - 1]);
             self.system
-                .switching_curvature_bound(k, mode, t0, &self.z_start[..self.n], dt)
+                .switching_curvature_bound(k, mode, t0, &self.buffers.z_start[..self.n], dt)
                 .is_some_and(|bound| {
                     let lowest = ends - bound * dt * dt / 8.0;
                     // False for a NaN bound: such a step is sampled in full.
@@ -756,7 +638,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         // A step inside the span is clear before it is taken: no second look at its ends.
         self.proven_clear = span.is_some_and(|span| span >= dt);
         self.exact_advance(mode, t0, dt);
-        if self.z_new.iter().any(|v| !v.is_finite()) {
+        if self.buffers.z_new.iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t1 });
         }
         self.kind = StepKind::Exact;
@@ -770,8 +652,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// `x = phi(dt, x0)`, `Phi_new = Phi_step Phi_old`, `s_new = Phi_step s_old + dxdp_step`.
     fn exact_advance(&mut self, mode: Mode, t0: f64, dt: f64) {
         let n = self.n;
-        let (x_start, _) = self.z_start.split_at(n);
-        let (x_new, rest) = self.z_new.split_at_mut(n);
+        let (x_start, _) = self.buffers.z_start.split_at(n);
+        let (x_new, rest) = self.buffers.z_new.split_at_mut(n);
         match self.sensitivity {
             Sensitivity::None => {
                 self.system
@@ -784,7 +666,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     x_start,
                     dt,
                     x_new,
-                    Some(&mut self.flow_transition),
+                    Some(&mut self.buffers.flow_transition),
                     None,
                 );
             }
@@ -795,25 +677,27 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     x_start,
                     dt,
                     x_new,
-                    Some(&mut self.flow_transition),
-                    Some(&mut self.flow_dxdp),
+                    Some(&mut self.buffers.flow_transition),
+                    Some(&mut self.buffers.flow_dxdp),
                 );
             }
         }
         if self.sensitivity.transition() {
             let nn = n * n;
             {
-                let phi_old = DMatrixView::from_slice(&self.z_start[n..n + nn], n, n);
-                self.product.gemm(1.0, &self.flow_transition, &phi_old, 0.0);
+                let phi_old = DMatrixView::from_slice(&self.buffers.z_start[n..n + nn], n, n);
+                self.buffers
+                    .product
+                    .gemm(1.0, &self.buffers.flow_transition, &phi_old, 0.0);
             }
-            rest[..nn].copy_from_slice(self.product.as_slice());
+            rest[..nn].copy_from_slice(self.buffers.product.as_slice());
             if self.sensitivity.parameter() {
-                let s_old = &self.z_start[n + nn..n + nn + n];
+                let s_old = &self.buffers.z_start[n + nn..n + nn + n];
                 let s_new = &mut rest[nn..nn + n];
                 for (i, out) in s_new.iter_mut().enumerate() {
-                    let mut v = self.flow_dxdp[i];
+                    let mut v = self.buffers.flow_dxdp[i];
                     for (j, &sj) in s_old.iter().enumerate() {
-                        v += self.flow_transition[(i, j)] * sj;
+                        v += self.buffers.flow_transition[(i, j)] * sj;
                     }
                     *out = v;
                 }
@@ -842,14 +726,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let rate = match self.first_same_as_last.then_some(self.stage0_rate) {
             Some(rate) if rate != 0.0 => rate,
             _ => {
-                let mut rhs = clocked_field(&mut self.field, system, mode, Clock::Time, true);
-                self.rk.evaluate_first_stage(&mut rhs, t0, &self.z);
+                let mut rhs =
+                    clocked_field(&mut self.buffers.field, system, mode, Clock::Time, true);
+                self.buffers
+                    .rk
+                    .evaluate_first_stage(&mut rhs, t0, &self.buffers.z);
                 1.0
             }
         };
         let mut stage0 = Some(rate);
-        self.rk.first_stage(&mut self.velocity);
-        for v in &mut self.velocity {
+        self.buffers.rk.first_stage(&mut self.buffers.velocity);
+        for v in &mut self.buffers.velocity {
             *v /= rate;
         }
         // Without a proposed step (the first step of a solver, whose stage 0 was just
@@ -857,9 +744,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let mut h = match self.proposed_step {
             Some(h) => h,
             None => {
-                let mut rhs = clocked_field(&mut self.field, system, mode, Clock::Time, true);
-                self.rk
-                    .initial_step(&mut rhs, t0, &self.z, rtol, atol, max_step)
+                let mut rhs =
+                    clocked_field(&mut self.buffers.field, system, mode, Clock::Time, true);
+                self.buffers
+                    .rk
+                    .initial_step(&mut rhs, t0, &self.buffers.z, rtol, atol, max_step)
             }
         }
         .min(max_step);
@@ -883,9 +772,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let h_proposed = h;
         let predicted = predict_crossing(
             system,
-            &self.velocity,
-            &mut self.x_ahead,
-            &self.z[..n],
+            &self.buffers.velocity,
+            &mut self.buffers.x_ahead,
+            &self.buffers.z[..n],
             mode,
             self.surfaces,
             t0,
@@ -971,13 +860,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 }
             };
             let error = {
-                let mut rhs = clocked_field(&mut self.field, system, mode, clock, true);
-                self.rk.attempt(
+                let mut rhs = clocked_field(&mut self.buffers.field, system, mode, clock, true);
+                self.buffers.rk.attempt(
                     &mut rhs,
                     sigma0,
-                    &self.z,
+                    &self.buffers.z,
                     dsigma,
-                    &mut self.z_new,
+                    &mut self.buffers.z_new,
                     rtol,
                     atol,
                 )
@@ -1002,8 +891,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 self.surfaces,
                 n,
                 clock,
-                (t0, sigma0, &self.z),
-                (t1, dsigma, &self.z_new),
+                (t0, sigma0, &self.buffers.z),
+                (t1, dsigma, &self.buffers.z_new),
             );
             // A trial that passed a crossing of the half-power surface: locate the crossing
             // on the trial's dense output and land on it on a square-root clock centred there
@@ -1114,16 +1003,23 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
         self.proposed_step = Some(next);
         {
-            let mut rhs = clocked_field(&mut self.field, system, mode, clock, true);
-            self.rk.derivative_at_end(&mut rhs, sigma0, &self.z_new);
+            let mut rhs = clocked_field(&mut self.buffers.field, system, mode, clock, true);
+            self.buffers
+                .rk
+                .derivative_at_end(&mut rhs, sigma0, &self.buffers.z_new);
         }
         {
-            let mut rhs = clocked_field(&mut self.field, system, mode, clock, false);
-            self.rk
-                .dense_coefficients(&mut rhs, sigma0, &self.z, &self.z_new, n);
+            let mut rhs = clocked_field(&mut self.buffers.field, system, mode, clock, false);
+            self.buffers.rk.dense_coefficients(
+                &mut rhs,
+                sigma0,
+                &self.buffers.z,
+                &self.buffers.z_new,
+                n,
+            );
         }
-        self.statistics.rhs_evaluations = self.field.evaluations;
-        if self.z_new.iter().any(|v| !v.is_finite()) {
+        self.statistics.rhs_evaluations = self.buffers.field.evaluations;
+        if self.buffers.z_new.iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t1 });
         }
         self.clock = clock;
@@ -1143,18 +1039,18 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let n = self.n;
         let system = self.system;
         let mode = self.mode;
-        let (clock, sigma0, dsigma) = (self.clock, self.sigma_start, self.rk.h);
+        let (clock, sigma0, dsigma) = (self.clock, self.sigma_start, self.buffers.rk.h);
         let t0 = self.t;
         let t1 = t0 + reach;
         let side = side_sign(mode, k);
-        let rk = &self.rk;
-        let z_end = &self.z;
-        let x = &mut self.x;
+        let rk = &self.buffers.rk;
+        let z_end = &self.buffers.z;
+        let x = &mut self.buffers.x;
         let mut g = |t: f64| {
             rk.extrapolate_from_end(z_end, (clock.sigma(t) - sigma0) / dsigma, x);
             side * system.switching(k, t, x)
         };
-        let g0 = (side * system.switching(k, t0, &self.z[..n])).abs();
+        let g0 = (side * system.switching(k, t0, &self.buffers.z[..n])).abs();
         let g1 = g(t1);
         if g1.is_nan() || g1 >= 0.0 {
             return None;
@@ -1177,27 +1073,37 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     ) -> Option<f64> {
         let n = self.n;
         {
-            let mut rhs = clocked_field(&mut self.field, self.system, mode, clock, false);
-            self.rk.derivative_at_end(&mut rhs, sigma0, &self.z_new);
-            self.rk
-                .dense_coefficients(&mut rhs, sigma0, &self.z, &self.z_new, n);
+            let mut rhs = clocked_field(&mut self.buffers.field, self.system, mode, clock, false);
+            self.buffers
+                .rk
+                .derivative_at_end(&mut rhs, sigma0, &self.buffers.z_new);
+            self.buffers.rk.dense_coefficients(
+                &mut rhs,
+                sigma0,
+                &self.buffers.z,
+                &self.buffers.z_new,
+                n,
+            );
         }
         let system = self.system;
         let side = side_sign(mode, k);
-        let g1 = side * system.switching(k, t1, &self.z_new[..n]);
+        let g1 = side * system.switching(k, t1, &self.buffers.z_new[..n]);
         if g1.is_nan() || g1 >= 0.0 {
             return None;
         }
-        let rk = &self.rk;
-        let z0 = &self.z;
-        let x = &mut self.x;
+        let rk = &self.buffers.rk;
+        let z0 = &self.buffers.z;
+        let x = &mut self.buffers.x;
         let mut g = |t: f64| {
             rk.interpolate(z0, (clock.sigma(t) - sigma0) / dsigma, x);
             side * system.switching(k, t, x)
         };
         // The first sample past the surface and the one before it bracket the crossing (a
         // start on the surface, right after the event that entered the mode, is no crossing).
-        let mut before = (t0, (side * system.switching(k, t0, &self.z[..n])).abs());
+        let mut before = (
+            t0,
+            (side * system.switching(k, t0, &self.buffers.z[..n])).abs(),
+        );
         let mut after = (t1, g1);
         for j in 1..TRIAL_SAMPLES {
             let t = clock.time(sigma0 + dsigma * j as f64 / TRIAL_SAMPLES as f64);
@@ -1228,10 +1134,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let rate = clock.rate(sigma0);
         match stage0 {
             Some(held) if held == rate => {}
-            Some(held) if held != 0.0 => self.rk.scale_first_stage(rate / held),
+            Some(held) if held != 0.0 => self.buffers.rk.scale_first_stage(rate / held),
             _ => {
-                let mut rhs = clocked_field(&mut self.field, self.system, mode, clock, true);
-                self.rk.evaluate_first_stage(&mut rhs, sigma0, &self.z);
+                let mut rhs =
+                    clocked_field(&mut self.buffers.field, self.system, mode, clock, true);
+                self.buffers
+                    .rk
+                    .evaluate_first_stage(&mut rhs, sigma0, &self.buffers.z);
             }
         }
         Some(rate)
@@ -1247,19 +1156,19 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         t1: f64,
         time_tolerance: f64,
     ) -> Option<(usize, Bracket)> {
-        let p = self.samples.points();
+        let p = self.buffers.samples.points();
         let mut best: Option<(usize, Bracket)> = None;
         for k in 0..self.surfaces {
             let side = side_sign(mode, k);
             // At the step start the side is the mode's, whatever the computed value.
             // Each point: time, g = side h_k, and h_k and its rate (for the first guess).
-            let h0 = self.samples.values[k * p];
-            let mut prev = (t0, (side * h0).abs(), h0, self.samples.rates[k * p]);
+            let h0 = self.buffers.samples.values[k * p];
+            let mut prev = (t0, (side * h0).abs(), h0, self.buffers.samples.rates[k * p]);
             let mut candidate = None;
             for i in 0..p - 1 {
-                let te = self.samples.extremum_time[k * (p - 1) + i];
+                let te = self.buffers.samples.extremum_time[k * (p - 1) + i];
                 if !te.is_nan() && te > prev.0 {
-                    let he = self.samples.extremum_value[k * (p - 1) + i];
+                    let he = self.buffers.samples.extremum_value[k * (p - 1) + i];
                     let point = (te, side * he, he, 0.0);
                     if point.1 < 0.0 {
                         candidate = Some((prev, point));
@@ -1267,12 +1176,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     }
                     prev = point;
                 }
-                let hb = self.samples.values[k * p + i + 1];
+                let hb = self.buffers.samples.values[k * p + i + 1];
                 let point = (
-                    self.samples.times[i + 1],
+                    self.buffers.samples.times[i + 1],
                     side * hb,
                     hb,
-                    self.samples.rates[k * p + i + 1],
+                    self.buffers.samples.rates[k * p + i + 1],
                 );
                 if point.1 < 0.0 {
                     candidate = Some((prev, point));
@@ -1294,11 +1203,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let system = self.system;
             let n = self.n;
             let kind = self.kind;
-            let rk = &self.rk;
-            let z_start = &self.z_start;
-            let z_new = &self.z_new;
+            let rk = &self.buffers.rk;
+            let z_start = &self.buffers.z_start;
+            let z_new = &self.buffers.z_new;
             let clock = (self.clock, self.sigma_start);
-            let x = &mut self.x;
+            let x = &mut self.buffers.x;
             let mut g = |t: f64| {
                 state_in_step(
                     system, kind, mode, rk, clock, z_start, z_new, t0, t1, n, t, x,
@@ -1331,7 +1240,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     fn augmented_at(&mut self, t: f64) {
         let (t0, t1, mode) = (self.step_start, self.step_end, self.step_mode);
         if t == t1 {
-            self.z.copy_from_slice(&self.z_new);
+            self.buffers.z.copy_from_slice(&self.buffers.z_new);
             return;
         }
         match self.kind {
@@ -1340,25 +1249,27 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 if !self.full_dense && self.dim > self.n {
                     {
                         let mut rhs =
-                            clocked_field(&mut self.field, self.system, mode, clock, true);
-                        self.rk.dense_coefficients(
+                            clocked_field(&mut self.buffers.field, self.system, mode, clock, true);
+                        self.buffers.rk.dense_coefficients(
                             &mut rhs,
                             sigma0,
-                            &self.z_start,
-                            &self.z_new,
+                            &self.buffers.z_start,
+                            &self.buffers.z_new,
                             self.dim,
                         );
                     }
-                    self.statistics.rhs_evaluations = self.field.evaluations;
+                    self.statistics.rhs_evaluations = self.buffers.field.evaluations;
                     self.full_dense = true;
                 }
-                let theta = (clock.sigma(t) - sigma0) / self.rk.h;
-                self.rk.interpolate(&self.z_start, theta, &mut self.z);
+                let theta = (clock.sigma(t) - sigma0) / self.buffers.rk.h;
+                self.buffers
+                    .rk
+                    .interpolate(&self.buffers.z_start, theta, &mut self.buffers.z);
             }
             StepKind::Exact => {
                 // Reuse z_new as scratch: the step is being truncated.
                 self.exact_advance(mode, t0, t - t0);
-                self.z.copy_from_slice(&self.z_new);
+                self.buffers.z.copy_from_slice(&self.buffers.z_new);
             }
             StepKind::None => {}
         }
@@ -1393,16 +1304,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         if reset {
             // Does the reset send the state back to the side it came from (a bounce)? Then
             // return the bracket end on that side.
-            self.x_after.copy_from_slice(&self.z[..n]);
+            self.buffers.x_after.copy_from_slice(&self.buffers.z[..n]);
             system.reset(
                 k,
                 direction,
                 t_event,
-                &mut self.x_after,
-                &mut self.reset_jacobian,
-                &mut self.reset_dxdp,
+                &mut self.buffers.x_after,
+                &mut self.buffers.reset_jacobian,
+                &mut self.buffers.reset_dxdp,
             );
-            let negative_after = system.switching_rate(k, mode, t_event, &self.x_after) < 0.0;
+            let negative_after =
+                system.switching_rate(k, mode, t_event, &self.buffers.x_after) < 0.0;
             let near_usable = bracket.far - bracket.near <= time_tolerance
                 || bracket.near_value <= self.settings.event_value_tolerance;
             if negative_after == was_negative && near_usable && bracket.near != t_event {
@@ -1410,28 +1322,29 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 self.augmented_at(t_event);
             }
         }
-        self.x.copy_from_slice(&self.z[..n]);
-        let rate = system.switching_rate(k, mode, t_event, &self.x);
+        self.buffers.x.copy_from_slice(&self.buffers.z[..n]);
+        let rate = system.switching_rate(k, mode, t_event, &self.buffers.x);
         if self.sensitivity.transition() {
-            system.vector_field(mode, t_event, &self.x, &mut self.f_minus);
-            self.field.evaluations += 1;
+            system.vector_field(mode, t_event, &self.buffers.x, &mut self.buffers.f_minus);
+            self.buffers.field.evaluations += 1;
         }
         let negative_after = if reset {
             system.reset(
                 k,
                 direction,
                 t_event,
-                &mut self.z[..n],
-                &mut self.reset_jacobian,
-                &mut self.reset_dxdp,
+                &mut self.buffers.z[..n],
+                &mut self.buffers.reset_jacobian,
+                &mut self.buffers.reset_dxdp,
             );
             // The side of the post-reset state; on the surface, the side it moves to.
-            let h = system.switching(k, t_event, &self.z[..n]);
-            h < 0.0 || (h == 0.0 && system.switching_rate(k, mode, t_event, &self.z[..n]) < 0.0)
+            let h = system.switching(k, t_event, &self.buffers.z[..n]);
+            h < 0.0
+                || (h == 0.0 && system.switching_rate(k, mode, t_event, &self.buffers.z[..n]) < 0.0)
         } else {
             !was_negative
         };
-        if self.z[..n].iter().any(|v| !v.is_finite()) {
+        if self.buffers.z[..n].iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t_event });
         }
         let new_mode = if negative_after {
@@ -1440,37 +1353,44 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             mode & !(1 << k)
         };
         if self.sensitivity.transition() {
-            system.vector_field(new_mode, t_event, &self.z[..n], &mut self.f_plus);
-            self.field.evaluations += 1;
-            let partials = system.switching_gradient(k, t_event, &self.x, &mut self.gradient);
+            system.vector_field(
+                new_mode,
+                t_event,
+                &self.buffers.z[..n],
+                &mut self.buffers.f_plus,
+            );
+            self.buffers.field.evaluations += 1;
+            let partials =
+                system.switching_gradient(k, t_event, &self.buffers.x, &mut self.buffers.gradient);
             let hdot = partials.t
                 + self
+                    .buffers
                     .gradient
                     .iter()
-                    .zip(&self.f_minus)
+                    .zip(&self.buffers.f_minus)
                     .map(|(a, b)| a * b)
                     .sum::<f64>();
             let reset_jacobian = if reset {
-                &self.reset_jacobian
+                &self.buffers.reset_jacobian
             } else {
-                &self.identity
+                &self.buffers.identity
             };
             if !reset {
-                self.reset_dxdp.fill(0.0);
+                self.buffers.reset_dxdp.fill(0.0);
             }
             let nn = n * n;
-            let (_, rest) = self.z.split_at_mut(n);
+            let (_, rest) = self.buffers.z.split_at_mut(n);
             let (phi, s) = rest.split_at_mut(nn);
             let parameter = if self.sensitivity.parameter() {
-                Some((&mut s[..n], &self.reset_dxdp[..], partials.p))
+                Some((&mut s[..n], &self.buffers.reset_dxdp[..], partials.p))
             } else {
                 None
             };
-            self.saltation.apply(
+            self.buffers.saltation.apply(
                 reset_jacobian,
-                &self.f_minus,
-                &self.f_plus,
-                &self.gradient,
+                &self.buffers.f_minus,
+                &self.buffers.f_plus,
+                &self.buffers.gradient,
                 hdot,
                 phi,
                 parameter,
@@ -1478,13 +1398,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 k,
             )?;
         }
-        self.statistics.rhs_evaluations = self.field.evaluations;
+        self.statistics.rhs_evaluations = self.buffers.field.evaluations;
         self.statistics.events += 1;
         self.t = t_event;
         self.mode = new_mode;
         self.step_end = t_event;
         self.first_same_as_last = false;
-        self.samples.start_valid = false;
+        self.buffers.samples.start_valid = false;
         self.landing_limit = None;
         self.steps_in_mode = 0;
         self.entered = Some((k, t_event));
@@ -1496,16 +1416,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             rate,
             grazing: rate.abs() < self.settings.grazing_rate,
             reset,
-            state: self.z[..n].to_vec(),
+            state: self.buffers.z[..n].to_vec(),
         })
     }
 
     fn sync_transition(&mut self) {
         if self.sensitivity.transition() {
             let n = self.n;
-            self.transition
+            self.buffers
+                .transition
                 .as_mut_slice()
-                .copy_from_slice(&self.z[n..n + n * n]);
+                .copy_from_slice(&self.buffers.z[n..n + n * n]);
         }
     }
 }

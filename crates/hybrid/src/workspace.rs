@@ -61,6 +61,7 @@ pub(crate) struct Buffers {
     pub rk: Dop853,
     pub x_ahead: Vec<f64>,
     pub grid: Vec<f64>,
+    /// `f(t, x)` at the start of a step, in time units (for the crossing prediction).
     pub velocity: Vec<f64>,
     pub samples: Samples,
     pub extrema: Vec<Extremum>,
