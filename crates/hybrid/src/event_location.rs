@@ -89,14 +89,18 @@ pub(crate) struct RootGuess {
 
 /// The cubic Hermite interpolant of a function on `[a, b]` from its values and rates at both
 /// ends, in the power basis of `s = (t - a) / (b - a)`: `c0 + c1 s + c2 s^2 + c3 s^3`.
-struct CubicHermite {
+pub(crate) struct CubicHermite {
     a: f64,
     width: f64,
     c: [f64; 4],
 }
 
 impl CubicHermite {
-    fn new((a, value_a, rate_a): (f64, f64, f64), (b, value_b, rate_b): (f64, f64, f64)) -> Self {
+    /// The interpolant of `(t, value, rate)` at `a` and at `b`.
+    pub(crate) fn new(
+        (a, value_a, rate_a): (f64, f64, f64),
+        (b, value_b, rate_b): (f64, f64, f64),
+    ) -> Self {
         let width = b - a;
         let (ra, rb) = (width * rate_a, width * rate_b);
         Self {
@@ -111,8 +115,8 @@ impl CubicHermite {
         }
     }
 
-    /// `d^k H / ds^k` at `s` for `k` in `0..=2`.
-    fn derivative(&self, k: usize, s: f64) -> f64 {
+    /// `d^k H / ds^k` at `s` for `k` in `0..=2` (`k = 0`: the interpolant's value).
+    pub(crate) fn derivative(&self, k: usize, s: f64) -> f64 {
         let [c0, c1, c2, c3] = self.c;
         match k {
             0 => c0 + s * (c1 + s * (c2 + s * c3)),
@@ -324,7 +328,7 @@ mod tests {
             (bracket, count)
         };
         let end = |t: f64| (t, t.cos(), -t.sin());
-        // Crossing of cos: g = cos (positive at 1, negative at 2), root pi/2.
+        // Crossing of cos: g = cos (positive at 1.5, negative at 1.6), root pi/2.
         let guess = crossing_guess(end(1.5), end(1.6), 1.0);
         let root = std::f64::consts::FRAC_PI_2;
         /// Interval, function, guess and root.

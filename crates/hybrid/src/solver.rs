@@ -88,7 +88,7 @@ use crate::clock::Clock;
 use crate::dop853::Dop853;
 use crate::error::HybridError;
 use crate::event::{Event, Extremum};
-use crate::event_location::{crossing_guess, locate_sign_change, Bracket};
+use crate::event_location::{crossing_guess, locate_sign_change, Bracket, CubicHermite};
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
 use crate::system::{Direction, HybridSystem, Mode, MAX_SURFACES};
@@ -1531,14 +1531,8 @@ fn crossing_fraction<S: HybridSystem + ?Sized>(
         if !(g0.is_finite() && r0.is_finite() && r1.is_finite()) {
             continue;
         }
-        let mut hermite = |s: f64| {
-            let s2 = s * s;
-            let s3 = s2 * s;
-            g0 * (2.0 * s3 - 3.0 * s2 + 1.0)
-                + r0 * (s3 - 2.0 * s2 + s)
-                + g1 * (-2.0 * s3 + 3.0 * s2)
-                + r1 * (s3 - s2)
-        };
+        let cubic = CubicHermite::new((0.0, g0, r0), (1.0, g1, r1));
+        let mut hermite = |s: f64| cubic.derivative(0, s);
         let bracket = locate_sign_change(0.0, g0, 1.0, g1, &mut hermite, 1e-9, 0.0, None);
         let theta = bracket.far;
         if earliest.is_none_or(|(e, _)| theta < e) {
