@@ -16,6 +16,15 @@ pub(crate) type Rhs<'a> = dyn FnMut(f64, &[f64], &mut [f64]) + 'a;
 /// Coefficients of the dense-output polynomial of one component (degree 7, value at 0 apart).
 const DENSE_COEFFICIENTS: usize = 7;
 
+/// For row `i` of the tableau `A` (row 12: the solution's weights), the index from which its
+/// weights after the first are summed: `A[i][1..SKIP_FROM[i]]` are zero (stages 2 to 5 feed
+/// only the first few stages; checked by a test). Row 0 has no weights.
+const SKIP_FROM: [usize; STAGES_EXTENDED] = [1, 1, 1, 2, 2, 3, 3, 3, 3, 3, 3, 3, 5, 6, 5, 5];
+
+/// The same for the error estimate's weights `E5`, `BHH` and the dense output's `D`: zero on
+/// stages 2 to 5.
+const ESTIMATE_SKIP_FROM: usize = 5;
+
 /// Safety factor of the step-size controller (Hairer's `safe`).
 const SAFETY: f64 = 0.9;
 /// Smallest ratio new step / old step (Hairer's `fac1`).
@@ -96,25 +105,24 @@ fn dot_skipping<const N: usize, const FIRST: usize>(a: &[f64], k: &[f64]) -> f64
 /// instructions per steady orbit at `A/A0 = 0.95`, 8% at 0.5).
 #[inline]
 fn combine(out: &mut [f64], z: &[f64], stages: &[f64], weights: &[f64], h: f64) {
-    // The number of weights is the stage index (1 to 15), or 12 for the solution; the
-    // second parameter skips the row's zeros after its first weight (see the test
-    // `zero_weights_skipped_are_zero`).
+    // The number of weights is the stage index (1 to 15), or 12 for the solution: the row of
+    // `A` they come from, whose zeros after the first weight `SKIP_FROM` skips.
     match weights.len() {
-        1 => combine_fixed::<1, 1>(out, z, stages, weights, h),
-        2 => combine_fixed::<2, 1>(out, z, stages, weights, h),
-        3 => combine_fixed::<3, 2>(out, z, stages, weights, h),
-        4 => combine_fixed::<4, 2>(out, z, stages, weights, h),
-        5 => combine_fixed::<5, 3>(out, z, stages, weights, h),
-        6 => combine_fixed::<6, 3>(out, z, stages, weights, h),
-        7 => combine_fixed::<7, 3>(out, z, stages, weights, h),
-        8 => combine_fixed::<8, 3>(out, z, stages, weights, h),
-        9 => combine_fixed::<9, 3>(out, z, stages, weights, h),
-        10 => combine_fixed::<10, 3>(out, z, stages, weights, h),
-        11 => combine_fixed::<11, 3>(out, z, stages, weights, h),
-        12 => combine_fixed::<12, 5>(out, z, stages, weights, h),
-        13 => combine_fixed::<13, 6>(out, z, stages, weights, h),
-        14 => combine_fixed::<14, 5>(out, z, stages, weights, h),
-        15 => combine_fixed::<15, 5>(out, z, stages, weights, h),
+        1 => combine_fixed::<1, { SKIP_FROM[1] }>(out, z, stages, weights, h),
+        2 => combine_fixed::<2, { SKIP_FROM[2] }>(out, z, stages, weights, h),
+        3 => combine_fixed::<3, { SKIP_FROM[3] }>(out, z, stages, weights, h),
+        4 => combine_fixed::<4, { SKIP_FROM[4] }>(out, z, stages, weights, h),
+        5 => combine_fixed::<5, { SKIP_FROM[5] }>(out, z, stages, weights, h),
+        6 => combine_fixed::<6, { SKIP_FROM[6] }>(out, z, stages, weights, h),
+        7 => combine_fixed::<7, { SKIP_FROM[7] }>(out, z, stages, weights, h),
+        8 => combine_fixed::<8, { SKIP_FROM[8] }>(out, z, stages, weights, h),
+        9 => combine_fixed::<9, { SKIP_FROM[9] }>(out, z, stages, weights, h),
+        10 => combine_fixed::<10, { SKIP_FROM[10] }>(out, z, stages, weights, h),
+        11 => combine_fixed::<11, { SKIP_FROM[11] }>(out, z, stages, weights, h),
+        12 => combine_fixed::<12, { SKIP_FROM[12] }>(out, z, stages, weights, h),
+        13 => combine_fixed::<13, { SKIP_FROM[13] }>(out, z, stages, weights, h),
+        14 => combine_fixed::<14, { SKIP_FROM[14] }>(out, z, stages, weights, h),
+        15 => combine_fixed::<15, { SKIP_FROM[15] }>(out, z, stages, weights, h),
         _ => {
             for ((y, &zc), k) in out
                 .iter_mut()
@@ -243,8 +251,9 @@ impl Dop853 {
             let scale = atol + rtol * z[c].abs().max(z_new[c].abs());
             let k = self.component(c);
             // E5, b and BHH vanish on stages 2 to 5 (tested).
-            let e5 = dot_skipping::<STAGES, 5>(&E5, k);
-            let e3 = dot_skipping::<STAGES, 5>(b, k) - dot_skipping::<STAGES, 5>(&BHH, k);
+            let e5 = dot_skipping::<STAGES, ESTIMATE_SKIP_FROM>(&E5, k);
+            let e3 = dot_skipping::<STAGES, ESTIMATE_SKIP_FROM>(b, k)
+                - dot_skipping::<STAGES, ESTIMATE_SKIP_FROM>(&BHH, k);
             err5 += (e5 / scale) * (e5 / scale);
             err3 += (e3 / scale) * (e3 / scale);
         }
@@ -308,7 +317,7 @@ impl Dop853 {
             coefficients[2] = 2.0 * delta - h * (f1 + f0);
             for (coefficient, d) in coefficients[3..].iter_mut().zip(&D) {
                 // The dense weights vanish on stages 2 to 5 (tested).
-                *coefficient = h * dot_skipping::<STAGES_EXTENDED, 5>(d, k);
+                *coefficient = h * dot_skipping::<STAGES_EXTENDED, ESTIMATE_SKIP_FROM>(d, k);
             }
         }
     }
@@ -419,14 +428,12 @@ mod tests {
         ((z[0] - 2.0f64.cos()).powi(2) + (z[1] + 2.0f64.sin()).powi(2)).sqrt()
     }
 
-    /// The weights `combine` leaves out are zero: after its first weight, row `i` of the
-    /// tableau (its `i` weights; row 12 is the solution) is summed from the index `combine`
-    /// dispatches to (the same numbers as its table); and so are those the error estimate and
-    /// the dense output leave out.
+    /// The weights the sums leave out are zero: `A[i][1..SKIP_FROM[i]]` for every row (row 12
+    /// is the solution), and entries `1..ESTIMATE_SKIP_FROM` of the error estimate's and the
+    /// dense output's weights.
     #[test]
     fn zero_weights_skipped_are_zero() {
-        let first = [0, 1, 1, 2, 2, 3, 3, 3, 3, 3, 3, 3, 5, 6, 5, 5];
-        for (row, &first) in first.iter().enumerate().skip(1) {
+        for (row, &first) in SKIP_FROM.iter().enumerate() {
             let skipped = &A[row][1..first];
             assert!(
                 skipped.iter().all(|&w| w == 0.0),
@@ -443,7 +450,10 @@ mod tests {
             &D[2],
             &D[3],
         ] {
-            assert!(weights[1..5].iter().all(|&w| w == 0.0), "{weights:?}");
+            assert!(
+                weights[1..ESTIMATE_SKIP_FROM].iter().all(|&w| w == 0.0),
+                "{weights:?}"
+            );
         }
     }
 
