@@ -427,12 +427,7 @@ fn shoot_observed(
             predicted_final,
             integration,
         )?;
-        let next_residual = next_image
-            .iter()
-            .zip(&candidate)
-            .map(|(p, x)| (p - x) * (p - x))
-            .sum::<f64>()
-            .sqrt();
+        let next_residual = distance(&next_image, &candidate);
         if next_residual > newton.divergence_factor * residual {
             let observables = observables_at(model, &x, observables, integration)?;
             return Ok(ObservedShot {
