@@ -35,15 +35,23 @@ struct ModalConstants {
     /// The free-flight flow of this mode.
     oscillator: DrivenOscillator,
     /// Its homogeneous transition over the standard exact step (`exact_step_limit`) and over
-    /// that step's grid spacing (`/ STANDARD_GRID`): computed once, the same numbers the
-    /// oscillator gives per call.
+    /// that step's grid spacings (`grid_transitions[c - 1]` for the spacing
+    /// `exact_step_limit / c`): computed once, the same numbers the oscillator gives per call.
     step_transition: [[f64; 2]; 2],
-    spacing_transition: [[f64; 2]; 2],
+    grid_transitions: [[[f64; 2]; 2]; KEPT_GRIDS],
 }
 
-/// The grid count the solver asks [`HybridSystem::exact_flow_grid`] for with its default
-/// `samples_per_step` (8 interior samples: 9 intervals), whose spacing's transitions are kept.
-const STANDARD_GRID: usize = 9;
+/// The grid counts `c = 1..=KEPT_GRIDS` over the standard exact step whose spacings'
+/// transitions are kept: the solver asks [`HybridSystem::exact_flow_grid`] for
+/// `samples_per_step + 1` intervals (9 with its default, 5 in a sweep), so any
+/// `samples_per_step` up to 15 is served without recomputing them.
+const KEPT_GRIDS: usize = 16;
+
+/// The spacing of a grid of `count` intervals over `dt`, us (one expression for the kept and
+/// the computed transitions, so that they agree bit for bit).
+fn grid_spacing(dt: f64, count: usize) -> f64 {
+    dt / count as f64
+}
 
 /// The N-mode tapping cantilever of Eq. 1 (MODEL.md section 1) as a [`HybridSystem`].
 ///
@@ -63,8 +71,9 @@ pub struct TappingModel {
     separation: Separation,
     modes: Vec<ModalConstants>,
     exact_step_limit: f64,
-    /// `(sin, cos)` of the drive phase advance over the standard grid spacing.
-    spacing_rotation: (f64, f64),
+    /// `(sin, cos)` of the drive phase advance over the spacing `exact_step_limit / c` at index
+    /// `c - 1`.
+    grid_rotations: [(f64, f64); KEPT_GRIDS],
 }
 
 impl TappingModel {
@@ -117,7 +126,6 @@ impl TappingModel {
             .map(|mode| 2.0 * PI / mode.angular_frequency())
             .fold(drive.period_us(), f64::min);
         let exact_step_limit = 0.25 * shortest_period;
-        let spacing = exact_step_limit / STANDARD_GRID as f64;
         let modes: Vec<ModalConstants> = cantilever
             .modes
             .iter()
@@ -137,12 +145,16 @@ impl TappingModel {
                     drive_acceleration: omega * omega * static_deflection,
                     optical_sensitivity: mode.optical_sensitivity,
                     step_transition: oscillator.homogeneous_transition(exact_step_limit),
-                    spacing_transition: oscillator.homogeneous_transition(spacing),
+                    grid_transitions: std::array::from_fn(|i| {
+                        oscillator.homogeneous_transition(grid_spacing(exact_step_limit, i + 1))
+                    }),
                     oscillator,
                 }
             })
             .collect();
-        let spacing_rotation = phase::sin_cos(drive.angular_frequency * spacing);
+        let grid_rotations = std::array::from_fn(|i| {
+            phase::sin_cos(drive.angular_frequency * grid_spacing(exact_step_limit, i + 1))
+        });
         Ok(Self {
             hertz: HertzContact::new(&cantilever, &sample),
             cantilever,
@@ -154,7 +166,7 @@ impl TappingModel {
             separation,
             modes,
             exact_step_limit,
-            spacing_rotation,
+            grid_rotations,
         })
     }
 
@@ -533,20 +545,20 @@ impl HybridSystem for TappingModel {
         states: &mut [f64],
     ) {
         let n = self.dim();
-        let spacing = dt / count as f64;
+        let spacing = grid_spacing(dt, count);
         let w = self.drive.angular_frequency;
-        let standard = dt == self.exact_step_limit && count == STANDARD_GRID;
+        // The index of the kept spacing, for a grid over the standard step.
+        let kept =
+            (dt == self.exact_step_limit && (1..=KEPT_GRIDS).contains(&count)).then(|| count - 1);
         let (sin0, cos0) = phase::sin_cos(w * t0);
-        let (sin_step, cos_step) = if standard {
-            self.spacing_rotation
-        } else {
-            phase::sin_cos(w * spacing)
+        let (sin_step, cos_step) = match kept {
+            Some(c) => self.grid_rotations[c],
+            None => phase::sin_cos(w * spacing),
         };
         for (i, m) in self.modes.iter().enumerate() {
-            let phi = if standard {
-                m.spacing_transition
-            } else {
-                m.oscillator.homogeneous_transition(spacing)
+            let phi = match kept {
+                Some(c) => m.grid_transitions[c],
+                None => m.oscillator.homogeneous_transition(spacing),
             };
             let start = m.oscillator.steady_state_at_phase(sin0, cos0);
             let mut y = [x0[2 * i] - start[0], x0[2 * i + 1] - start[1]];
@@ -651,9 +663,10 @@ mod tests {
         }
     }
 
-    /// The transitions kept for the standard exact step and its grid spacing are the numbers
-    /// the oscillators compute per call: the flow and grid over the standard step are bit for
-    /// bit those over a step computed afresh (the same expressions on the same inputs).
+    /// The transitions and drive rotations kept for the standard exact step and its grid
+    /// spacings (every kept count) are the numbers the oscillators compute per call: the flow
+    /// and grids over the standard step are bit for bit those over a step computed afresh (the
+    /// same expressions on the same inputs).
     #[test]
     fn kept_standard_step_transitions_equal_fresh_ones() {
         for name in ["biolever-mica", "maclever-soft"] {
@@ -661,7 +674,6 @@ mod tests {
             let model = TappingModel::from_case(&case).expect("model");
             let n = model.dim();
             let dt = model.exact_step_limit(FREE_FLIGHT);
-            let spacing = dt / STANDARD_GRID as f64;
             let x0: Vec<f64> = (0..n).map(|i| 3.0 - 0.7 * i as f64).collect();
             let t0 = 5.678;
             let mut kept = vec![0.0; n];
@@ -675,20 +687,24 @@ mod tests {
                 Some(&mut transition),
                 None,
             );
-            let mut grid = vec![0.0; STANDARD_GRID * n];
-            model.exact_flow_grid(FREE_FLIGHT, t0, &x0, dt, STANDARD_GRID, &mut grid);
             let w = model.drive.angular_frequency;
-            assert_eq!(
-                model.spacing_rotation,
-                phase::sin_cos(w * spacing),
-                "{name}"
-            );
+            for count in 1..=KEPT_GRIDS {
+                let spacing = dt / count as f64;
+                assert_eq!(
+                    model.grid_rotations[count - 1],
+                    phase::sin_cos(w * spacing),
+                    "{name}, {count} intervals"
+                );
+                for m in &model.modes {
+                    assert_eq!(
+                        m.grid_transitions[count - 1],
+                        m.oscillator.homogeneous_transition(spacing),
+                        "{name}, {count} intervals"
+                    );
+                }
+            }
             for (i, m) in model.modes.iter().enumerate() {
                 assert_eq!(m.step_transition, m.oscillator.homogeneous_transition(dt));
-                assert_eq!(
-                    m.spacing_transition,
-                    m.oscillator.homogeneous_transition(spacing)
-                );
                 let (fresh, phi) = m.oscillator.flow(t0, [x0[2 * i], x0[2 * i + 1]], dt);
                 assert_eq!([kept[2 * i], kept[2 * i + 1]], fresh, "{name} mode {i}");
                 assert_eq!(transition[(2 * i, 2 * i + 1)], phi[0][1], "{name} mode {i}");
