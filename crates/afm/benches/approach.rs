@@ -5,7 +5,7 @@
 //! about 24 ms per drive cycle (the reference figure).
 //!
 //! Run with `cargo bench -p afm --bench approach` (release build, one core). Pass `--quick`
-//! after `--` to sweep only 11 nm -> 8 nm, `--samples N` to change the solver's samples per
+//! after `--` to sweep only 11 nm -> 8 nm, `--from Z --to Z` for another window (nm), `--samples N` to change the solver's samples per
 //! step (default `afm::sweep::SAMPLES_PER_STEP`), `--tolerance X` for the contact integration's tolerance (default
 //! `afm::sweep::DEFAULT_TOLERANCE`), `--all-extrema` to search every free-flight step for extrema
 //! (`extremum_height` infinite, as before the sweep skipped steps proven clear of the sample).
@@ -34,8 +34,20 @@ fn main() {
     settings.to_nm = if quick { 8.0 } else { 0.0 };
     settings.rate_nm_per_s = 1.0;
     settings.settle_cycles = 0;
-    // `--samples N`: the solver's samples per step (extrema search), to weigh its cost.
     let arguments: Vec<String> = std::env::args().collect();
+    // `--from Z --to Z`: another window of the sweep, nm (to profile one impact regime).
+    for (flag, end) in [
+        ("--from", &mut settings.from_nm),
+        ("--to", &mut settings.to_nm),
+    ] {
+        if let Some(index) = arguments.iter().position(|a| a == flag) {
+            *end = arguments
+                .get(index + 1)
+                .and_then(|z| z.parse().ok())
+                .unwrap_or_else(|| panic!("{flag} Z"));
+        }
+    }
+    // `--samples N`: the solver's samples per step (extrema search), to weigh its cost.
     if let Some(index) = arguments.iter().position(|a| a == "--samples") {
         settings.integration.samples_per_step = arguments
             .get(index + 1)
