@@ -10,10 +10,31 @@
 use crate::error::HybridError;
 use crate::event::{Extremum, ExtremumKind};
 use crate::event_location::{extremum_guess, locate_sign_change};
+use crate::solver::side_sign;
 use crate::system::{HybridSystem, Mode};
 
 /// The state at time `t` inside the current step, written into the slice.
 pub(crate) type StateAt<'a> = dyn FnMut(f64, &mut [f64]) + 'a;
+
+/// What lets [`Samples::locate_extrema`] leave a sample interval unsearched: the system's bound
+/// `M_k` on `|h_k''|` over the step, and the distance from the surfaces beyond which extrema
+/// need not be found (`Settings::extremum_height`).
+pub(crate) struct Clearance<'a> {
+    /// `Settings::extremum_height`, switching-function units (finite).
+    pub height: f64,
+    /// `M_k` for every surface `k`, switching-function units per time squared.
+    pub bounds: &'a [f64],
+}
+
+impl Clearance<'_> {
+    /// Whether `h_k` stays farther than the height from its surface (and on the side the mode
+    /// says) between two neighbouring samples `spacing` apart with values `a` and `b` on the
+    /// mode's side: the chord bent by `M_k spacing^2 / 8` stays above the height.
+    fn proves(&self, k: usize, a: f64, b: f64, spacing: f64) -> bool {
+        let lowest = a.min(b) - self.bounds[k] * spacing * spacing / 8.0;
+        lowest > self.height && lowest > 0.0
+    }
+}
 
 /// Samples of every switching function over one step, and the extrema found between them.
 pub(crate) struct Samples {
@@ -179,6 +200,9 @@ impl Samples {
     /// to `>= 0` is a minimum, from `> 0` to `<= 0` a maximum (a zero of the rate exactly at
     /// the step start is therefore never reported: it belongs to the previous step's end).
     /// Appends to `found` (unsorted) and records per-interval extrema for event location.
+    /// With a `clearance`, an interval that it proves farther than the extremum height from
+    /// the surface is not searched (its extremum, if any, is neither located nor reported:
+    /// it cannot hide a crossing).
     #[allow(clippy::too_many_arguments)]
     pub fn locate_extrema<S: HybridSystem + ?Sized>(
         &mut self,
@@ -187,12 +211,14 @@ impl Samples {
         state_at: &mut StateAt<'_>,
         x: &mut [f64],
         time_tolerance: f64,
+        clearance: Option<Clearance<'_>>,
         found: &mut Vec<Extremum>,
     ) {
         let p = self.points;
         self.extremum_time.fill(f64::NAN);
         self.extremum_value.fill(f64::NAN);
         for k in 0..self.surfaces {
+            let side = side_sign(mode, k);
             for i in 0..p - 1 {
                 let ra = self.rates[k * p + i];
                 let rb = self.rates[k * p + i + 1];
@@ -203,6 +229,16 @@ impl Samples {
                 } else {
                     continue;
                 };
+                if clearance.as_ref().is_some_and(|clearance| {
+                    clearance.proves(
+                        k,
+                        side * self.values[k * p + i],
+                        side * self.values[k * p + i + 1],
+                        self.times[i + 1] - self.times[i],
+                    )
+                }) {
+                    continue;
+                }
                 // Orient so that g > 0 at the interval start and g <= 0 at its end.
                 let sign = match kind {
                     ExtremumKind::Minimum => -1.0,
@@ -248,6 +284,117 @@ impl Samples {
                     });
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+
+    /// `h(t) = m + (t - t_m)^2` as the state `[h, dh/dt]` (so `|h''| = 2` everywhere).
+    struct Valley {
+        depth: f64,
+        t_m: f64,
+    }
+
+    impl Valley {
+        fn state_at(&self, t: f64, x: &mut [f64]) {
+            x[0] = self.depth + (t - self.t_m) * (t - self.t_m);
+            x[1] = 2.0 * (t - self.t_m);
+        }
+    }
+
+    impl HybridSystem for Valley {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn surface_count(&self) -> usize {
+            1
+        }
+        fn vector_field(&self, _mode: Mode, _t: f64, x: &[f64], dxdt: &mut [f64]) {
+            dxdt[0] = x[1];
+            dxdt[1] = 2.0;
+        }
+        fn jacobian(&self, _mode: Mode, _t: f64, _x: &[f64], j: &mut DMatrix<f64>) {
+            j.fill(0.0);
+            j[(0, 1)] = 1.0;
+        }
+        fn switching(&self, _k: usize, _t: f64, x: &[f64]) -> f64 {
+            x[0]
+        }
+        fn switching_rate(&self, _k: usize, _mode: Mode, _t: f64, x: &[f64]) -> f64 {
+            x[1]
+        }
+        fn switching_gradient(
+            &self,
+            _k: usize,
+            _t: f64,
+            _x: &[f64],
+            g: &mut [f64],
+        ) -> crate::SwitchingPartials {
+            g[0] = 1.0;
+            g[1] = 0.0;
+            crate::SwitchingPartials::default()
+        }
+    }
+
+    /// The minimum of `h` found over one step `[0, 1]` sampled at 4 interior points (spacing
+    /// 0.2; the minimum at `t_m = 0.37` lies in `[0.2, 0.4]`, where the samples are
+    /// `m + 0.0289` and `m + 0.0009`), with the curvature bound 2 and `height` if given.
+    fn minima(depth: f64, height: Option<f64>) -> Vec<Extremum> {
+        let valley = Valley { depth, t_m: 0.37 };
+        let mut samples = Samples::new(1, 4);
+        let mut x = [0.0; 2];
+        let mut state_at = |t: f64, x: &mut [f64]| valley.state_at(t, x);
+        samples
+            .sample(&valley, 0, 0.0, 1.0, &mut state_at, None, &mut x)
+            .expect("finite samples");
+        let mut found = Vec::with_capacity(4);
+        let bounds = [2.0];
+        samples.locate_extrema(
+            &valley,
+            0,
+            &mut state_at,
+            &mut x,
+            1e-13,
+            height.map(|height| Clearance {
+                height,
+                bounds: &bounds,
+            }),
+            &mut found,
+        );
+        found
+    }
+
+    /// An interval is left unsearched exactly when the chord of its samples, bent by the
+    /// curvature bound (`2 * 0.2^2 / 8 = 0.01`), stays above the height: its lowest possible
+    /// value is `m + 0.0009 - 0.01`, which never exceeds the true minimum `m`.
+    #[test]
+    fn intervals_proven_clear_are_not_searched() {
+        // m = 0.02: the bound proves the interval above 0.0109, so heights 0 and 0.01 skip it,
+        // 0.015 does not; without a clearance it is always searched.
+        for (height, searched) in [
+            (Some(0.0), false),
+            (Some(0.01), false),
+            (Some(0.015), true),
+            (None, true),
+        ] {
+            let found = minima(0.02, height);
+            assert_eq!(found.len(), usize::from(searched), "height {height:?}");
+            for minimum in &found {
+                assert_eq!(minimum.kind, ExtremumKind::Minimum);
+                assert!((minimum.t - 0.37).abs() < 1e-12, "{minimum:?}");
+                assert!((minimum.value - 0.02).abs() < 1e-15, "{minimum:?}");
+            }
+        }
+        // m = 0.005: the bound only proves the interval above -0.0041, so the minimum is
+        // located even at height 0, and so is a dip below the surface.
+        for depth in [0.005, -1e-9] {
+            let found = minima(depth, Some(0.0));
+            assert_eq!(found.len(), 1, "depth {depth}");
+            assert!((found[0].value - depth).abs() < 1e-15);
         }
     }
 }

@@ -55,7 +55,9 @@ pub struct Settings {
     /// Every step is sampled inside and its extrema located, except a step that the system
     /// proves farther than this from every surface throughout (by
     /// [`crate::HybridSystem::switching_curvature_bound`]): such a step is sampled at its ends
-    /// only and reports no extrema. Crossings are found either way. `INFINITY` (the default)
+    /// only and reports no extrema; likewise, an extremum between two samples that the bound
+    /// proves farther than this is neither located nor reported. Crossings are found either
+    /// way. `INFINITY` (the default)
     /// reports every extremum, as observables of an orbit need; a time-domain sweep or a
     /// Newton iteration that only needs the crossings sets it to 0. Allowed: `>= 0` (infinity
     /// allowed).

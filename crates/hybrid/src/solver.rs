@@ -34,7 +34,10 @@
 //!   end values stays farther than the height from every surface even when bent by
 //!   `M dt^2 / 8` is sampled at its ends only, and reports no extrema; an exact-flow step is
 //!   stretched (beyond `exact_step_limit`) as far as `h_k(t0) + h_k'(t0) s - M s^2 / 2` stays
-//!   above the height. Neither can hide a crossing: the bound is rigorous.
+//!   above the height. In a step that is sampled, a sample interval whose chord bent by
+//!   `M spacing^2 / 8` stays above the height is not searched for an extremum (free flight
+//!   between contacts, whose gap minima clear the sample). None of these can hide a crossing:
+//!   the bound is rigorous.
 //!
 //! # Step-size control
 //!
@@ -89,6 +92,7 @@ use crate::dop853::Dop853;
 use crate::error::HybridError;
 use crate::event::{Event, Extremum};
 use crate::event_location::{crossing_guess, locate_sign_change, Bracket, CubicHermite};
+use crate::extrema::Clearance;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
 use crate::system::{Direction, HybridSystem, Mode, MAX_SURFACES};
@@ -453,6 +457,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         // Sample h and dh/dt, locate extrema, then the earliest crossing.
         let time_tolerance =
             self.settings.event_time_tolerance * t0.abs().max(t1.abs()).max(t1 - t0);
+        // With a finite extremum height, the curvature bounds of the step (if the system
+        // gives them): a step, or a sample interval of it, that they prove farther than the
+        // height from every surface is not searched for extrema.
+        let mut bounds = [0.0; MAX_SURFACES];
+        let bounded = self.settings.extremum_height.is_finite()
+            && !self.proven_clear
+            && self.curvature_bounds(mode, t0, t1, &mut bounds);
         let clear = self.settings.extremum_height.is_finite() && {
             self.buffers.samples.sample_ends(
                 self.system,
@@ -462,7 +473,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 &self.buffers.z_start[..self.n],
                 &self.buffers.z_new[..self.n],
             )?;
-            self.proven_clear || self.clear_of_surfaces(mode, t0, t1)
+            self.proven_clear || (bounded && self.clear_of_surfaces(mode, t0, t1, &bounds))
         };
         if !clear {
             let system = self.system;
@@ -502,12 +513,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 grid,
                 &mut self.buffers.x,
             )?;
+            let clearance = bounded.then(|| Clearance {
+                height: self.settings.extremum_height,
+                bounds: &bounds[..self.surfaces],
+            });
             self.buffers.samples.locate_extrema(
                 system,
                 mode,
                 &mut state_at,
                 &mut self.buffers.x,
                 time_tolerance,
+                clearance,
                 &mut self.buffers.extrema,
             );
         }
@@ -586,12 +602,33 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         Some(span)
     }
 
+    /// The system's bound `M_k` on `|h_k''|` over the step `[t0, t1]` for every surface
+    /// ([`HybridSystem::switching_curvature_bound`]), written into `bounds`; `false` (and
+    /// nothing usable written) when the system gives none, or a bound is NaN or negative.
+    fn curvature_bounds(&self, mode: Mode, t0: f64, t1: f64, bounds: &mut [f64]) -> bool {
+        (0..self.surfaces).all(|k| {
+            match self.system.switching_curvature_bound(
+                k,
+                mode,
+                t0,
+                &self.buffers.z_start[..self.n],
+                t1 - t0,
+            ) {
+                Some(bound) if bound >= 0.0 => {
+                    bounds[k] = bound;
+                    true
+                }
+                _ => false,
+            }
+        })
+    }
+
     /// Whether the step `[t0, t1]` just sampled at its ends ([`Samples::sample_ends`]) stays
     /// farther than `extremum_height` from every surface throughout: for each surface, the
-    /// smaller end value on the mode's side less `M (t1 - t0)^2 / 8`, with `M` the system's
-    /// bound on `|h''|` ([`HybridSystem::switching_curvature_bound`]), must exceed the height
-    /// (and zero). `false` when the system gives no bound.
-    fn clear_of_surfaces(&self, mode: Mode, t0: f64, t1: f64) -> bool {
+    /// smaller end value on the mode's side less `M_k (t1 - t0)^2 / 8` (the chord bent by the
+    /// curvature bound, `bounds` from [`Solver::curvature_bounds`]) must exceed the height
+    /// (and zero).
+    fn clear_of_surfaces(&self, mode: Mode, t0: f64, t1: f64, bounds: &[f64]) -> bool {
         let p = self.buffers.samples.points();
         let dt = t1 - t0;
         let height = self.settings.extremum_height;
@@ -599,13 +636,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let side = side_sign(mode, k);
             let ends = (side * self.buffers.samples.values[k * p])
                 .min(side * self.buffers.samples.values[k * p + p - 1]);
-            self.system
-                .switching_curvature_bound(k, mode, t0, &self.buffers.z_start[..self.n], dt)
-                .is_some_and(|bound| {
-                    let lowest = ends - bound * dt * dt / 8.0;
-                    // False for a NaN bound: such a step is sampled in full.
-                    lowest > height && lowest > 0.0
-                })
+            let lowest = ends - bounds[k] * dt * dt / 8.0;
+            lowest > height && lowest > 0.0
         })
     }
 
@@ -1582,7 +1614,7 @@ fn predict_crossing<S: HybridSystem + ?Sized>(
 
 /// `+1` if `mode` has `h_k` on its positive side, `-1` if on its negative side (bit `k` set):
 /// `side_sign * h_k` is positive on the current side of surface `k`.
-fn side_sign(mode: Mode, k: usize) -> f64 {
+pub(crate) fn side_sign(mode: Mode, k: usize) -> f64 {
     if mode & (1 << k) != 0 {
         -1.0
     } else {
