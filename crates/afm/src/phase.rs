@@ -40,17 +40,34 @@ const C4: f64 = -2.755_731_435_139_066_330_35e-7;
 const C5: f64 = 2.087_572_321_298_174_827_90e-9;
 const C6: f64 = -1.135_964_755_778_819_482_65e-11;
 
-/// `(sin r, cos r)` for `|r| <= pi/4` (plus the reduction's rounding).
+/// `sin r` for `|r| <= pi/4` (plus the reduction's rounding).
 #[inline]
-fn kernel(r: f64) -> (f64, f64) {
+fn kernel_sin(r: f64) -> f64 {
     let z = r * r;
-    let sine = r + r * z * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
+    r + r * z * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))))
+}
+
+/// `cos r` for `|r| <= pi/4` (plus the reduction's rounding).
+#[inline]
+fn kernel_cos(r: f64) -> f64 {
+    let z = r * r;
     let tail = z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
     // 1 - z/2 + tail, with the rounding of 1 - z/2 recovered (fdlibm's compensation).
     let half = 0.5 * z;
     let w = 1.0 - half;
-    let cosine = w + (((1.0 - w) - half) + tail);
-    (sine, cosine)
+    w + (((1.0 - w) - half) + tail)
+}
+
+/// `x` reduced by the nearest multiple `k` of `pi/2`: `(r, k mod 4)`, for `|x|` within the
+/// reduction limit.
+#[inline]
+fn reduce(x: f64) -> (f64, i64) {
+    // The nearest integer to `x / (pi/2)` (ties to even), by adding and subtracting
+    // `1.5 * 2^52`: exact for quotients below 2^51, far above the reduction limit, and an
+    // addition where `f64::round` is a library call on the baseline x86-64 target.
+    let k = (x * std::f64::consts::FRAC_2_PI + ROUNDING_SHIFT) - ROUNDING_SHIFT;
+    let r = (x - k * FRAC_PI_2_HIGH) - k * FRAC_PI_2_LOW;
+    (r, (k as i64).rem_euclid(4))
 }
 
 /// `(sin x, cos x)`, within 2 ulps (see the module docs).
@@ -59,13 +76,9 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if x.is_nan() || x.abs() > REDUCTION_LIMIT {
         return x.sin_cos();
     }
-    // The nearest integer to `x / (pi/2)` (ties to even), by adding and subtracting
-    // `1.5 * 2^52`: exact for quotients below 2^51, far above the reduction limit, and an
-    // addition where `f64::round` is a library call on the baseline x86-64 target.
-    let k = (x * std::f64::consts::FRAC_2_PI + ROUNDING_SHIFT) - ROUNDING_SHIFT;
-    let r = (x - k * FRAC_PI_2_HIGH) - k * FRAC_PI_2_LOW;
-    let (s, c) = kernel(r);
-    match (k as i64).rem_euclid(4) {
+    let (r, quadrant) = reduce(x);
+    let (s, c) = (kernel_sin(r), kernel_cos(r));
+    match quadrant {
         0 => (s, c),
         1 => (c, -s),
         2 => (-s, -c),
@@ -73,10 +86,19 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     }
 }
 
-/// `cos x`, within 2 ulps (see the module docs).
+/// `cos x`, within 2 ulps (see the module docs): bit for bit the cosine of [`sin_cos`], with
+/// only the one kernel the quadrant needs (the drive factor of every field evaluation).
 #[inline]
 pub fn cos(x: f64) -> f64 {
-    sin_cos(x).1
+    if x.is_nan() || x.abs() > REDUCTION_LIMIT {
+        return x.sin_cos().1;
+    }
+    match reduce(x) {
+        (r, 0) => kernel_cos(r),
+        (r, 1) => -kernel_sin(r),
+        (r, 2) => -kernel_cos(r),
+        (r, _) => kernel_sin(r),
+    }
 }
 
 #[cfg(test)]
@@ -106,6 +128,8 @@ mod tests {
         };
         let mut check = |x: f64| {
             let (s, c) = sin_cos(x);
+            // `cos` alone is the same value, bit for bit.
+            assert_eq!(cos(x).to_bits(), c.to_bits(), "cos({x:e})");
             let (rs, rc) = x.sin_cos();
             for (value, reference) in [(s, rs), (c, rc)] {
                 if reference.abs() >= 0.1 {
@@ -135,6 +159,7 @@ mod tests {
             let (rs, rc) = x.sin_cos();
             assert!(s.to_bits() == rs.to_bits() || (s.is_nan() && rs.is_nan()));
             assert!(c.to_bits() == rc.to_bits() || (c.is_nan() && rc.is_nan()));
+            assert!(cos(x).to_bits() == c.to_bits() || (c.is_nan() && cos(x).is_nan()));
         }
     }
 }
