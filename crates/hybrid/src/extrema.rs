@@ -28,9 +28,10 @@ pub(crate) struct Clearance<'a> {
 
 impl Clearance<'_> {
     /// Whether `h_k` stays farther than the height from its surface (and on the side the mode
-    /// says) between two neighbouring samples `spacing` apart with values `a` and `b` on the
-    /// mode's side: the chord bent by `M_k spacing^2 / 8` stays above the height.
-    fn proves(&self, k: usize, a: f64, b: f64, spacing: f64) -> bool {
+    /// says) between two samples `spacing` apart with values `a` and `b` on the mode's side:
+    /// the chord bent by `M_k spacing^2 / 8` stays above the height (and zero). Used for a
+    /// sample interval and for a whole step between its ends.
+    pub fn proves(&self, k: usize, a: f64, b: f64, spacing: f64) -> bool {
         let lowest = a.min(b) - self.bounds[k] * spacing * spacing / 8.0;
         lowest > self.height && lowest > 0.0
     }

@@ -464,6 +464,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let bounded = self.settings.extremum_height.is_finite()
             && !self.proven_clear
             && self.curvature_bounds(mode, t0, t1, &mut bounds);
+        let clearance = bounded.then(|| Clearance {
+            height: self.settings.extremum_height,
+            bounds: &bounds[..self.surfaces],
+        });
         let clear = self.settings.extremum_height.is_finite() && {
             self.buffers.samples.sample_ends(
                 self.system,
@@ -473,7 +477,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 &self.buffers.z_start[..self.n],
                 &self.buffers.z_new[..self.n],
             )?;
-            self.proven_clear || (bounded && self.clear_of_surfaces(mode, t0, t1, &bounds))
+            self.proven_clear
+                || clearance
+                    .as_ref()
+                    .is_some_and(|clearance| self.clear_of_surfaces(mode, t0, t1, clearance))
         };
         if !clear {
             let system = self.system;
@@ -513,10 +520,6 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 grid,
                 &mut self.buffers.x,
             )?;
-            let clearance = bounded.then(|| Clearance {
-                height: self.settings.extremum_height,
-                bounds: &bounds[..self.surfaces],
-            });
             self.buffers.samples.locate_extrema(
                 system,
                 mode,
@@ -624,20 +627,20 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     }
 
     /// Whether the step `[t0, t1]` just sampled at its ends ([`Samples::sample_ends`]) stays
-    /// farther than `extremum_height` from every surface throughout: for each surface, the
-    /// smaller end value on the mode's side less `M_k (t1 - t0)^2 / 8` (the chord bent by the
-    /// curvature bound, `bounds` from [`Solver::curvature_bounds`]) must exceed the height
-    /// (and zero).
-    fn clear_of_surfaces(&self, mode: Mode, t0: f64, t1: f64, bounds: &[f64]) -> bool {
+    /// farther than the extremum height from every surface throughout: the chord between its
+    /// end values, bent by the curvature bound over the whole step, as
+    /// [`Clearance::proves`] tests a sample interval.
+    fn clear_of_surfaces(&self, mode: Mode, t0: f64, t1: f64, clearance: &Clearance) -> bool {
         let p = self.buffers.samples.points();
-        let dt = t1 - t0;
-        let height = self.settings.extremum_height;
+        let values = &self.buffers.samples.values;
         (0..self.surfaces).all(|k| {
             let side = side_sign(mode, k);
-            let ends = (side * self.buffers.samples.values[k * p])
-                .min(side * self.buffers.samples.values[k * p + p - 1]);
-            let lowest = ends - bounds[k] * dt * dt / 8.0;
-            lowest > height && lowest > 0.0
+            clearance.proves(
+                k,
+                side * values[k * p],
+                side * values[k * p + p - 1],
+                t1 - t0,
+            )
         })
     }
 
