@@ -10,8 +10,7 @@
 use crate::error::HybridError;
 use crate::event::{Extremum, ExtremumKind};
 use crate::event_location::{extremum_guess, locate_sign_change};
-use crate::solver::side_sign;
-use crate::system::{HybridSystem, Mode};
+use crate::system::{side_sign, HybridSystem, Mode};
 
 /// The state at time `t` inside the current step, written into the slice.
 pub(crate) type StateAt<'a> = dyn FnMut(f64, &mut [f64]) + 'a;

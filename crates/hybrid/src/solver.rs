@@ -95,7 +95,7 @@ use crate::event_location::{crossing_guess, locate_sign_change, Bracket, CubicHe
 use crate::extrema::Clearance;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
-use crate::system::{Direction, HybridSystem, Mode, MAX_SURFACES};
+use crate::system::{side_sign, Direction, HybridSystem, Mode, MAX_SURFACES};
 use crate::workspace::{Buffers, SolverWorkspace};
 
 /// Why [`Solver::step`] returned.
@@ -1613,16 +1613,6 @@ fn predict_crossing<S: HybridSystem + ?Sized>(
         }
     }
     earliest
-}
-
-/// `+1` if `mode` has `h_k` on its positive side, `-1` if on its negative side (bit `k` set):
-/// `side_sign * h_k` is positive on the current side of surface `k`.
-pub(crate) fn side_sign(mode: Mode, k: usize) -> f64 {
-    if mode & (1 << k) != 0 {
-        -1.0
-    } else {
-        1.0
-    }
 }
 
 /// The smallest positive root of `a s^2 + b s + c` (`c >= 0`), if any (finite values only).
