@@ -25,6 +25,14 @@ fn thread_cpu_seconds() -> Option<f64> {
 /// The reference: scipy `solve_ivp` with event location, seconds per drive cycle.
 const SCIPY_SECONDS_PER_CYCLE: f64 = 0.024;
 
+/// The value after `flag` on the command line, if the flag is given (a missing or unreadable
+/// value stops the benchmark with `usage`).
+fn flag_value<T: std::str::FromStr>(arguments: &[String], flag: &str, usage: &str) -> Option<T> {
+    let index = arguments.iter().position(|a| a == flag)?;
+    let value = arguments.get(index + 1).and_then(|v| v.parse().ok());
+    Some(value.unwrap_or_else(|| panic!("{flag} {usage}")))
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let case = builtin_case("biolever-mica").expect("built-in case");
@@ -36,34 +44,19 @@ fn main() {
     settings.settle_cycles = 0;
     let arguments: Vec<String> = std::env::args().collect();
     // `--from Z --to Z`: another window of the sweep, nm (to profile one impact regime).
-    for (flag, end) in [
-        ("--from", &mut settings.from_nm),
-        ("--to", &mut settings.to_nm),
-    ] {
-        if let Some(index) = arguments.iter().position(|a| a == flag) {
-            *end = arguments
-                .get(index + 1)
-                .and_then(|z| z.parse().ok())
-                .unwrap_or_else(|| panic!("{flag} Z"));
-        }
+    if let Some(z) = flag_value(&arguments, "--from", "Z") {
+        settings.from_nm = z;
+    }
+    if let Some(z) = flag_value(&arguments, "--to", "Z") {
+        settings.to_nm = z;
     }
     // `--samples N`: the solver's samples per step (extrema search), to weigh its cost.
-    if let Some(index) = arguments.iter().position(|a| a == "--samples") {
-        settings.integration.samples_per_step = arguments
-            .get(index + 1)
-            .and_then(|n| n.parse().ok())
-            .expect("--samples N");
-        println!(
-            "samples per step: {}",
-            settings.integration.samples_per_step
-        );
+    if let Some(samples) = flag_value(&arguments, "--samples", "N") {
+        settings.integration.samples_per_step = samples;
+        println!("samples per step: {samples}");
     }
     // `--tolerance X`: the contact integration's relative and absolute tolerance.
-    if let Some(index) = arguments.iter().position(|a| a == "--tolerance") {
-        let tolerance: f64 = arguments
-            .get(index + 1)
-            .and_then(|x| x.parse().ok())
-            .expect("--tolerance X");
+    if let Some(tolerance) = flag_value::<f64>(&arguments, "--tolerance", "X") {
         settings.integration.relative_tolerance = tolerance;
         settings.integration.absolute_tolerance = tolerance;
         println!("tolerance: {tolerance:e}");
