@@ -31,6 +31,99 @@ fn contact_state(model: &TappingModel) -> Vec<f64> {
     x
 }
 
+/// A five-mode cantilever: more modes than the model's compile-time special cases.
+fn five_mode_model() -> TappingModel {
+    let cantilever = common::cantilever(&[
+        (0.1, 3.5, 1.6, 1.0, 1.0),
+        (10.0, 28.0, 4.3, 5.26, -1.54),
+        (60.0, 80.0, 0.3, -2.0, 0.8),
+        (150.0, 160.0, 3.0, 1.5, -0.6),
+        (400.0, 300.0, 5.0, -1.2, 0.4),
+    ]);
+    TappingModel::new(
+        cantilever,
+        common::mica(),
+        20.0,
+        Some(3.3),
+        Separation::Constant(12.0),
+    )
+    .expect("model")
+}
+
+/// The model's structured variational field (`J v` without forming `J`) against the dense
+/// products of its own Jacobian (`linearisation` + `jacobian_products`), for 1, 2, 3 and 5
+/// modes, free flight and contact, with and without the parameter column: equal to rounding.
+#[test]
+fn variational_field_equals_the_dense_jacobian_products() {
+    let one_mode = TappingModel::new(
+        common::cantilever(&[(0.1, 3.5, 1.6, 1.0, 1.0)]),
+        common::mica(),
+        20.0,
+        Some(3.3),
+        Separation::Constant(12.0),
+    )
+    .expect("model");
+    for model in [
+        one_mode,
+        TappingModel::from_case(&afm::builtin_case("biolever-mica").expect("case")).expect("m"),
+        three_mode_model(Separation::Constant(12.0)),
+        five_mode_model(),
+    ] {
+        let n = model.dim();
+        let x = contact_state(&model);
+        let t = 0.37;
+        for mode in [FREE_FLIGHT, CONTACT] {
+            for parameter in [false, true] {
+                let columns = if parameter { n + 1 } else { n };
+                let tangents: Vec<f64> = (0..columns * n)
+                    .map(|i| ((i * 7919) % 97) as f64 / 97.0 - 0.5)
+                    .collect();
+                let mut buffers = hybrid::LinearisationBuffers::new(n);
+                let (mut field, mut rates) = (vec![0.0; n], vec![0.0; columns * n]);
+                model.variational_field(
+                    mode,
+                    t,
+                    &x,
+                    &mut field,
+                    &tangents,
+                    &mut rates,
+                    parameter,
+                    &mut buffers,
+                );
+                let (mut dense_field, mut dense_rates) = (vec![0.0; n], vec![0.0; columns * n]);
+                let mut jacobian = DMatrix::zeros(n, n);
+                let mut dfdp = vec![0.0; n];
+                model.linearisation(
+                    mode,
+                    t,
+                    &x,
+                    &mut dense_field,
+                    &mut jacobian,
+                    Some(&mut dfdp),
+                );
+                hybrid::sensitivity::jacobian_products(
+                    &jacobian,
+                    &tangents,
+                    &mut dense_rates,
+                    parameter.then_some(&dfdp[..]),
+                );
+                assert_eq!(field, dense_field, "field, {} modes", n / 2);
+                // Both sum the same terms in different orders: agreement to a few roundings of
+                // the largest term, |J| |v| with |v| <= 0.5.
+                let scale =
+                    jacobian.amax() * 0.5 * n as f64 + dfdp.iter().fold(0.0, |m, d| d.abs().max(m));
+                for (r, (a, b)) in rates.iter().zip(&dense_rates).enumerate() {
+                    assert!(
+                        (a - b).abs() <= 1e-14 * scale,
+                        "{} modes, mode {mode}, parameter {parameter}, entry {r}: {a} vs {b}",
+                        n / 2
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn jacobian_and_parameter_derivative_match_finite_differences() {
     for model in [

@@ -38,7 +38,7 @@ pub mod workspace;
 pub use error::HybridError;
 pub use event::{Event, Extremum, ExtremumKind};
 pub use flow_map::{flow_map, flow_map_observed, FlowMap};
-pub use sensitivity::Sensitivity;
+pub use sensitivity::{LinearisationBuffers, Sensitivity};
 pub use settings::Settings;
 pub use solver::{Solver, Statistics, StepOutcome};
 pub use system::{Direction, HybridSystem, Mode, SwitchingPartials, MAX_SURFACES};

@@ -43,13 +43,32 @@ impl Sensitivity {
     }
 }
 
+/// Scratch space for the Jacobian `J = df/dx` (`n x n`) and `df/dp` (length `n`) of one point,
+/// in which the default [`HybridSystem::variational_field`] forms them.
+#[derive(Debug, Clone)]
+pub struct LinearisationBuffers {
+    /// `df/dx`, `n x n`.
+    pub jacobian: DMatrix<f64>,
+    /// `df/dp`, length `n`.
+    pub dfdp: Vec<f64>,
+}
+
+impl LinearisationBuffers {
+    /// Zeroed buffers for a system of dimension `n`.
+    pub fn new(n: usize) -> Self {
+        Self {
+            jacobian: DMatrix::zeros(n, n),
+            dfdp: vec![0.0; n],
+        }
+    }
+}
+
 /// The augmented right-hand side `[f, J Phi, J s + df/dp]` of one mode, with preallocated
-/// Jacobian and `df/dp` buffers and a count of vector-field evaluations.
+/// linearisation buffers and a count of vector-field evaluations.
 pub(crate) struct VariationalField {
     n: usize,
     sensitivity: Sensitivity,
-    jacobian: DMatrix<f64>,
-    dfdp: Vec<f64>,
+    buffers: LinearisationBuffers,
     /// Number of calls of `HybridSystem::vector_field` made through this object.
     pub evaluations: usize,
 }
@@ -59,8 +78,7 @@ impl VariationalField {
         Self {
             n,
             sensitivity,
-            jacobian: DMatrix::zeros(n, n),
-            dfdp: vec![0.0; n],
+            buffers: LinearisationBuffers::new(n),
             evaluations: 0,
         }
     }
@@ -88,31 +106,41 @@ impl VariationalField {
             system.vector_field(mode, t, &z[..n], &mut dz[..n]);
             return;
         }
+        // The columns of Phi (and s) follow the state, column-major and contiguous.
         let parameter = self.sensitivity.parameter();
-        let (dx, dvar) = dz.split_at_mut(n);
-        system.linearisation(
+        let columns = if parameter { n + 1 } else { n };
+        let (x, tangents) = z.split_at(n);
+        let (dx, tangent_rates) = dz.split_at_mut(n);
+        system.variational_field(
             mode,
             t,
-            &z[..n],
+            x,
             dx,
-            &mut self.jacobian,
-            parameter.then_some(&mut self.dfdp[..]),
+            &tangents[..columns * n],
+            &mut tangent_rates[..columns * n],
+            parameter,
+            &mut self.buffers,
         );
-        // Phi' = J Phi and s' = J s + df/dp, column by column (column-major storage; the
-        // columns of Phi and s are contiguous): small dense products written out, with fixed
-        // sizes for the common small systems (unrolled by the compiler).
-        let columns = if parameter { n + 1 } else { n };
-        let j = self.jacobian.as_slice();
-        let dfdp = parameter.then_some(&self.dfdp[..]);
-        let input = &z[n..n + columns * n];
-        let out = &mut dvar[..columns * n];
-        match n {
-            2 => products::<2>(j, input, out, dfdp),
-            4 => products::<4>(j, input, out, dfdp),
-            6 => products::<6>(j, input, out, dfdp),
-            8 => products::<8>(j, input, out, dfdp),
-            _ => products_any(n, j, input, out, dfdp),
-        }
+    }
+}
+
+/// `tangent_rates[:, c] = J tangents[:, c]` for every column `c` (column-major, `n` rows),
+/// plus `dfdp` on the last column if given: the variational right-hand side with a dense
+/// Jacobian (`n^2` multiply-adds per column), written out with fixed sizes for the common small
+/// systems (unrolled by the compiler).
+pub fn jacobian_products(
+    jacobian: &DMatrix<f64>,
+    tangents: &[f64],
+    tangent_rates: &mut [f64],
+    dfdp: Option<&[f64]>,
+) {
+    let j = jacobian.as_slice();
+    match jacobian.nrows() {
+        2 => products::<2>(j, tangents, tangent_rates, dfdp),
+        4 => products::<4>(j, tangents, tangent_rates, dfdp),
+        6 => products::<6>(j, tangents, tangent_rates, dfdp),
+        8 => products::<8>(j, tangents, tangent_rates, dfdp),
+        n => products_any(n, j, tangents, tangent_rates, dfdp),
     }
 }
 

@@ -25,6 +25,8 @@
 
 use nalgebra::DMatrix;
 
+use crate::sensitivity::{jacobian_products, LinearisationBuffers};
+
 /// Which side of every switching surface a state lies on: bit `k` is set when `h_k < 0`.
 ///
 /// With at most 32 surfaces, a `u32` names every region of state space.
@@ -92,8 +94,9 @@ pub trait HybridSystem {
         dfdp.fill(0.0);
     }
 
-    /// The field, its Jacobian and (if `dfdp` is `Some`) its parameter derivative at one point:
-    /// what the variational equations need per evaluation. The default calls
+    /// The field, its Jacobian and (if `dfdp` is `Some`) its parameter derivative at one point,
+    /// from which the default [`HybridSystem::variational_field`] forms the variational
+    /// equations' right-hand side. The default calls
     /// [`HybridSystem::vector_field`], [`HybridSystem::jacobian`] and
     /// [`HybridSystem::parameter_derivative`]; override it (with the same results) when the
     /// three share expensive work, such as a contact force and its slope.
@@ -111,6 +114,47 @@ pub trait HybridSystem {
         if let Some(dfdp) = dfdp {
             self.parameter_derivative(mode, t, x, dfdp);
         }
+    }
+
+    /// The right-hand side of the variational equations at one point: the field `f_m(t, x)`
+    /// into `dxdt`, and `J v` (`J = df_m/dx`) for every column `v` of `tangents` into the same
+    /// column of `tangent_rates` (both column-major with `n` rows, as many columns as
+    /// `tangents.len() / n`), plus `df_m/dp` on the last column when `parameter_column` is
+    /// true: `Phi' = J Phi` for the transition matrix and `s' = J s + df/dp` for the parameter
+    /// sensitivity (Hairer, Norsett, Wanner I, Sec. I.14).
+    ///
+    /// The default forms `J` and `df/dp` with [`HybridSystem::linearisation`] in `buffers` and
+    /// multiplies (`n^2` multiply-adds per column). Override it, with the same results up to
+    /// rounding, when `J` has a structure that makes the products cheaper (a mechanical system's
+    /// `[[0, I], [-K, -C]]` blocks with a low-rank contact coupling); `buffers` is then free
+    /// scratch space.
+    #[allow(clippy::too_many_arguments)]
+    fn variational_field(
+        &self,
+        mode: Mode,
+        t: f64,
+        x: &[f64],
+        dxdt: &mut [f64],
+        tangents: &[f64],
+        tangent_rates: &mut [f64],
+        parameter_column: bool,
+        buffers: &mut LinearisationBuffers,
+    ) {
+        let LinearisationBuffers { jacobian, dfdp } = buffers;
+        self.linearisation(
+            mode,
+            t,
+            x,
+            dxdt,
+            jacobian,
+            parameter_column.then_some(&mut dfdp[..]),
+        );
+        jacobian_products(
+            jacobian,
+            tangents,
+            tangent_rates,
+            parameter_column.then_some(&dfdp[..]),
+        );
     }
 
     /// The switching function `h_k(t, x)`; the surface is `h_k = 0`.
