@@ -591,6 +591,11 @@ impl HybridSystem for TappingModel {
         self.gap_rate(x)
     }
 
+    /// The gap `Z(t) + sum_i q_i` is affine: `Z(t)` is a constant or a linear ramp.
+    fn switching_is_affine(&self, _k: usize) -> bool {
+        true
+    }
+
     /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'`; `dh/dt|_x = Z'(t)`; `dh/dZ = 1`.
     fn switching_gradient(
         &self,
@@ -627,7 +632,7 @@ impl HybridSystem for TappingModel {
     /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
     /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
     /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
-    /// (contacts are always sampled).
+    /// (extrema inside the sample, the gap's minima, are always wanted).
     fn switching_curvature_bound(
         &self,
         _k: usize,

@@ -157,8 +157,9 @@ impl SweepSettings {
             integration: Settings {
                 relative_tolerance: DEFAULT_TOLERANCE,
                 absolute_tolerance: DEFAULT_TOLERANCE,
-                // The lock-in reads only gap minima in contact, which are always sampled: free
-                // flight proven clear of the sample is not searched for extrema.
+                // The lock-in reads only gap minima in contact, which are found at any height
+                // (they lie inside the sample): free flight proven clear of the sample is not
+                // searched for extrema.
                 extremum_height: 0.0,
                 samples_per_step: SAMPLES_PER_STEP,
                 ..Settings::default()

@@ -135,6 +135,22 @@ fn combine(out: &mut [f64], z: &[f64], stages: &[f64], weights: &[f64], h: f64) 
     }
 }
 
+/// `p <- theta p` for the power-basis polynomial `p` of degree `degree` (`p` long enough).
+fn times_theta(p: &mut [f64], degree: usize) {
+    for i in (0..=degree).rev() {
+        p[i + 1] = p[i];
+    }
+    p[0] = 0.0;
+}
+
+/// `p <- (1 - theta) p` for the power-basis polynomial `p` of degree `degree`.
+fn times_one_minus_theta(p: &mut [f64], degree: usize) {
+    p[degree + 1] = 0.0;
+    for i in (1..=degree + 1).rev() {
+        p[i] -= p[i - 1];
+    }
+}
+
 impl Dop853 {
     pub fn new(dim: usize, controlled: usize, variational_tolerance: Option<f64>) -> Self {
         Self {
@@ -325,6 +341,44 @@ impl Dop853 {
         }
     }
 
+    /// The power-basis coefficients in `theta` (`[c_0, ..., c_7]`, `c_j` multiplying
+    /// `theta^j`, `c_0 = 0`) of `sum_c w_c (y_c(theta) - y_c(0))`, the weighted sum of the
+    /// dense-output polynomials of the components `c < weights.len()` less their values at the
+    /// step start: the interpolant of a switching function affine in the state. Components
+    /// with weight zero are skipped.
+    pub fn dense_polynomial(&self, weights: &[f64]) -> [f64; DENSE_COEFFICIENTS + 1] {
+        // The weighted nested coefficients e_j = sum_c w_c d_j[c].
+        let mut e = [0.0; DENSE_COEFFICIENTS];
+        for (&w, d) in weights
+            .iter()
+            .zip(self.dense.chunks_exact(DENSE_COEFFICIENTS))
+        {
+            if w != 0.0 {
+                for (ej, &dj) in e.iter_mut().zip(d) {
+                    *ej += w * dj;
+                }
+            }
+        }
+        // Expand theta (e0 + s (e1 + theta (e2 + s (e3 + theta (e4 + s (e5 + theta e6))))))
+        // with s = 1 - theta from the inside out, in the power basis: before e_j is added the
+        // bracket so far is multiplied by theta (odd j) or by s (even j), and the whole by
+        // theta at the end.
+        let mut p = [0.0; DENSE_COEFFICIENTS + 1];
+        p[0] = e[DENSE_COEFFICIENTS - 1];
+        let mut degree = 0;
+        for j in (0..DENSE_COEFFICIENTS - 1).rev() {
+            if j % 2 == 1 {
+                times_theta(&mut p, degree);
+            } else {
+                times_one_minus_theta(&mut p, degree);
+            }
+            degree += 1;
+            p[0] += e[j];
+        }
+        times_theta(&mut p, degree);
+        p
+    }
+
     /// Dense output at `theta = (t - t0) / h` in `[0, 1]` for components `0..out.len()`:
     /// `z0 + theta (d0 + (1-theta) (d1 + theta (d2 + (1-theta) (d3 + theta (d4 + (1-theta)
     /// (d5 + theta d6))))))` (Hairer's `contd8`).
@@ -406,6 +460,32 @@ impl Dop853 {
 
 #[cfg(test)]
 mod tests {
+
+    /// The power-basis form of a weighted sum of dense outputs equals the nested form
+    /// (`dense_increment`) it was expanded from, at points across the step.
+    #[test]
+    fn dense_polynomial_equals_the_nested_dense_output() {
+        let mut stepper = Dop853::new(3, 3, None);
+        for (i, d) in stepper.dense.iter_mut().enumerate() {
+            *d = ((i * 37) % 11) as f64 / 11.0 - 0.4;
+        }
+        let weights = [1.0, 0.0, -2.5];
+        let power = stepper.dense_polynomial(&weights);
+        assert_eq!(power[0], 0.0);
+        for theta in [0.0, 0.2, 0.5, 0.77, 1.0, 1.3] {
+            let nested: f64 = weights
+                .iter()
+                .enumerate()
+                .map(|(c, w)| w * stepper.dense_increment(c, theta))
+                .sum();
+            let expanded = power.iter().rev().fold(0.0, |acc, &a| acc * theta + a);
+            assert!(
+                (nested - expanded).abs() < 1e-13,
+                "theta {theta}: {nested} vs {expanded}"
+            );
+        }
+    }
+
     use super::*;
 
     /// Harmonic oscillator `y1' = y2, y2' = -y1`, exact `y = (cos t, -sin t)` from `(1, 0)`.

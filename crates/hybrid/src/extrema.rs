@@ -26,13 +26,14 @@ pub(crate) struct Clearance<'a> {
 }
 
 impl Clearance<'_> {
-    /// Whether `h_k` stays farther than the height from its surface (and on the side the mode
-    /// says) between two samples `spacing` apart with values `a` and `b` on the mode's side:
-    /// the chord bent by `M_k spacing^2 / 8` stays above the height (and zero). Used for a
-    /// sample interval and for a whole step between its ends.
-    pub fn proves(&self, k: usize, a: f64, b: f64, spacing: f64) -> bool {
+    /// Whether `h_k` stays above the height (and zero) between two samples `spacing` apart
+    /// with values `a` and `b`, in a mode on the positive side of surface `k` (`side = 1`):
+    /// the chord bent by `M_k spacing^2 / 8` stays above. On the negative side (inside a
+    /// contact) nothing is proven: every extremum there is wanted. Used for a sample interval
+    /// and for a whole step between its ends.
+    pub fn proves(&self, k: usize, side: f64, a: f64, b: f64, spacing: f64) -> bool {
         let lowest = a.min(b) - self.bounds[k] * spacing * spacing / 8.0;
-        lowest > self.height && lowest > 0.0
+        side > 0.0 && lowest > self.height && lowest > 0.0
     }
 }
 
@@ -232,8 +233,9 @@ impl Samples {
                 if clearance.as_ref().is_some_and(|clearance| {
                     clearance.proves(
                         k,
-                        side * self.values[k * p + i],
-                        side * self.values[k * p + i + 1],
+                        side,
+                        self.values[k * p + i],
+                        self.values[k * p + i + 1],
                         self.times[i + 1] - self.times[i],
                     )
                 }) {

@@ -15,11 +15,14 @@
 //!
 //! Tuning ([`Settings`]): the cost of a step is its right-hand-side evaluations (15 per
 //! accepted DOP853 step, 11 per rejected one) plus `samples_per_step + 1` evaluations of the
-//! interpolant and of every `h_k`, `dh_k/dt`, and a few more per extremum and event. With
+//! interpolant and of every `h_k`, `dh_k/dt`, and a few more per extremum and event (a step
+//! proven to hold no extremum is sampled at its ends only: see
+//! [`HybridSystem::switching_is_affine`] and [`Settings::extremum_height`]). With
 //! sensitivities, `sensitivity_tolerance` trades accuracy of the transition matrix against
 //! steps where the Jacobian is not smooth (Hertz contact); see its documentation.
 #![warn(missing_docs)]
 
+mod bernstein;
 mod clock;
 mod dop853;
 pub mod error;

@@ -51,16 +51,19 @@ pub struct Settings {
     /// evaluations than stepping in time (see [`crate::solver`]).
     /// Allowed: `1e-16 ..= 1`. Default `None`.
     pub sensitivity_tolerance: Option<f64>,
-    /// How far from a surface extrema must still be found, in switching-function units.
-    /// Every step is sampled inside and its extrema located, except a step that the system
-    /// proves farther than this from every surface throughout (by
-    /// [`crate::HybridSystem::switching_curvature_bound`]): such a step is sampled at its ends
-    /// only and reports no extrema; likewise, an extremum between two samples that the bound
-    /// proves farther than this is neither located nor reported. Crossings are found either
-    /// way. `INFINITY` (the default)
-    /// reports every extremum, as observables of an orbit need; a time-domain sweep or a
-    /// Newton iteration that only needs the crossings sets it to 0. Allowed: `>= 0` (infinity
-    /// allowed).
+    /// How far above a surface (on the positive side of `h_k`) extrema must still be found, in
+    /// switching-function units; on the negative side (inside a contact) every extremum is
+    /// found. Every step is sampled inside and its extrema located, except a step that the
+    /// system proves above this height throughout (by
+    /// [`crate::HybridSystem::switching_curvature_bound`], or for an affine `h_k` by the
+    /// Bernstein bound of its interpolant): such a step is sampled at its ends only and reports
+    /// no extrema; likewise, an extremum between two samples that the curvature bound proves
+    /// above the height is neither located nor reported. Crossings are found either way.
+    /// `INFINITY` (the default) reports every extremum, as observables of an orbit need; a
+    /// time-domain sweep or a Newton iteration that needs only the crossings and the extrema
+    /// inside contact sets it to 0. (A step whose affine `h_k` are all proven strictly
+    /// monotone is not sampled inside at any height: it holds no extremum.) Allowed: `>= 0`
+    /// (infinity allowed).
     pub extremum_height: f64,
 }
 

@@ -30,14 +30,24 @@
 //!   (a minimum and a maximum between the same two samples) are not seen, and nor is a dip
 //!   through a surface that lies between them.
 //! * Steps proven clear. With a finite `Settings::extremum_height` and a system that bounds
-//!   `|h_k''|` ([`HybridSystem::switching_curvature_bound`]), a step whose chord between its
-//!   end values stays farther than the height from every surface even when bent by
-//!   `M dt^2 / 8` is sampled at its ends only, and reports no extrema; an exact-flow step is
+//!   `|h_k''|` ([`HybridSystem::switching_curvature_bound`]), a step on the positive side of
+//!   every surface whose chord between its end values stays above the height even when bent
+//!   by `M dt^2 / 8` is sampled at its ends only, and reports no extrema; an exact-flow step is
 //!   stretched (beyond `exact_step_limit`) as far as `h_k(t0) + h_k'(t0) s - M s^2 / 2` stays
 //!   above the height. In a step that is sampled, a sample interval whose chord bent by
 //!   `M spacing^2 / 8` stays above the height is not searched for an extremum (free flight
 //!   between contacts, whose gap minima clear the sample). None of these can hide a crossing:
 //!   the bound is rigorous.
+//! * Steps settled on their interpolant. Where every `h_k` is affine in the state and time
+//!   ([`HybridSystem::switching_is_affine`]), its interpolant over a Runge-Kutta step is a
+//!   polynomial of degree 7 in the step's clock, and the Bernstein coefficients of it and of
+//!   its derivative bound them on the whole step (`crate::bernstein`). A step on which every
+//!   `h_k` is proven strictly monotone (both end rates of that sign too), or above the surface
+//!   and the extremum height, is sampled at its ends only: it holds no extremum the samples
+//!   could find, and at most one crossing per surface, which the signs at its ends show and
+//!   which is located on the interpolant as usual. Inside a Hertz contact every step but the
+//!   one holding the deepest indentation is monotone. The bound is rigorous for the
+//!   interpolant, which is what sampling inspects too.
 //!
 //! # Step-size control
 //!
@@ -87,6 +97,7 @@
 
 use nalgebra::{DMatrix, DMatrixView};
 
+use crate::bernstein::{stays_above, strict_sign};
 use crate::clock::Clock;
 use crate::dop853::Dop853;
 use crate::error::HybridError;
@@ -124,6 +135,10 @@ pub struct Statistics {
     pub rhs_evaluations: usize,
     /// Events fired.
     pub events: usize,
+    /// Steps sampled inside (at `samples_per_step` interior points) for extrema and brief
+    /// dips; the others were proven clear of the surfaces or settled on their interpolant and
+    /// sampled at their ends only (see the module docs).
+    pub sampled_steps: usize,
 }
 
 /// What produced the last step, for interpolation.
@@ -171,6 +186,9 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// Whether the last step was proven clear of every surface before it was taken (an exact
     /// step inside the span of [`Solver::clear_exact_span`], stretched or not).
     proven_clear: bool,
+    /// Whether every switching function is affine (gradients and drifts in the buffers), so
+    /// that a Runge-Kutta step may be proven settled on its interpolant.
+    affine_switching: bool,
     statistics: Statistics,
 }
 
@@ -234,6 +252,18 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         buffers.flow_transition.fill_with_identity();
         buffers.reset_dxdp.fill(0.0);
         buffers.flow_dxdp.fill(0.0);
+        let affine_switching = (0..surfaces).all(|k| system.switching_is_affine(k));
+        if affine_switching {
+            for k in 0..surfaces {
+                let partials = system.switching_gradient(
+                    k,
+                    t0,
+                    x0,
+                    &mut buffers.affine_gradients[k * n..(k + 1) * n],
+                );
+                buffers.affine_drifts[k] = partials.t;
+            }
+        }
         let mut solver = Self {
             system,
             sensitivity,
@@ -257,6 +287,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             step_end: t0,
             full_dense: false,
             proven_clear: false,
+            affine_switching,
             statistics: Statistics::default(),
             settings,
         };
@@ -468,7 +499,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             height: self.settings.extremum_height,
             bounds: &bounds[..self.surfaces],
         });
-        let clear = self.settings.extremum_height.is_finite() && {
+        // A Runge-Kutta step with affine switching functions may be proven settled on its
+        // interpolant, whatever the height.
+        let polynomial = self.affine_switching && self.kind == StepKind::RungeKutta;
+        let clear = (self.settings.extremum_height.is_finite() || polynomial) && {
             self.buffers.samples.sample_ends(
                 self.system,
                 mode,
@@ -481,8 +515,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 || clearance
                     .as_ref()
                     .is_some_and(|clearance| self.clear_of_surfaces(mode, t0, t1, clearance))
+                || (polynomial && self.interpolant_settled(mode))
         };
         if !clear {
+            self.statistics.sampled_steps += 1;
             let system = self.system;
             let n = self.n;
             let kind = self.kind;
@@ -586,7 +622,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 &self.buffers.z_start[..self.n],
                 longest,
             )?;
-            if !(margin > 0.0 && bound >= 0.0 && bound.is_finite() && rate.is_finite()) {
+            if !(side > 0.0
+                && margin > 0.0
+                && bound >= 0.0
+                && bound.is_finite()
+                && rate.is_finite())
+            {
                 return None;
             }
             // The positive root of margin + rate s - bound s^2 / 2, in the form without
@@ -603,6 +644,53 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             span = span.min(clear * (1.0 - 1e-9));
         }
         Some(span)
+    }
+
+    /// Whether the Runge-Kutta step just taken (sampled at its ends, [`Samples::sample_ends`])
+    /// is proven, on its interpolant, to hold nothing that interior samples would find: for
+    /// every surface either `side h_k` stays above the extremum height (and zero) on the whole
+    /// step, or `h_k` is strictly monotone with both end rates of that sign (no extremum; a
+    /// crossing shows in the signs at the ends). The interpolant of an affine `h_k` is
+    /// `h_k(t0) + g . (x(theta) - x0) + b (t(theta) - t0)`, a polynomial of degree 7 in the
+    /// clock fraction `theta` (`t(theta)` is linear on the time clock and quadratic on a
+    /// square-root clock, whose `sigma` keeps one sign over a step); its range and that of its
+    /// derivative are bounded by their Bernstein coefficients.
+    fn interpolant_settled(&self, mode: Mode) -> bool {
+        let n = self.n;
+        let p = self.buffers.samples.points();
+        let height = self.settings.extremum_height;
+        let rk = &self.buffers.rk;
+        // t(theta) - t0 = linear theta + quadratic theta^2.
+        let (linear, quadratic) = match self.clock {
+            Clock::Time => (rk.h, 0.0),
+            Clock::SquareRoot { .. } => {
+                let (sigma0, dsigma) = (self.sigma_start, rk.h);
+                let sign = (sigma0 + 0.5 * dsigma).signum();
+                (sign * 2.0 * sigma0 * dsigma, sign * dsigma * dsigma)
+            }
+        };
+        (0..self.surfaces).all(|k| {
+            let samples = &self.buffers.samples;
+            let mut power = rk.dense_polynomial(&self.buffers.affine_gradients[k * n..(k + 1) * n]);
+            power[0] = samples.values[k * p];
+            let drift = self.buffers.affine_drifts[k];
+            power[1] += drift * linear;
+            power[2] += drift * quadratic;
+            // Above the surface (positive side) and the height throughout: nothing wanted.
+            if side_sign(mode, k) > 0.0
+                && height.is_finite()
+                && stays_above(&power, height.max(0.0))
+            {
+                return true;
+            }
+            let mut derivative = [0.0; 7];
+            for (j, d) in derivative.iter_mut().enumerate() {
+                *d = (j + 1) as f64 * power[j + 1];
+            }
+            let (start_rate, end_rate) = (samples.rates[k * p], samples.rates[k * p + p - 1]);
+            strict_sign(&derivative)
+                .is_some_and(|sign| sign * start_rate > 0.0 && sign * end_rate > 0.0)
+        })
     }
 
     /// The system's bound `M_k` on `|h_k''|` over the step `[t0, t1]` for every surface
@@ -634,11 +722,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let p = self.buffers.samples.points();
         let values = &self.buffers.samples.values;
         (0..self.surfaces).all(|k| {
-            let side = side_sign(mode, k);
             clearance.proves(
                 k,
-                side * values[k * p],
-                side * values[k * p + p - 1],
+                side_sign(mode, k),
+                values[k * p],
+                values[k * p + p - 1],
                 t1 - t0,
             )
         })

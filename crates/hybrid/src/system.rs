@@ -176,6 +176,21 @@ pub trait HybridSystem {
         gradient: &mut [f64],
     ) -> SwitchingPartials;
 
+    /// Whether `h_k` is affine in the state and in time, `h_k(t, x) = g . x + b t + c` with
+    /// `g` and `b` constant (as [`HybridSystem::switching_gradient`] gives them, read once per
+    /// solver). The default is `false`.
+    ///
+    /// Over a Runge-Kutta step the interpolant of such an `h_k` is a polynomial in the step's
+    /// clock, and the solver bounds it through its Bernstein coefficients: a step on which
+    /// every surface's `h_k` is proven strictly monotone (no extremum; a crossing shows in the
+    /// signs at the ends) or farther than [`crate::Settings::extremum_height`] from its
+    /// surface is not sampled inside. A gap `Z(t) + sum_i q_i` with a constant or linear
+    /// `Z(t)` is affine.
+    fn switching_is_affine(&self, k: usize) -> bool {
+        let _ = k;
+        false
+    }
+
     /// Whether reaching surface `k` in `direction` applies a reset map (a hard impact) rather
     /// than a plain crossing. The default is `false` for every surface.
     fn has_reset(&self, k: usize, direction: Direction) -> bool {

@@ -77,6 +77,11 @@ pub(crate) struct Buffers {
     pub flow_transition: DMatrix<f64>,
     pub flow_dxdp: Vec<f64>,
     pub product: DMatrix<f64>,
+    /// `grad_x h_k` of every surface (`k n .. (k + 1) n`) when all are affine
+    /// ([`crate::HybridSystem::switching_is_affine`]).
+    pub affine_gradients: Vec<f64>,
+    /// `dh_k/dt` at fixed state of every surface when all are affine.
+    pub affine_drifts: Vec<f64>,
 }
 
 impl Buffers {
@@ -120,6 +125,8 @@ impl Buffers {
             flow_transition: DMatrix::identity(n, n),
             flow_dxdp: vec![0.0; n],
             product: DMatrix::zeros(n, n),
+            affine_gradients: vec![0.0; surfaces * n],
+            affine_drifts: vec![0.0; surfaces],
         }
     }
 

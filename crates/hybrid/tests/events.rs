@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{ForcedOscillator, Rotation};
+use common::{ForcedOscillator, HertzOscillator, Rotation};
 use hybrid::{flow_map, Direction, ExtremumKind, Sensitivity, Settings, Solver, StepOutcome};
 
 /// `h = c - cos(t - t_c)` with `c = 1 - 1e-6`: `h` dips below zero for `2 acos(c) = 2.8e-3`
@@ -23,6 +23,7 @@ fn brief_dip_found_through_its_minimum_exact_flow() {
         t_c: 1.05,
         exact_flow_limit: Some(1.5),
         curvature_bound: false,
+        affine: false,
     };
     check_dip(&system, 1e-11, 1e-15);
 }
@@ -30,15 +31,22 @@ fn brief_dip_found_through_its_minimum_exact_flow() {
 /// The same dip with DOP853 steps (no step limit): the steps are ~0.2 long, 70 times the dip.
 /// The state is accurate to ~1e-12, so crossing times are good to ~1e-12 / 1.4e-3 = 7e-10
 /// (asserted 1e-8) and the minimum value to ~1e-12 (asserted 1e-11).
+///
+/// Declared affine, `h`'s interpolant is bounded on each step instead of sampled where its
+/// Bernstein coefficients prove it monotone: the step holding the dip is not, so it is found
+/// all the same.
 #[test]
 fn brief_dip_found_through_its_minimum_runge_kutta() {
-    let system = Rotation {
-        c: 1.0 - 1e-6,
-        t_c: 1.05,
-        exact_flow_limit: None,
-        curvature_bound: false,
-    };
-    check_dip(&system, 1e-8, 1e-11);
+    for affine in [false, true] {
+        let system = Rotation {
+            c: 1.0 - 1e-6,
+            t_c: 1.05,
+            exact_flow_limit: None,
+            curvature_bound: false,
+            affine,
+        };
+        check_dip(&system, 1e-8, 1e-11);
+    }
 }
 
 fn check_dip(system: &Rotation, time_tolerance: f64, value_tolerance: f64) {
@@ -91,12 +99,18 @@ fn check_dip(system: &Rotation, time_tolerance: f64, value_tolerance: f64) {
 /// so step boundaries land on extrema: each must still be reported exactly once.
 #[test]
 fn events_and_extrema_fire_exactly_once() {
-    for limit in [Some(PI / 4.0), Some(1.0), None] {
+    for (limit, affine) in [
+        (Some(PI / 4.0), false),
+        (Some(1.0), false),
+        (None, false),
+        (None, true),
+    ] {
         let system = Rotation {
             c: 0.3,
             t_c: 0.0,
             exact_flow_limit: limit,
             curvature_bound: false,
+            affine,
         };
         let result = flow_map(
             &system,
@@ -199,7 +213,7 @@ fn exact_flow_matches_runge_kutta() {
 /// Step boundaries placed on the extrema themselves: `h = 2 - cos t` (never crossed) has
 /// extrema at `k pi`. (a) exact-flow steps of `pi/4` from t = 0 end on every extremum (to
 /// rounding); (b) DOP853 steps driven with `step(t_end)` for `t_end = pi, 2 pi, ...` end
-/// exactly there (then on to `20 pi + 0.5`). Either way each of the 20 extrema in
+/// exactly there (then on to `20 pi + 0.5`), with `h` declared affine or not. Either way each of the 20 extrema in
 /// `(0, 20 pi + 0.5]` is reported exactly once, at `k pi` to 1e-9.
 #[test]
 fn extrema_on_step_boundaries_are_reported_once() {
@@ -208,6 +222,7 @@ fn extrema_on_step_boundaries_are_reported_once() {
         t_c: 0.0,
         exact_flow_limit: Some(PI / 4.0),
         curvature_bound: false,
+        affine: false,
     };
     let result = flow_map(
         &exact,
@@ -221,37 +236,43 @@ fn extrema_on_step_boundaries_are_reported_once() {
     assert!(result.events.is_empty());
     check_extrema_at_multiples_of_pi(&result.extrema, 20);
 
-    let rk = Rotation {
-        exact_flow_limit: None,
-        curvature_bound: false,
-        ..exact
-    };
-    let mut solver = Solver::new(
-        &rk,
-        0.0,
-        &rk.initial_state(),
-        Sensitivity::None,
-        Settings::default(),
-    )
-    .expect("valid");
-    let mut extrema = Vec::new();
-    for k in 1..=21 {
-        // The numerical phase error (~1e-12) may put an extremum just after a t_end, so the
-        // run goes on past the 20th extremum.
-        let t_end = if k == 21 {
-            20.0 * PI + 0.5
-        } else {
-            PI * k as f64
+    // (b) with h sampled in every step, and declared affine (steps on which its interpolant
+    // is proven monotone are not sampled inside: an extremum at a step's end must still be
+    // reported once).
+    for affine in [false, true] {
+        let rk = Rotation {
+            exact_flow_limit: None,
+            curvature_bound: false,
+            affine,
+            ..exact
         };
-        loop {
-            let outcome = solver.step(t_end).expect("integration succeeds");
-            extrema.extend_from_slice(solver.step_extrema());
-            if outcome == StepOutcome::EndTime {
-                break;
+        let mut solver = Solver::new(
+            &rk,
+            0.0,
+            &rk.initial_state(),
+            Sensitivity::None,
+            Settings::default(),
+        )
+        .expect("valid");
+        let mut extrema = Vec::new();
+        for k in 1..=21 {
+            // The numerical phase error (~1e-12) may put an extremum just after a t_end, so
+            // the run goes on past the 20th extremum.
+            let t_end = if k == 21 {
+                20.0 * PI + 0.5
+            } else {
+                PI * k as f64
+            };
+            loop {
+                let outcome = solver.step(t_end).expect("integration succeeds");
+                extrema.extend_from_slice(solver.step_extrema());
+                if outcome == StepOutcome::EndTime {
+                    break;
+                }
             }
         }
+        check_extrema_at_multiples_of_pi(&extrema, 20);
     }
-    check_extrema_at_multiples_of_pi(&extrema, 20);
 }
 
 fn check_extrema_at_multiples_of_pi(extrema: &[hybrid::Extremum], count: usize) {
@@ -287,6 +308,7 @@ fn exact_grazing_never_loops() {
             t_c,
             exact_flow_limit: limit,
             curvature_bound: false,
+            affine: false,
         };
         let result = flow_map(
             &system,
@@ -341,6 +363,7 @@ fn step_to_current_time_reports_nothing() {
         t_c: 0.0,
         exact_flow_limit: Some(3.0),
         curvature_bound: false,
+        affine: false,
     };
     let mut solver = Solver::new(
         &system,
@@ -453,6 +476,7 @@ fn steps_clear_of_the_surface_skip_sampling_but_no_crossing() {
             t_c: 1.05,
             exact_flow_limit: limit,
             curvature_bound: true,
+            affine: false,
         };
         let run = |height: f64| {
             let settings = Settings {
@@ -496,5 +520,60 @@ fn steps_clear_of_the_surface_skip_sampling_but_no_crossing() {
         // A height above the maxima's value reports them again.
         let high = run(2.5);
         assert_eq!(count(&high, ExtremumKind::Maximum), 6);
+    }
+}
+
+/// Hertz contact from rest over 3 drive periods (5 crossings, contact minima inside the
+/// obstacle, maxima and minima in free flight), with every extremum wanted (the default
+/// height): declaring the affine gap lets the solver skip the interior sampling of the steps on
+/// which the Bernstein bound proves the gap monotone, and changes nothing else. The events and
+/// extrema are those of the fully sampled run, times within 1e-12 (both locate the same roots
+/// of the same interpolants, to the event tolerance) and values within 1e-14; the state at the
+/// end is the same to rounding (the steps are the same).
+#[test]
+fn steps_settled_on_their_interpolant_skip_sampling_and_nothing_else() {
+    let duration = 3.0 * 2.0 * std::f64::consts::PI / 1.2;
+    let run = |affine: bool| {
+        let system = HertzOscillator {
+            affine,
+            ..HertzOscillator::reference()
+        };
+        flow_map(
+            &system,
+            0.0,
+            &[0.0, 0.0],
+            duration,
+            Sensitivity::None,
+            &Settings::default(),
+        )
+        .expect("integration succeeds")
+    };
+    let (sampled, settled) = (run(false), run(true));
+    eprintln!(
+        "sampled {:?}\nsettled {:?}",
+        sampled.statistics, settled.statistics
+    );
+    assert_eq!(sampled.statistics.steps, settled.statistics.steps);
+    assert_eq!(sampled.statistics.sampled_steps, sampled.statistics.steps);
+    // Most steps, in contact and in free flight, hold no extremum.
+    assert!(2 * settled.statistics.sampled_steps < settled.statistics.steps);
+    assert_eq!(sampled.events.len(), 5);
+    assert_eq!(sampled.events.len(), settled.events.len());
+    for (a, b) in sampled.events.iter().zip(&settled.events) {
+        assert_eq!(a.direction, b.direction);
+        assert!((a.t - b.t).abs() < 1e-12, "{a:?} vs {b:?}");
+    }
+    assert_eq!(sampled.extrema.len(), settled.extrema.len());
+    assert!(
+        sampled.extrema.iter().any(|e| e.value < 0.0),
+        "a minimum inside contact"
+    );
+    for (a, b) in sampled.extrema.iter().zip(&settled.extrema) {
+        assert_eq!(a.kind, b.kind);
+        assert!((a.t - b.t).abs() < 1e-12, "{a:?} vs {b:?}");
+        assert!((a.value - b.value).abs() < 1e-14, "{a:?} vs {b:?}");
+    }
+    for (a, b) in sampled.state.iter().zip(&settled.state) {
+        assert!((a - b).abs() < 1e-13);
     }
 }

@@ -111,6 +111,7 @@ fn steps_do_not_allocate() {
             t_c: 0.0,
             exact_flow_limit: Some(0.5),
             curvature_bound: false,
+            affine: false,
         };
         assert_eq!(
             allocations_beyond_events(&rotation, &rotation.initial_state(), s),

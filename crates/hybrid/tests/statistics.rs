@@ -38,6 +38,7 @@ fn hertz_contact_statistics_are_pinned() {
             exact_steps: 0,
             rhs_evaluations: 2935,
             events: 5,
+            sampled_steps: 180,
         }
     );
     // Accuracy: within 1e-9 of a run at tolerance 1e-14 (the global error of a default run
@@ -96,6 +97,7 @@ fn bouncing_ball_statistics_are_pinned() {
             exact_steps: 0,
             rhs_evaluations: 382,
             events: 20,
+            sampled_steps: 24,
         }
     );
 }

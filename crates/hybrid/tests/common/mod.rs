@@ -153,6 +153,9 @@ pub struct Rotation {
     pub t_c: f64,
     pub exact_flow_limit: Option<f64>,
     pub curvature_bound: bool,
+    /// Whether `h = c - x_0` is declared affine (the solver may then skip sampling steps on
+    /// which its interpolant is proven monotone).
+    pub affine: bool,
 }
 
 impl Rotation {
@@ -164,6 +167,9 @@ impl Rotation {
 impl HybridSystem for Rotation {
     fn dim(&self) -> usize {
         2
+    }
+    fn switching_is_affine(&self, _k: usize) -> bool {
+        self.affine
     }
     fn surface_count(&self) -> usize {
         1
@@ -323,6 +329,8 @@ pub struct HertzOscillator {
     /// Whether the contact mode declares the gap its half-power surface (the solver then
     /// steps next to contact onset and release on a square-root clock).
     pub half_power: bool,
+    /// Whether `h = obstacle - x_0` is declared affine.
+    pub affine: bool,
 }
 
 impl HertzOscillator {
@@ -335,6 +343,7 @@ impl HertzOscillator {
             obstacle: 0.8,
             contact_stiffness: 20.0,
             half_power: true,
+            affine: false,
         }
     }
 }
@@ -345,6 +354,9 @@ impl HybridSystem for HertzOscillator {
     }
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
         (self.half_power && mode & 1 != 0).then_some(0)
+    }
+    fn switching_is_affine(&self, _k: usize) -> bool {
+        self.affine
     }
     fn surface_count(&self) -> usize {
         1
