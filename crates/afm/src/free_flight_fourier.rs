@@ -92,23 +92,34 @@ impl FreeFlightFourier {
     /// `[int_a^b u cos(w t) dt, int_a^b u sin(w t) dt]` (nm us) for free flight from state
     /// `x_a = [q_1, q_1', ..., q_N, q_N']` at time `a` (us) to time `b >= a`.
     pub fn integrate(&self, a: f64, x_a: &[f64], b: f64) -> [f64; 2] {
+        self.integrate_harmonic(1, a, x_a, b)
+    }
+
+    /// `[int_a^b u cos(k w t) dt, int_a^b u sin(k w t) dt]` (nm us) for harmonic `k >= 1`, for
+    /// free flight from state `x_a` at time `a` (us) to time `b >= a`: the closed form of the
+    /// module docs with `e^{-i k w t}`, where the steady part `p = Re((alpha - i beta)
+    /// e^{iwt})` integrates as `(alpha - i beta)/2 int e^{i(1-k)wt} dt + (alpha + i beta)/2 int
+    /// e^{-i(1+k)wt} dt` and the homogeneous part as `c e^{-ikwa} (e^{(lambda - ikw) L} - 1) /
+    /// (lambda - ikw)`.
+    pub fn integrate_harmonic(&self, k: usize, a: f64, x_a: &[f64], b: f64) -> [f64; 2] {
         let w = self.angular_frequency;
+        let kw = k as f64 * w;
         let length = b - a;
         let (sin_a, cos_a) = (w * a).sin_cos();
-        // e^{-iwa}, and e^{-2iwb} - e^{-2iwa} = e^{-2iwa} (e^{-2iwL} - 1) with
-        // e^{-2iwL} - 1 = -2 sin(wL) (sin(wL) + i cos(wL)): no cancellation for short L.
-        let rotation_a = Complex::new(cos_a, -sin_a);
-        let (sin_l, cos_l) = (w * length).sin_cos();
-        let double_difference =
-            rotation_a * rotation_a * Complex::new(sin_l, cos_l) * (-2.0 * sin_l);
-        let steady_oscillating = double_difference / Complex::new(0.0, -4.0 * w);
-        let minus_iw = Complex::new(0.0, -w);
+        let (sin_ka, cos_ka) = (kw * a).sin_cos();
+        // e^{-ikwa}, by which the homogeneous part is rotated.
+        let rotation_a = Complex::new(cos_ka, -sin_ka);
+        // The steady part's two exponentials against e^{-ikwt}: frequencies (1 - k) w and
+        // -(1 + k) w, each integrated over [a, b] without cancellation for short L.
+        let co_rotating = exponential_integral((1.0 - k as f64) * w, a, length);
+        let counter_rotating = exponential_integral(-(1.0 + k as f64) * w, a, length);
+        let minus_ikw = Complex::new(0.0, -kw);
         let mut total = Complex::new(0.0, 0.0);
         for (i, mode) in self.modes.iter().enumerate() {
             let [alpha, beta] = mode.steady;
             // The steady part.
-            let steady = Complex::new(alpha, -beta) * (0.5 * length)
-                + Complex::new(alpha, beta) * steady_oscillating;
+            let steady = Complex::new(alpha, -beta) * 0.5 * co_rotating
+                + Complex::new(alpha, beta) * 0.5 * counter_rotating;
             // The homogeneous part's initial conditions.
             let p = alpha * cos_a + beta * sin_a;
             let dp = w * (beta * cos_a - alpha * sin_a);
@@ -119,11 +130,23 @@ impl FreeFlightFourier {
             let c2 = Complex::new(y, 0.0) - c1;
             let mut homogeneous = Complex::new(0.0, 0.0);
             for (c, l) in [(c1, l1), (c2, l2)] {
-                let z = l + minus_iw;
+                let z = l + minus_ikw;
                 homogeneous += c * ((z * length).exp() - 1.0) / z;
             }
             total += (steady + rotation_a * homogeneous) * mode.optical_sensitivity;
         }
         [total.re, -total.im]
     }
+}
+
+/// `int_a^{a+L} e^{i nu t} dt = e^{i nu a} (e^{i nu L} - 1) / (i nu)` (`L` for `nu = 0`), with
+/// `e^{i nu L} - 1 = 2 i sin(nu L / 2) e^{i nu L / 2}`, free of cancellation for short `L`.
+fn exponential_integral(nu: f64, a: f64, length: f64) -> Complex<f64> {
+    if nu == 0.0 {
+        return Complex::new(length, 0.0);
+    }
+    let half = 0.5 * nu * length;
+    let (sin_start, cos_start) = (nu * a + half).sin_cos();
+    // e^{i nu (a + L/2)} 2 sin(nu L / 2) / nu.
+    Complex::new(cos_start, sin_start) * (2.0 * half.sin() / nu)
 }

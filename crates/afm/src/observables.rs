@@ -2,18 +2,20 @@
 //! (and higher) harmonics of `u`, the impacts with their onset velocities and peak forces, every
 //! local minimum of the gap, and the force integrals.
 //!
-//! The Fourier coefficients and force integrals are integrated by 8-point Gauss-Legendre
-//! quadrature over every solver step (exact to rounding in free flight, where the solver
-//! interpolates with the exact flow; to dense-output accuracy in contact). Impacts come from the
+//! The Fourier coefficients are integrated in closed form over free flight
+//! ([`crate::free_flight_fourier`], exact to rounding; by quadrature near critical damping),
+//! and they and the force integrals by 8-point Gauss-Legendre quadrature over every contact
+//! step (to dense-output accuracy). Impacts come from the
 //! solver's events, gap minima from its extrema, so none is missed between samples.
 
 use hybrid::{
-    flow_map_observed, Direction, ExtremumKind, FlowMap, HybridSystem, Sensitivity, Settings,
+    flow_map_observed, Direction, ExtremumKind, FlowMap, HybridSystem, Mode, Sensitivity, Settings,
     Solver, StepOutcome,
 };
 
 use serde::Serialize;
 
+use crate::free_flight_fourier::FreeFlightFourier;
 use crate::gauss_legendre::GAUSS_LEGENDRE_8;
 use crate::model::{CONTACT, GAP_SURFACE};
 use crate::validation::invalid;
@@ -107,6 +109,14 @@ pub struct PeriodObserver {
     events: Vec<(f64, Direction, f64)>,
     minima: Vec<(f64, f64)>,
     state: Vec<f64>,
+    /// The closed-form Fourier integrals over free flight (`None` near critical damping, where
+    /// free flight is integrated by quadrature like contact).
+    free_flight: Option<FreeFlightFourier>,
+    /// The mode of the next step (the solver's mode after the last one observed).
+    mode: Mode,
+    /// Start time and state of the free-flight interval in progress, if any.
+    free_start: Option<f64>,
+    free_state: Vec<f64>,
 }
 
 impl PeriodObserver {
@@ -128,25 +138,43 @@ impl PeriodObserver {
             events: Vec::new(),
             minima: Vec::new(),
             state: vec![0.0; model.dim()],
+            free_flight: FreeFlightFourier::new(model),
+            mode: model.mode_of(t0, x0),
+            free_start: None,
+            free_state: vec![0.0; model.dim()],
         }
     }
 
-    /// Accumulate the last step of `solver` (its part inside the window): Gauss-Legendre
-    /// quadrature of `u cos(k w t)`, `u sin(k w t)` and `F_ts` on `Solver::interpolate`, the
-    /// step's gap minima and its contact event.
+    /// Accumulate the last step of `solver` (its part inside the window): the integrals of
+    /// `u cos(k w t)`, `u sin(k w t)` and `F_ts`, the step's gap minima and its contact event.
+    /// Over free flight (exact-flow steps, `F_ts = 0`) the Fourier integrals are taken in
+    /// closed form ([`FreeFlightFourier`]) once per free-flight interval, when it ends; over
+    /// contact steps by 8-point Gauss-Legendre quadrature on `Solver::interpolate`.
     pub fn observe(&mut self, solver: &Solver<TappingModel>, outcome: &StepOutcome) {
         let model = solver.system();
         let (step_start, step_end) = solver.last_step();
         let a = step_start.max(self.start);
         let b = step_end.min(self.end);
         if b > a {
-            let middle = 0.5 * (a + b);
-            for (offset, weight) in GAUSS_LEGENDRE_8.pairs(a, b) {
-                for t in [middle - offset, middle + offset] {
-                    self.accumulate(solver, model, t, weight);
+            if self.free_flight.is_some() && model.has_exact_flow(self.mode) {
+                if self.free_start.is_none() {
+                    self.free_start = Some(a);
+                    solver.interpolate(a, &mut self.free_state);
+                }
+                if !matches!(outcome, StepOutcome::Internal) || b >= self.end {
+                    self.close_free_flight(b);
+                }
+            } else {
+                self.close_free_flight(a);
+                let middle = 0.5 * (a + b);
+                for (offset, weight) in GAUSS_LEGENDRE_8.pairs(a, b) {
+                    for t in [middle - offset, middle + offset] {
+                        self.accumulate(solver, model, t, weight);
+                    }
                 }
             }
         }
+        self.mode = solver.mode();
         for extremum in solver.step_extrema() {
             if extremum.surface == GAP_SURFACE
                 && extremum.kind == ExtremumKind::Minimum
@@ -167,6 +195,19 @@ impl PeriodObserver {
             } else {
                 solver.interpolate(self.end, &mut self.state);
                 self.gap_at_end = model.gap(self.end, &self.state);
+            }
+        }
+    }
+
+    /// Add the closed-form Fourier integrals of the free-flight interval in progress, up to
+    /// `end`, and close it.
+    fn close_free_flight(&mut self, end: f64) {
+        if let (Some(start), Some(free_flight)) = (self.free_start.take(), &self.free_flight) {
+            for (k, coefficient) in self.fourier.iter_mut().enumerate() {
+                let [cosine, sine] =
+                    free_flight.integrate_harmonic(k + 1, start, &self.free_state, end);
+                coefficient[0] += cosine;
+                coefficient[1] += sine;
             }
         }
     }
