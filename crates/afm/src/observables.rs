@@ -18,6 +18,7 @@ use serde::Serialize;
 use crate::free_flight_fourier::FreeFlightFourier;
 use crate::gauss_legendre::GAUSS_LEGENDRE_8;
 use crate::model::{CONTACT, GAP_SURFACE};
+use crate::phase;
 use crate::validation::invalid;
 use crate::{AfmError, TappingModel};
 
@@ -166,10 +167,18 @@ impl PeriodObserver {
                 }
             } else {
                 self.close_free_flight(a);
+                // The drive phase at the nodes by angle addition from the middle.
                 let middle = 0.5 * (a + b);
+                let w = self.angular_frequency;
+                let (sin_m, cos_m) = phase::sin_cos(w * middle);
                 for (offset, weight) in GAUSS_LEGENDRE_8.pairs(a, b) {
-                    for t in [middle - offset, middle + offset] {
-                        self.accumulate(solver, model, t, weight);
+                    let (sin_d, cos_d) = phase::sin_cos(w * offset);
+                    for (t, sign) in [(middle - offset, -1.0), (middle + offset, 1.0)] {
+                        let drive = (
+                            sin_m * cos_d + sign * cos_m * sin_d,
+                            cos_m * cos_d - sign * sin_m * sin_d,
+                        );
+                        self.accumulate(solver, model, t, drive, weight);
                     }
                 }
             }
@@ -212,17 +221,19 @@ impl PeriodObserver {
         }
     }
 
+    /// Add the quadrature node at `t` with `weight`, given the drive phase there as
+    /// `(sin w t, cos w t)`.
     fn accumulate(
         &mut self,
         solver: &Solver<TappingModel>,
         model: &TappingModel,
         t: f64,
+        (sin, cos): (f64, f64),
         weight: f64,
     ) {
         solver.interpolate(t, &mut self.state);
         let u = model.photodiode(&self.state);
         self.impulse += weight * model.hertz().force(model.gap(t, &self.state));
-        let (sin, cos) = (self.angular_frequency * t).sin_cos();
         let (mut sin_k, mut cos_k) = (sin, cos);
         for coefficient in self.fourier.iter_mut() {
             coefficient[0] += weight * u * cos_k;
