@@ -61,9 +61,9 @@ pub struct Settings {
     /// above the height is neither located nor reported. Crossings are found either way.
     /// `INFINITY` (the default) reports every extremum, as observables of an orbit need; a
     /// time-domain sweep or a Newton iteration that needs only the crossings and the extrema
-    /// inside contact sets it to 0. (A step whose affine `h_k` are all proven strictly
-    /// monotone is not sampled inside at any height: it holds no extremum.) Allowed: `>= 0`
-    /// (infinity allowed).
+    /// inside contact sets it to 0. (A step on which every `h_k` is proven strictly monotone,
+    /// by the curvature bound or an affine `h_k`'s interpolant, is not sampled inside at any
+    /// height: it holds no extremum.) Allowed: `>= 0` (infinity allowed).
     pub extremum_height: f64,
 }
 

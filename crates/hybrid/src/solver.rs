@@ -36,8 +36,10 @@
 //!   stretched (beyond `exact_step_limit`) as far as `h_k(t0) + h_k'(t0) s - M s^2 / 2` stays
 //!   above the height. In a step that is sampled, a sample interval whose chord bent by
 //!   `M spacing^2 / 8` stays above the height is not searched for an extremum (free flight
-//!   between contacts, whose gap minima clear the sample). None of these can hide a crossing:
-//!   the bound is rigorous.
+//!   between contacts, whose gap minima clear the sample). At any height, a step whose end
+//!   rates have one sign and `|r0| + |r1| > M dt` is monotone (the rate cannot reach zero in
+//!   between) and is sampled at its ends only. None of these can hide a crossing: the bound
+//!   is rigorous.
 //! * Steps settled on their interpolant. Where every `h_k` is affine in the state and time
 //!   ([`HybridSystem::switching_is_affine`]), its interpolant over a Runge-Kutta step is a
 //!   polynomial of degree 7 in the step's clock, and the Bernstein coefficients of it and of
@@ -488,21 +490,20 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         // Sample h and dh/dt, locate extrema, then the earliest crossing.
         let time_tolerance =
             self.settings.event_time_tolerance * t0.abs().max(t1.abs()).max(t1 - t0);
-        // With a finite extremum height, the curvature bounds of the step (if the system
-        // gives them): a step, or a sample interval of it, that they prove farther than the
-        // height from every surface is not searched for extrema.
+        // The curvature bounds of the step (if the system gives them): a step they prove
+        // monotone holds no extremum; with a finite extremum height, a step, or a sample
+        // interval of it, that they prove farther than the height from every surface is not
+        // searched for extrema.
         let mut bounds = [0.0; MAX_SURFACES];
-        let bounded = self.settings.extremum_height.is_finite()
-            && !self.proven_clear
-            && self.curvature_bounds(mode, t0, t1, &mut bounds);
-        let clearance = bounded.then(|| Clearance {
+        let bounded = !self.proven_clear && self.curvature_bounds(mode, t0, t1, &mut bounds);
+        let clearance = (bounded && self.settings.extremum_height.is_finite()).then(|| Clearance {
             height: self.settings.extremum_height,
             bounds: &bounds[..self.surfaces],
         });
         // A Runge-Kutta step with affine switching functions may be proven settled on its
         // interpolant, whatever the height.
         let polynomial = self.affine_switching && self.kind == StepKind::RungeKutta;
-        let clear = (self.settings.extremum_height.is_finite() || polynomial) && {
+        let clear = (self.settings.extremum_height.is_finite() || polynomial || bounded) && {
             self.buffers.samples.sample_ends(
                 self.system,
                 mode,
@@ -516,6 +517,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     .as_ref()
                     .is_some_and(|clearance| self.clear_of_surfaces(mode, t0, t1, clearance))
                 || (polynomial && self.interpolant_settled(mode))
+                || (bounded && self.monotone_by_curvature(t1 - t0, &bounds))
         };
         if !clear {
             self.statistics.sampled_steps += 1;
@@ -644,6 +646,21 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             span = span.min(clear * (1.0 - 1e-9));
         }
         Some(span)
+    }
+
+    /// Whether the step of length `dt` just sampled at its ends ([`Samples::sample_ends`])
+    /// has every `h_k` strictly monotone, by the curvature bounds `M_k` on `|h_k''|`: with end
+    /// rates `r0`, `r1` of one sign, `|dh_k/dt| >= (|r0| + |r1| - M_k dt) / 2` throughout (the
+    /// rate moves at most `M_k` per time unit from either end), so a positive right side
+    /// leaves no extremum, and a crossing shows in the signs at the ends.
+    fn monotone_by_curvature(&self, dt: f64, bounds: &[f64]) -> bool {
+        let p = self.buffers.samples.points();
+        let rates = &self.buffers.samples.rates;
+        (0..self.surfaces).all(|k| {
+            let (r0, r1) = (rates[k * p], rates[k * p + p - 1]);
+            // A margin for the rounding of the bound's product.
+            r0 * r1 > 0.0 && r0.abs() + r1.abs() > bounds[k] * dt * (1.0 + 1e-9)
+        })
     }
 
     /// Whether the Runge-Kutta step just taken (sampled at its ends, [`Samples::sample_ends`])

@@ -255,9 +255,11 @@ pub trait HybridSystem {
     ///
     /// With the bound `M`, `h_k` stays within `M dt^2 / 8` of the chord between its values at
     /// the step's ends, so a step whose ends both lie farther than that from surface `k` cannot
-    /// cross it. The solver uses this to skip the interior sampling of steps proven clear of
-    /// every surface by more than [`crate::Settings::extremum_height`] (their extrema are then
-    /// not reported). A bound that is too small makes the solver miss contacts: it must hold
+    /// cross it; and `dh_k/dt` moves at most `M` per time unit, so end rates `r0`, `r1` of one
+    /// sign with `|r0| + |r1| > M dt` leave no extremum inside. The solver uses this to skip
+    /// the interior sampling of steps proven clear of every surface by more than
+    /// [`crate::Settings::extremum_height`] (their extrema are then not reported) and of steps
+    /// proven monotone. A bound that is too small makes the solver miss contacts: it must hold
     /// for every time in the interval, not only at `t0`.
     fn switching_curvature_bound(
         &self,

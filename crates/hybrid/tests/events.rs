@@ -99,17 +99,22 @@ fn check_dip(system: &Rotation, time_tolerance: f64, value_tolerance: f64) {
 /// so step boundaries land on extrema: each must still be reported exactly once.
 #[test]
 fn events_and_extrema_fire_exactly_once() {
-    for (limit, affine) in [
-        (Some(PI / 4.0), false),
-        (Some(1.0), false),
-        (None, false),
-        (None, true),
+    // (exact-flow step limit, curvature bound, affine): the last three let the solver skip
+    // sampling steps it proves monotone (by the curvature bound, or the interpolant's
+    // Bernstein bound).
+    for (limit, curvature_bound, affine) in [
+        (Some(PI / 4.0), false, false),
+        (Some(1.0), false, false),
+        (None, false, false),
+        (Some(PI / 4.0), true, false),
+        (Some(1.0), true, false),
+        (None, false, true),
     ] {
         let system = Rotation {
             c: 0.3,
             t_c: 0.0,
             exact_flow_limit: limit,
-            curvature_bound: false,
+            curvature_bound,
             affine,
         };
         let result = flow_map(
@@ -157,6 +162,15 @@ fn events_and_extrema_fire_exactly_once() {
             );
         }
         eprintln!("limit {limit:?}: {:?}", result.statistics);
+        if curvature_bound || affine {
+            assert!(
+                2 * result.statistics.sampled_steps < result.statistics.steps,
+                "{:?}",
+                result.statistics
+            );
+        } else {
+            assert_eq!(result.statistics.sampled_steps, result.statistics.steps);
+        }
     }
 }
 
