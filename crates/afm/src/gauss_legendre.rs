@@ -2,6 +2,8 @@
 //! force integrals) are integrated step by step, where the dense output (or the exact flow) is a
 //! smooth function of time, so a few nodes per step reach rounding accuracy.
 
+use crate::phase;
+
 /// A symmetric Gauss-Legendre rule on `[-1, 1]`: its positive nodes and their weights (each
 /// node `x` stands for the pair `+-x`).
 #[derive(Debug, Clone, Copy)]
@@ -43,6 +45,28 @@ impl GaussLegendre {
             .zip(self.weights)
             .map(move |(node, weight)| (half * node, half * weight))
     }
+
+    /// The rule's nodes on `[a, b]` with the drive phase there: `(t, weight, (sin w t,
+    /// cos w t))` for every node, the pair `mid -+ offset` in turn. The phase comes by angle
+    /// addition from the middle (`phase::sin_cos` at the middle and at each offset: one
+    /// evaluation per pair of nodes, plus one).
+    pub fn drive_nodes(
+        &self,
+        a: f64,
+        b: f64,
+        angular_frequency: f64,
+    ) -> impl Iterator<Item = (f64, f64, (f64, f64))> + '_ {
+        let middle = 0.5 * (a + b);
+        let (sin_m, cos_m) = phase::sin_cos(angular_frequency * middle);
+        self.pairs(a, b).flat_map(move |(offset, weight)| {
+            let (sin_d, cos_d) = phase::sin_cos(angular_frequency * offset);
+            [(middle - offset, -1.0), (middle + offset, 1.0)].map(|(t, sign)| {
+                let sin = sin_m * cos_d + sign * cos_m * sin_d;
+                let cos = cos_m * cos_d - sign * sin_m * sin_d;
+                (t, weight, (sin, cos))
+            })
+        })
+    }
 }
 
 #[cfg(test)]
@@ -64,6 +88,27 @@ mod tests {
                 assert!(
                     (integral - exact).abs() < 1e-13 * exact,
                     "degree {k}: {integral} vs {exact}"
+                );
+            }
+        }
+    }
+
+    /// The drive phases by angle addition are those of the library's `sin_cos` at each node to
+    /// a few ulps, the nodes are those of `pairs`, and the weights integrate 1 to `b - a`.
+    #[test]
+    fn drive_nodes_carry_the_phase_at_each_node() {
+        let (a, b, w) = (123.456, 123.789, 0.0584);
+        for rule in [GAUSS_LEGENDRE_8, GAUSS_LEGENDRE_4] {
+            let nodes: Vec<_> = rule.drive_nodes(a, b, w).collect();
+            assert_eq!(nodes.len(), 2 * rule.pairs(a, b).count());
+            let total: f64 = nodes.iter().map(|node| node.1).sum();
+            assert!((total - (b - a)).abs() < 1e-15);
+            for (t, _, (sin, cos)) in nodes {
+                assert!(t > a && t < b);
+                let (sin_t, cos_t) = (w * t).sin_cos();
+                assert!(
+                    (sin - sin_t).abs() < 1e-15 && (cos - cos_t).abs() < 1e-15,
+                    "{t}"
                 );
             }
         }

@@ -21,7 +21,6 @@ use hybrid::{Direction, ExtremumKind, HybridSystem, Mode, Solver, StepOutcome};
 use crate::free_flight_fourier::FreeFlightFourier;
 use crate::gauss_legendre::GAUSS_LEGENDRE_4;
 use crate::model::GAP_SURFACE;
-use crate::phase;
 use crate::TappingModel;
 
 /// What the lock-in reads over one drive cycle `[0, T]` (time from the cycle's start).
@@ -155,20 +154,11 @@ impl CycleLockIn {
     /// relative for a step `h`, about 2e-8 even for a step of a quarter drive period (contact
     /// steps are far shorter).
     fn quadrature(&mut self, solver: &Solver<TappingModel>, model: &TappingModel, a: f64, b: f64) {
-        let middle = 0.5 * (a + b);
-        let w = self.angular_frequency;
-        // Drive phase at the nodes by angle addition from the middle (3 sin_cos, not 4).
-        let (sin_m, cos_m) = phase::sin_cos(w * middle);
-        for (offset, weight) in GAUSS_LEGENDRE_4.pairs(a, b) {
-            let (sin_d, cos_d) = phase::sin_cos(w * offset);
-            for (t, sign) in [(middle - offset, -1.0), (middle + offset, 1.0)] {
-                solver.interpolate(t, &mut self.state);
-                let u = model.photodiode(&self.state);
-                let sin = sin_m * cos_d + sign * cos_m * sin_d;
-                let cos = cos_m * cos_d - sign * sin_m * sin_d;
-                self.cosine += weight * u * cos;
-                self.sine += weight * u * sin;
-            }
+        for (t, weight, (sin, cos)) in GAUSS_LEGENDRE_4.drive_nodes(a, b, self.angular_frequency) {
+            solver.interpolate(t, &mut self.state);
+            let u = model.photodiode(&self.state);
+            self.cosine += weight * u * cos;
+            self.sine += weight * u * sin;
         }
     }
 

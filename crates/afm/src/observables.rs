@@ -18,7 +18,6 @@ use serde::Serialize;
 use crate::free_flight_fourier::FreeFlightFourier;
 use crate::gauss_legendre::GAUSS_LEGENDRE_8;
 use crate::model::{CONTACT, GAP_SURFACE};
-use crate::phase;
 use crate::validation::invalid;
 use crate::{AfmError, TappingModel};
 
@@ -167,19 +166,9 @@ impl PeriodObserver {
                 }
             } else {
                 self.close_free_flight(a);
-                // The drive phase at the nodes by angle addition from the middle.
-                let middle = 0.5 * (a + b);
-                let w = self.angular_frequency;
-                let (sin_m, cos_m) = phase::sin_cos(w * middle);
-                for (offset, weight) in GAUSS_LEGENDRE_8.pairs(a, b) {
-                    let (sin_d, cos_d) = phase::sin_cos(w * offset);
-                    for (t, sign) in [(middle - offset, -1.0), (middle + offset, 1.0)] {
-                        let drive = (
-                            sin_m * cos_d + sign * cos_m * sin_d,
-                            cos_m * cos_d - sign * sin_m * sin_d,
-                        );
-                        self.accumulate(solver, model, t, drive, weight);
-                    }
+                for (t, weight, drive) in GAUSS_LEGENDRE_8.drive_nodes(a, b, self.angular_frequency)
+                {
+                    self.accumulate(solver, model, t, drive, weight);
                 }
             }
         }
