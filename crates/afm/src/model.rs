@@ -322,8 +322,8 @@ impl TappingModel {
 
     /// `J v` for every column `v` of `tangents` (column-major, `2N` rows) into `rates`, given
     /// the Hertz slope `F_ts'(d)` (nN/nm); with `parameter_column`, the last column also gets
-    /// `df/dZ`. See `variational_field` in the `HybridSystem` implementation. The common mode
-    /// counts run with the count fixed at compile time (unrolled loops); the same expressions.
+    /// `df/dZ`. See `variational_field` in the `HybridSystem` implementation. One body for any
+    /// number of modes, called with the common counts as constants (unrolled loops).
     #[inline]
     fn modal_tangent_rates(
         &self,
@@ -332,36 +332,33 @@ impl TappingModel {
         rates: &mut [f64],
         parameter_column: bool,
     ) {
+        // The common mode counts as constants, so that the loops unroll.
         match self.modes.len() {
-            1 => self.tangent_rates_for::<1>(slope, tangents, rates, parameter_column),
-            2 => self.tangent_rates_for::<2>(slope, tangents, rates, parameter_column),
-            3 => self.tangent_rates_for::<3>(slope, tangents, rates, parameter_column),
-            4 => self.tangent_rates_for::<4>(slope, tangents, rates, parameter_column),
-            _ => self.tangent_rates_any(slope, tangents, rates, parameter_column),
+            1 => self.tangent_rates_with(1, slope, tangents, rates, parameter_column),
+            2 => self.tangent_rates_with(2, slope, tangents, rates, parameter_column),
+            3 => self.tangent_rates_with(3, slope, tangents, rates, parameter_column),
+            4 => self.tangent_rates_with(4, slope, tangents, rates, parameter_column),
+            count => self.tangent_rates_with(count, slope, tangents, rates, parameter_column),
         }
     }
 
-    /// [`Self::modal_tangent_rates`] for `M` modes fixed at compile time.
-    #[inline]
-    fn tangent_rates_for<const M: usize>(
+    /// [`Self::modal_tangent_rates`] over the first `count` modes (all of them), inlined into
+    /// each call so that a constant `count` unrolls it.
+    #[inline(always)]
+    fn tangent_rates_with(
         &self,
+        count: usize,
         slope: f64,
         tangents: &[f64],
         rates: &mut [f64],
         parameter_column: bool,
     ) {
-        let mut coupling = [0.0; M];
-        let mut stiffness = [0.0; M];
-        let mut damping = [0.0; M];
-        for (i, m) in self.modes.iter().take(M).enumerate() {
-            coupling[i] = m.omega_squared_over_stiffness * slope;
-            stiffness[i] = m.omega_squared;
-            damping[i] = m.damping;
-        }
-        let columns = tangents.len() / (2 * M);
+        let modes = &self.modes[..count];
+        let n = 2 * count;
+        let columns = tangents.len() / n;
         for (c, (v, rate)) in tangents
-            .chunks_exact(2 * M)
-            .zip(rates.chunks_exact_mut(2 * M))
+            .chunks_exact(n)
+            .zip(rates.chunks_exact_mut(n))
             .enumerate()
         {
             // The gap's change along this column: the sum of the modal displacements (+1 on
@@ -371,50 +368,14 @@ impl TappingModel {
             } else {
                 0.0
             };
-            for i in 0..M {
+            for i in 0..count {
                 gap_change += v[2 * i];
             }
-            for i in 0..M {
+            for (i, m) in modes.iter().enumerate() {
                 rate[2 * i] = v[2 * i + 1];
-                rate[2 * i + 1] =
-                    coupling[i] * gap_change - stiffness[i] * v[2 * i] - damping[i] * v[2 * i + 1];
-            }
-        }
-    }
-
-    /// [`Self::modal_tangent_rates`] for any number of modes.
-    fn tangent_rates_any(
-        &self,
-        slope: f64,
-        tangents: &[f64],
-        rates: &mut [f64],
-        parameter_column: bool,
-    ) {
-        let n = 2 * self.modes.len();
-        let columns = tangents.len() / n;
-        for (c, (v, rate)) in tangents
-            .chunks_exact(n)
-            .zip(rates.chunks_exact_mut(n))
-            .enumerate()
-        {
-            let mut gap_change = if parameter_column && c + 1 == columns {
-                1.0
-            } else {
-                0.0
-            };
-            for q in v.iter().step_by(2) {
-                gap_change += q;
-            }
-            for ((m, vi), ri) in self
-                .modes
-                .iter()
-                .zip(v.chunks_exact(2))
-                .zip(rate.chunks_exact_mut(2))
-            {
-                ri[0] = vi[1];
-                ri[1] = m.omega_squared_over_stiffness * slope * gap_change
-                    - m.omega_squared * vi[0]
-                    - m.damping * vi[1];
+                rate[2 * i + 1] = m.omega_squared_over_stiffness * slope * gap_change
+                    - m.omega_squared * v[2 * i]
+                    - m.damping * v[2 * i + 1];
             }
         }
     }
