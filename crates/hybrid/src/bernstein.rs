@@ -13,7 +13,6 @@
 /// `power` (`power[j]` multiplies `theta^j`; degree `D - 1`).
 pub(crate) fn bernstein_coefficients<const D: usize>(power: &[f64; D]) -> [f64; D] {
     let degree = D - 1;
-    // ratio[j] = C(i, j) / C(d, j), updated row by row in i.
     let mut bernstein = [0.0; D];
     for (i, b) in bernstein.iter_mut().enumerate() {
         let mut sum = 0.0;
@@ -33,7 +32,7 @@ pub(crate) fn bernstein_coefficients<const D: usize>(power: &[f64; D]) -> [f64; 
 /// The bound on the rounding of [`bernstein_coefficients`]: each coefficient is a sum of at most
 /// `D` products of `|a_j|` with factors in `[0, 1]` each rounded a few times, so its error is
 /// below this multiple of `EPSILON * sum_j |a_j|` (generously).
-const ROUNDING_FACTOR: f64 = 16.0 * (f64::EPSILON * 64.0);
+const ROUNDING_FACTOR: f64 = 1024.0 * f64::EPSILON;
 
 /// Whether the polynomial with power-basis coefficients `power` is proven, from its Bernstein
 /// coefficients, to stay above `floor` on all of `[0, 1]`, with a margin for the rounding of
