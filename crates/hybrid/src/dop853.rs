@@ -181,8 +181,8 @@ impl Dop853 {
 
     /// Stage 0: `f(t, z)` (needed before [`Dop853::attempt`] unless reused from stage 12).
     pub fn evaluate_first_stage(&mut self, rhs: &mut Rhs<'_>, t: f64, z: &[f64]) {
-        self.argument.copy_from_slice(z);
         let dim = self.dim;
+        self.argument.copy_from_slice(&z[..dim]);
         self.evaluate_stage(rhs, 0, t, dim);
     }
 
@@ -299,8 +299,8 @@ impl Dop853 {
     /// Complete an accepted step to `z_new`: stage 12, the augmented derivative at the new point
     /// (reused as stage 0 of the next step, and needed by the dense output).
     pub fn derivative_at_end(&mut self, rhs: &mut Rhs<'_>, t: f64, z_new: &[f64]) {
-        self.argument.copy_from_slice(z_new);
         let dim = self.dim;
+        self.argument.copy_from_slice(&z_new[..dim]);
         self.evaluate_stage(rhs, 12, t + self.h, dim);
     }
 

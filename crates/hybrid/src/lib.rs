@@ -19,11 +19,15 @@
 //! proven to hold no extremum is sampled at its ends only: see
 //! [`HybridSystem::switching_is_affine`] and [`Settings::extremum_height`]). With
 //! sensitivities, `sensitivity_tolerance` trades accuracy of the transition matrix against
-//! steps where the Jacobian is not smooth (Hertz contact); see its documentation.
+//! steps where the Jacobian is not smooth (Hertz contact), and `sensitivity_method` chooses
+//! between the variational equations carried in the state's Runge-Kutta system (the exact
+//! derivative of the numerical flow) and a cheaper sixth-order integration over the accepted
+//! steps (enough for Newton); see their documentation.
 #![warn(missing_docs)]
 
 mod bernstein;
 mod clock;
+mod decoupled_tangents;
 mod dop853;
 pub mod error;
 pub mod event;
@@ -42,7 +46,7 @@ pub use error::HybridError;
 pub use event::{Event, Extremum, ExtremumKind};
 pub use flow_map::{flow_map, flow_map_observed, FlowMap};
 pub use sensitivity::{LinearisationBuffers, Sensitivity};
-pub use settings::Settings;
+pub use settings::{SensitivityMethod, Settings};
 pub use solver::{Solver, Statistics, StepOutcome};
 pub use system::{Direction, HybridSystem, Mode, SwitchingPartials, MAX_SURFACES};
 pub use workspace::SolverWorkspace;

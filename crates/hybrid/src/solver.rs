@@ -1158,6 +1158,25 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 n,
             );
         }
+        let buffers = &mut self.buffers;
+        if let Some(tangents) = buffers.tangents.as_mut() {
+            let (x1, end) = buffers.z_new.split_at_mut(n);
+            let (rk, z0) = (&buffers.rk, &buffers.z);
+            let mut state_at = |fraction: f64, x: &mut [f64]| match fraction {
+                0.0 => x.copy_from_slice(&z0[..n]),
+                1.0 => x.copy_from_slice(x1),
+                _ => rk.interpolate(z0, fraction, x),
+            };
+            buffers.field.evaluations += tangents.advance(
+                system,
+                mode,
+                clock,
+                (sigma0, dsigma),
+                &mut state_at,
+                &z0[n..],
+                end,
+            );
+        }
         self.statistics.rhs_evaluations = self.buffers.field.evaluations;
         if self.buffers.z_new.iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t1 });
@@ -1384,6 +1403,32 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             return;
         }
         match self.kind {
+            StepKind::RungeKutta if self.buffers.tangents.is_some() => {
+                // The state from the dense output, the sensitivities carried to `t` from the
+                // step start as over a whole step.
+                let n = self.n;
+                let (clock, sigma0) = (self.clock, self.sigma_start);
+                let theta = (clock.sigma(t) - sigma0) / self.buffers.rk.h;
+                let buffers = &mut self.buffers;
+                let (x, tangents_at) = buffers.z.split_at_mut(n);
+                buffers.rk.interpolate(&buffers.z_start, theta, x);
+                let (rk, z_start) = (&buffers.rk, &buffers.z_start);
+                let mut state_at = |fraction: f64, x: &mut [f64]| {
+                    rk.interpolate(z_start, fraction * theta, x);
+                };
+                if let Some(tangents) = buffers.tangents.as_mut() {
+                    buffers.field.evaluations += tangents.advance(
+                        self.system,
+                        mode,
+                        clock,
+                        (sigma0, theta * rk.h),
+                        &mut state_at,
+                        &z_start[n..],
+                        tangents_at,
+                    );
+                }
+                self.statistics.rhs_evaluations = buffers.field.evaluations;
+            }
             StepKind::RungeKutta => {
                 let (clock, sigma0) = (self.clock, self.sigma_start);
                 if !self.full_dense && self.dim > self.n {

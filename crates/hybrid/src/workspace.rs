@@ -8,12 +8,13 @@
 
 use nalgebra::DMatrix;
 
+use crate::decoupled_tangents::DecoupledTangents;
 use crate::dop853::Dop853;
 use crate::event::Extremum;
 use crate::extrema::Samples;
 use crate::saltation::Saltation;
 use crate::sensitivity::{Sensitivity, VariationalField};
-use crate::settings::Settings;
+use crate::settings::{SensitivityMethod, Settings};
 
 /// The buffers a [`crate::Solver`] allocates for a state of dimension `n`, a number of switching
 /// surfaces, a [`Sensitivity`] and the sampling and error-control settings that size them.
@@ -52,6 +53,7 @@ pub(crate) struct Buffers {
     pub sensitivity: Sensitivity,
     pub samples_per_step: usize,
     pub sensitivity_tolerance: Option<f64>,
+    pub sensitivity_method: SensitivityMethod,
     pub z: Vec<f64>,
     pub z_start: Vec<f64>,
     pub z_new: Vec<f64>,
@@ -59,6 +61,9 @@ pub(crate) struct Buffers {
     pub zero_parameter: Vec<f64>,
     pub field: VariationalField,
     pub rk: Dop853,
+    /// The variational integration apart from the state's steps, with
+    /// [`SensitivityMethod::Decoupled`] and a tracked transition.
+    pub tangents: Option<DecoupledTangents>,
     pub x_ahead: Vec<f64>,
     pub grid: Vec<f64>,
     /// `f(t, x)` at the start of a step, in time units (for the crossing prediction).
@@ -93,6 +98,14 @@ impl Buffers {
         settings: &Settings,
     ) -> Self {
         let dim = sensitivity.augmented_dim(n);
+        // With decoupled sensitivities the Runge-Kutta steps carry the state only.
+        let decoupled =
+            settings.sensitivity_method == SensitivityMethod::Decoupled && sensitivity.transition();
+        let stepped = if decoupled {
+            Sensitivity::None
+        } else {
+            sensitivity
+        };
         let samples = Samples::new(surfaces, settings.samples_per_step);
         let extrema_capacity = surfaces * (samples.points() - 1);
         Self {
@@ -101,13 +114,15 @@ impl Buffers {
             sensitivity,
             samples_per_step: settings.samples_per_step,
             sensitivity_tolerance: settings.sensitivity_tolerance,
+            sensitivity_method: settings.sensitivity_method,
             z: vec![0.0; dim],
             z_start: vec![0.0; dim],
             z_new: vec![0.0; dim],
             transition: DMatrix::identity(n, n),
             zero_parameter: vec![0.0; n],
-            field: VariationalField::new(n, sensitivity),
-            rk: Dop853::new(dim, n, settings.sensitivity_tolerance),
+            field: VariationalField::new(n, stepped),
+            rk: Dop853::new(stepped.augmented_dim(n), n, settings.sensitivity_tolerance),
+            tangents: decoupled.then(|| DecoupledTangents::new(n, sensitivity)),
             x_ahead: vec![0.0; n],
             grid: vec![0.0; (settings.samples_per_step + 1) * n],
             velocity: vec![0.0; n],
@@ -143,5 +158,6 @@ impl Buffers {
             && self.sensitivity == sensitivity
             && self.samples_per_step == settings.samples_per_step
             && self.sensitivity_tolerance == settings.sensitivity_tolerance
+            && self.sensitivity_method == settings.sensitivity_method
     }
 }

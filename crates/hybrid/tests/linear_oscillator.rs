@@ -5,7 +5,9 @@
 mod common;
 
 use common::ForcedOscillator;
-use hybrid::{flow_map, flow_map_observed, Sensitivity, Settings, Solver, StepOutcome};
+use hybrid::{
+    flow_map, flow_map_observed, Sensitivity, SensitivityMethod, Settings, Solver, StepOutcome,
+};
 
 const X0: [f64; 2] = [0.4, -0.3];
 const DURATION: f64 = 20.0;
@@ -150,3 +152,46 @@ const PINNED_REJECTED: usize = 0;
 /// 15 evaluations per step (11 new stages, the end derivative, 3 dense-output stages) plus 2
 /// for the starting-step heuristic.
 const PINNED_RHS: usize = 1922;
+
+/// With [`SensitivityMethod::Decoupled`] the transition matrix and `dx/dA` come from a
+/// sixth-order method over the state's steps: against the closed form their error falls like
+/// the sixth power of the step (the state's tolerance sets the steps), and the state is that
+/// of a run without sensitivities to the last bit (its steps do not depend on them).
+#[test]
+fn decoupled_sensitivities_converge_at_sixth_order() {
+    let system = ForcedOscillator::reference();
+    let (_, phi, dxda) = system.exact(0.0, X0, DURATION);
+    let error = |tolerance: f64| {
+        let settings = Settings {
+            relative_tolerance: tolerance,
+            absolute_tolerance: tolerance,
+            sensitivity_method: SensitivityMethod::Decoupled,
+            ..Settings::default()
+        };
+        let decoupled = flow_map(
+            &system,
+            0.0,
+            &X0,
+            DURATION,
+            Sensitivity::TransitionAndParameter,
+            &settings,
+        )
+        .expect("integration succeeds");
+        let state_only = flow_map(&system, 0.0, &X0, DURATION, Sensitivity::None, &settings)
+            .expect("integration succeeds");
+        assert_eq!(decoupled.state, state_only.state);
+        let mut worst: f64 = max_abs_diff(&decoupled.parameter_sensitivity, &dxda);
+        for i in 0..2 {
+            for j in 0..2 {
+                worst = worst.max((decoupled.transition[(i, j)] - phi[i][j]).abs());
+            }
+        }
+        (worst, decoupled.statistics.steps)
+    };
+    let (coarse, coarse_steps) = error(1e-8);
+    let (fine, fine_steps) = error(1e-12);
+    eprintln!("decoupled: error {coarse:e} in {coarse_steps} steps, {fine:e} in {fine_steps}");
+    let order = (coarse / fine).ln() / (fine_steps as f64 / coarse_steps as f64).ln();
+    assert!((5.5..7.0).contains(&order), "observed order {order}");
+    assert!(fine < 1e-5, "error at tolerance 1e-12: {fine:e}");
+}
