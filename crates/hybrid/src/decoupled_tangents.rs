@@ -143,13 +143,35 @@ impl DecoupledTangents {
 }
 
 /// `v += h sum_j w_j k_j` over the stages `k_j` (blocks of length `m` of `stages`) with a
-/// nonzero weight.
+/// nonzero weight; unrolled for the common lengths (the transition matrix of a 2-mode model,
+/// with and without the parameter column).
 fn axpy_stages(v: &mut [f64], stages: &[f64], weights: &[f64], h: f64, m: usize) {
+    match m {
+        16 => axpy_fixed::<16>(v, stages, weights, h),
+        20 => axpy_fixed::<20>(v, stages, weights, h),
+        _ => axpy_fixed::<0>(v, stages, weights, h),
+    }
+}
+
+/// [`axpy_stages`] for `M = v.len()` (`M = 0`: any length, not unrolled).
+#[inline(always)]
+fn axpy_fixed<const M: usize>(v: &mut [f64], stages: &[f64], weights: &[f64], h: f64) {
+    let m = v.len();
     for (&w, k) in weights.iter().zip(stages.chunks_exact(m)) {
-        if w != 0.0 {
-            let scale = h * w;
-            for (a, &r) in v.iter_mut().zip(k) {
-                *a += scale * r;
+        if w == 0.0 {
+            continue;
+        }
+        let scale = h * w;
+        match (<&mut [f64; M]>::try_from(&mut *v), <&[f64; M]>::try_from(k)) {
+            (Ok(v), Ok(k)) if M > 0 => {
+                for (a, &r) in v.iter_mut().zip(k) {
+                    *a += scale * r;
+                }
+            }
+            _ => {
+                for (a, &r) in v.iter_mut().zip(k) {
+                    *a += scale * r;
+                }
             }
         }
     }
