@@ -148,7 +148,7 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
     let radius = continuation::spectral_radius(&orbit.multipliers);
     let _ = writeln!(
         s,
-        "stability: {} (largest |Floquet multiplier| = {radius:.6})",
+        "stability: {} (largest |Floquet multiplier| = {radius:.3e})",
         if orbit.stable { "stable" } else { "unstable" }
     );
     let _ = writeln!(

@@ -90,8 +90,8 @@ pub enum SensitivityMethod {
     /// `(step / time scale)^6` per step. Over one period of the Biolever on mica (A/A0 = 0.95
     /// and 0.5, default tolerances) the monodromy is within 2.6e-6 and 6.4e-6 relative of a
     /// tight reference, against 4.2e-8 and 1.1e-7 coupled (`cargo run --release -p afm
-    /// --example monodromy_error`), for 10% fewer instructions in the period map with the
-    /// monodromy at A/A0 = 0.5 (callgrind: 1.48M against 1.64M; 0.92M without it). Enough for Newton iterations, which need the Jacobian only well
+    /// --example monodromy_error`), for 12% fewer instructions in the period map with the
+    /// monodromy at A/A0 = 0.5 (callgrind: 1.44M against 1.64M; 0.92M without it). Enough for Newton iterations, which need the Jacobian only well
     /// enough to contract (each iteration then also reduces the error by about that relative
     /// amount instead of only squaring it), and for stability; not where the derivative of the
     /// numerical flow itself is wanted. `sensitivity_tolerance` must be `None`.
