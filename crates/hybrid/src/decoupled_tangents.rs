@@ -11,6 +11,7 @@
 
 use crate::clock::Clock;
 use crate::sensitivity::{Sensitivity, VariationalField};
+use crate::solver::clocked_field;
 use crate::system::{HybridSystem, Mode};
 
 /// Stages of the method.
@@ -70,7 +71,8 @@ pub(crate) struct DecoupledTangents {
     field: VariationalField,
     /// Stage argument `[x, V]` (augmented length).
     argument: Vec<f64>,
-    /// Stage rate `[dx/dsigma, dV/dsigma]` (augmented length).
+    /// Stage rate `[dx/dsigma, dV/dsigma]` (augmented length), from the solver's clocked
+    /// field.
     rate: Vec<f64>,
     /// The variational part of every stage's rate, stage-major (`STAGES` blocks).
     stages: Vec<f64>,
@@ -104,49 +106,35 @@ impl DecoupledTangents {
         tangents: &[f64],
         tangents_end: &mut [f64],
     ) -> usize {
-        let n = self.n;
+        let Self {
+            n,
+            field,
+            argument,
+            rate,
+            stages,
+        } = self;
+        let n = *n;
+        let mut rhs = clocked_field(field, system, mode, clock, true);
         let m = tangents.len();
         for i in 0..STAGES {
-            let (x, v) = self.argument.split_at_mut(n);
+            let (x, v) = argument.split_at_mut(n);
             state_at(C[i], x);
             v.copy_from_slice(tangents);
-            axpy_stages(v, &self.stages, &A[i][..i], dsigma, m);
-            self.evaluate(system, mode, clock, sigma0 + C[i] * dsigma);
-            self.stages[i * m..(i + 1) * m].copy_from_slice(&self.rate[n..]);
+            axpy_stages(v, stages, &A[i][..i], dsigma);
+            rhs(sigma0 + C[i] * dsigma, argument, rate);
+            stages[i * m..(i + 1) * m].copy_from_slice(&rate[n..]);
         }
         tangents_end.copy_from_slice(tangents);
-        axpy_stages(tangents_end, &self.stages, &B, dsigma, m);
+        axpy_stages(tangents_end, stages, &B, dsigma);
         STAGES
-    }
-
-    /// The augmented rate on `clock` at `sigma` for the current argument, into `rate`.
-    fn evaluate<S: HybridSystem + ?Sized>(
-        &mut self,
-        system: &S,
-        mode: Mode,
-        clock: Clock,
-        sigma: f64,
-    ) {
-        let (t, scale) = match clock {
-            Clock::Time => (sigma, 1.0),
-            Clock::SquareRoot { .. } => (clock.time(sigma), clock.rate(sigma)),
-        };
-        self.field
-            .eval(system, mode, t, &self.argument, &mut self.rate, true);
-        if scale != 1.0 {
-            let n = self.n;
-            for r in &mut self.rate[n..] {
-                *r *= scale;
-            }
-        }
     }
 }
 
-/// `v += h sum_j w_j k_j` over the stages `k_j` (blocks of length `m` of `stages`) with a
-/// nonzero weight; unrolled for the common lengths (the transition matrix of a 2-mode model,
-/// with and without the parameter column).
-fn axpy_stages(v: &mut [f64], stages: &[f64], weights: &[f64], h: f64, m: usize) {
-    match m {
+/// `v += h sum_j w_j k_j` over the stages `k_j` (blocks of length `v.len()` of `stages`) with
+/// a nonzero weight; unrolled for the common lengths (the transition matrix of a 2-mode
+/// model, with and without the parameter column).
+fn axpy_stages(v: &mut [f64], stages: &[f64], weights: &[f64], h: f64) {
+    match v.len() {
         16 => axpy_fixed::<16>(v, stages, weights, h),
         20 => axpy_fixed::<20>(v, stages, weights, h),
         _ => axpy_fixed::<0>(v, stages, weights, h),

@@ -1664,7 +1664,7 @@ const MAX_RETARGETS: usize = 3;
 
 /// The field of `mode` on `clock`: `dz/dsigma = (dt/dsigma) f(t(sigma), z)`, augmented with
 /// the variational equations when `variational` (else only the state part is written).
-fn clocked_field<'b, S: HybridSystem + ?Sized>(
+pub(crate) fn clocked_field<'b, S: HybridSystem + ?Sized>(
     field: &'b mut VariationalField,
     system: &'b S,
     mode: Mode,
