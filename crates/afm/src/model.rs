@@ -3,10 +3,13 @@
 
 use std::f64::consts::PI;
 
-use hybrid::{HybridSystem, LinearisationBuffers, Mode, SwitchingPartials};
+use hybrid::{
+    ClockPolynomial, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials, TaylorSeries,
+};
 use nalgebra::DMatrix;
 
 use crate::case::check_case_numbers;
+use crate::contact_series;
 use crate::free_flight::DrivenOscillator;
 use crate::phase;
 use crate::validation::invalid;
@@ -21,15 +24,15 @@ pub const GAP_SURFACE: usize = 0;
 
 /// The constants of one line of Eq. 1 in internal units.
 #[derive(Debug, Clone)]
-struct ModalConstants {
+pub(crate) struct ModalConstants {
     /// `w_i^2`, 1/us^2.
-    omega_squared: f64,
+    pub(crate) omega_squared: f64,
     /// `w_i^2 / k_i`, (1/us^2)(nm/nN).
-    omega_squared_over_stiffness: f64,
+    pub(crate) omega_squared_over_stiffness: f64,
     /// `w_i / Q_i`, 1/us.
-    damping: f64,
+    pub(crate) damping: f64,
     /// `w_i^2 F_i / k_i`, nm/us^2.
-    drive_acceleration: f64,
+    pub(crate) drive_acceleration: f64,
     /// `chi_i`.
     optical_sensitivity: f64,
     /// The free-flight flow of this mode.
@@ -571,6 +574,59 @@ impl HybridSystem for TappingModel {
         SwitchingPartials {
             t: self.separation.rate(),
             p: 1.0,
+        }
+    }
+
+    /// In contact, [`crate::contact_series::MAX_ORDER`]: the contact flow's Taylor series come
+    /// from the recurrences of [`crate::contact_series`].
+    fn taylor_order_limit(&self, mode: Mode) -> usize {
+        if Self::in_contact(mode) {
+            contact_series::MAX_ORDER
+        } else {
+            0
+        }
+    }
+
+    /// In contact, the series of [`contact_series::contact_state_series`]; `false` in free
+    /// flight (which has its exact flow).
+    fn taylor_series(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        series: &mut TaylorSeries,
+    ) -> bool {
+        Self::in_contact(mode)
+            && contact_series::contact_state_series(
+                &self.modes,
+                self.hertz.coefficient,
+                self.drive.angular_frequency,
+                &self.separation,
+                clock,
+                series,
+            )
+    }
+
+    /// In contact, the tangent series of [`contact_series::contact_tangent_series`].
+    fn taylor_tangents(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        state: &TaylorSeries,
+        tangents: &mut TaylorSeries,
+        parameter_column: bool,
+        scratch: &mut Vec<f64>,
+    ) {
+        if Self::in_contact(mode) {
+            contact_series::contact_tangent_series(
+                &self.modes,
+                self.hertz.coefficient,
+                &self.separation,
+                clock,
+                state,
+                tangents,
+                parameter_column,
+                scratch,
+            );
         }
     }
 

@@ -40,6 +40,7 @@ pub mod settings;
 pub mod solver;
 pub mod system;
 mod tableau;
+pub mod taylor;
 pub mod workspace;
 
 pub use error::HybridError;
@@ -49,4 +50,5 @@ pub use sensitivity::{LinearisationBuffers, Sensitivity};
 pub use settings::{SensitivityMethod, Settings};
 pub use solver::{Solver, Statistics, StepOutcome};
 pub use system::{Direction, HybridSystem, Mode, SwitchingPartials, MAX_SURFACES};
+pub use taylor::{ClockPolynomial, TaylorSeries};
 pub use workspace::SolverWorkspace;

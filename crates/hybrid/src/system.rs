@@ -26,6 +26,7 @@
 use nalgebra::DMatrix;
 
 use crate::sensitivity::{jacobian_products, LinearisationBuffers};
+use crate::taylor::{ClockPolynomial, TaylorSeries};
 
 /// Which side of every switching surface a state lies on: bit `k` is set when `h_k < 0`.
 ///
@@ -226,6 +227,54 @@ pub trait HybridSystem {
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
         let _ = mode;
         None
+    }
+
+    /// The highest order to which [`HybridSystem::taylor_series`] expands the solution of mode
+    /// `mode`; 0 (the default) where the system gives no Taylor series. Where it is positive,
+    /// the solver takes Taylor-series steps in that mode (see [`crate::taylor`]).
+    fn taylor_order_limit(&self, mode: Mode) -> usize {
+        let _ = mode;
+        0
+    }
+
+    /// The Taylor coefficients, to `series.order()`, of the solution of `dx/ds = (dt/ds)
+    /// f_mode(t(s), x)` through `x(0)` = the constant terms of `series` (set by the caller), in
+    /// the clock offset `s` with `t(s)` = `clock`: every coefficient of `series` written.
+    /// `false` if the series cannot be formed there (the solver then takes a Runge-Kutta step).
+    ///
+    /// Called only for modes with a positive [`HybridSystem::taylor_order_limit`] and orders up
+    /// to it. A clock with `rate == 0` starts at the reference of a square-root clock, which the
+    /// solver places at a step start only at the crossing of the mode's
+    /// [`HybridSystem::half_power_surface`] that entered the mode: the state is on that surface.
+    fn taylor_series(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        series: &mut TaylorSeries,
+    ) -> bool {
+        let _ = (mode, clock, series);
+        false
+    }
+
+    /// The Taylor coefficients of a tangent matrix `V` (`n` rows, `tangents.dim() / n` columns)
+    /// along the solution whose series is `state` (from [`HybridSystem::taylor_series`] with the
+    /// same `mode` and `clock`): `dV/ds = (dt/ds) J(t(s), x(s)) V`, plus `(dt/ds) df/dp` on the
+    /// last column when `parameter_column`. Each coefficient of `tangents` is a row-major
+    /// matrix (component `row * columns + column`: the recurrences then run along rows of
+    /// contiguous columns); the constant terms hold `V` at `s = 0`, and every other coefficient
+    /// is written. `scratch` is free space the implementation may resize.
+    ///
+    /// Called only where [`HybridSystem::taylor_series`] returned `true` for `state`.
+    fn taylor_tangents(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        state: &TaylorSeries,
+        tangents: &mut TaylorSeries,
+        parameter_column: bool,
+        scratch: &mut Vec<f64>,
+    ) {
+        let _ = (mode, clock, state, tangents, parameter_column, scratch);
     }
 
     /// Whether mode `mode` has a closed-form flow ([`HybridSystem::exact_flow`]).
