@@ -85,8 +85,8 @@ fn accelerations<'a>(
 /// state is outside the sample (`d >= 0`) where the clock runs at a finite rate, or the
 /// indentation does not grow from the surface at an onset (a grazing touch, not analytic in
 /// `s`). A clock whose rate is zero at the start (`tau(0) = 0`) is the square-root clock
-/// centred on the crossing that entered contact (the only place the solver puts one at a step
-/// start): the state there is taken to be on the surface (`delta_0 = 0`, whatever its rounding).
+/// centred on the crossing that entered contact (the only place a step starts from one): the
+/// state there is taken to be on the surface (`delta_0 = 0`, whatever its rounding).
 pub(crate) fn contact_state_series(
     modes: &[ModalConstants],
     hertz: f64,

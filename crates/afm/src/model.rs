@@ -577,8 +577,8 @@ impl HybridSystem for TappingModel {
         }
     }
 
-    /// In contact, [`crate::contact_series::MAX_ORDER`]: the contact flow's Taylor series come
-    /// from the recurrences of [`crate::contact_series`].
+    /// In contact, 40: the contact flow's Taylor series come from the recurrences of automatic
+    /// differentiation (module `contact_series`), whose intermediate series live on the stack.
     fn taylor_order_limit(&self, mode: Mode) -> usize {
         if Self::in_contact(mode) {
             contact_series::MAX_ORDER
@@ -587,8 +587,8 @@ impl HybridSystem for TappingModel {
         }
     }
 
-    /// In contact, the series of [`contact_series::contact_state_series`]; `false` in free
-    /// flight (which has its exact flow).
+    /// In contact, the series of Eq. 1 with the Hertz force in the step's clock (module
+    /// `contact_series`); `false` in free flight (which has its exact flow).
     fn taylor_series(
         &self,
         mode: Mode,
@@ -606,7 +606,8 @@ impl HybridSystem for TappingModel {
             )
     }
 
-    /// In contact, the tangent series of [`contact_series::contact_tangent_series`].
+    /// In contact, the series of the variational equations along the contact series (module
+    /// `contact_series`).
     fn taylor_tangents(
         &self,
         mode: Mode,

@@ -230,8 +230,8 @@ pub trait HybridSystem {
     }
 
     /// The highest order to which [`HybridSystem::taylor_series`] expands the solution of mode
-    /// `mode`; 0 (the default) where the system gives no Taylor series. Where it is positive,
-    /// the solver takes Taylor-series steps in that mode (see [`crate::taylor`]).
+    /// `mode`; 0 (the default) where the system gives no Taylor series (see [`crate::taylor`]
+    /// for their use).
     fn taylor_order_limit(&self, mode: Mode) -> usize {
         let _ = mode;
         0
@@ -240,11 +240,11 @@ pub trait HybridSystem {
     /// The Taylor coefficients, to `series.order()`, of the solution of `dx/ds = (dt/ds)
     /// f_mode(t(s), x)` through `x(0)` = the constant terms of `series` (set by the caller), in
     /// the clock offset `s` with `t(s)` = `clock`: every coefficient of `series` written.
-    /// `false` if the series cannot be formed there (the solver then takes a Runge-Kutta step).
+    /// `false` if the series cannot be formed there.
     ///
-    /// Called only for modes with a positive [`HybridSystem::taylor_order_limit`] and orders up
-    /// to it. A clock with `rate == 0` starts at the reference of a square-root clock, which the
-    /// solver places at a step start only at the crossing of the mode's
+    /// To be called only for modes with a positive [`HybridSystem::taylor_order_limit`] and
+    /// orders up to it. A clock with `rate == 0` starts at the reference of a square-root clock,
+    /// which a step starts from only at the crossing of the mode's
     /// [`HybridSystem::half_power_surface`] that entered the mode: the state is on that surface.
     fn taylor_series(
         &self,
@@ -264,7 +264,7 @@ pub trait HybridSystem {
     /// contiguous columns); the constant terms hold `V` at `s = 0`, and every other coefficient
     /// is written. `scratch` is free space the implementation may resize.
     ///
-    /// Called only where [`HybridSystem::taylor_series`] returned `true` for `state`.
+    /// To be called only where [`HybridSystem::taylor_series`] returned `true` for `state`.
     fn taylor_tangents(
         &self,
         mode: Mode,

@@ -5,8 +5,14 @@
 //! of high order replaces many Runge-Kutta stages: a step is as long as the series converges
 //! fast enough for the tolerance, and the polynomial itself is the step's dense output, exact
 //! to the same order everywhere in the step. The series is taken in the step's clock variable
-//! `s` (see [`crate::clock`]): on a square-root clock the solution next to a Hertz contact's
+//! `s` (time, or the square root of the time from a crossing): on a square-root clock the solution next to a Hertz contact's
 //! onset or release is analytic in `s`, though not in time.
+//!
+//! Status: systems state their series through [`crate::HybridSystem::taylor_series`] and
+//! [`crate::HybridSystem::taylor_tangents`] (the AFM contact does, tested against DOP853), but
+//! the solver does not take Taylor steps yet: a first integration took 8 series steps per
+//! contact of the Biolever on mica against ~30 DOP853 attempts, yet no fewer instructions per
+//! period map than DOP853 until the series themselves get cheaper.
 
 /// The time along a step as a polynomial in the step's clock offset `s` (the clock reading
 /// minus its reading at the step start): `t(s) = start + rate s + curvature s^2`. On the time
