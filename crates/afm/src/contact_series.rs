@@ -61,6 +61,34 @@ fn update_root(root: &mut [f64], y: &[f64], k: usize) {
     };
 }
 
+/// Coefficient `k` of the indentation `delta = -(Z(t(s)) + sum_i q_i)` from the state's
+/// coefficient row `k` (`[q_1, v_1, ...]`).
+#[inline]
+fn indentation_coefficient(
+    separation: &Separation,
+    clock: &ClockPolynomial,
+    row: &[f64],
+    k: usize,
+) -> f64 {
+    -(separation_coefficient(separation, clock, k)
+        + row.chunks_exact(2).map(|qv| qv[0]).sum::<f64>())
+}
+
+/// Coefficient `m` of `r = sqrt(delta)` from `delta`'s coefficients and `r`'s below `m`. Off
+/// an onset, `delta_0 > 0` and [`update_root`] applies (it needs `delta` to `m`). On an onset
+/// (`delta = s^2 g`, `g_j = delta_{j+2}`), `r = s sqrt(g)`: `r_0 = 0` and `r_m = sqrt(g)_{m-1}`
+/// (it needs `delta` to `m + 1`).
+#[inline]
+fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
+    if !onset {
+        update_root(root, delta, m);
+    } else if m == 0 {
+        root[0] = 0.0;
+    } else {
+        update_root(&mut root[1..], &delta[2..], m - 1);
+    }
+}
+
 /// `(w_i^2 F_i / k_i) cos + (w_i^2/k_i) F - w_i^2 q_i - (w_i/Q_i) v_i` for every mode `i` of the
 /// state row `row` (`[q_1, v_1, ...]`), Eq. 1's acceleration given the drive factor and the
 /// force.
@@ -112,20 +140,18 @@ pub(crate) fn contact_state_series(
     for k in 0..p {
         let (done, rest) = x.split_at_mut((k + 1) * n);
         let row = &done[k * n..];
-        delta[k] = -(separation_coefficient(separation, clock, k)
-            + row.chunks_exact(2).map(|qv| qv[0]).sum::<f64>());
+        delta[k] = indentation_coefficient(separation, clock, row, k);
         force[k] = if onset {
             // delta_0 = delta_1 = 0: delta = s^2 g (g_j = delta_{j+2}), r = s sqrt(g),
-            // F = c s^3 g sqrt(g); coefficient k needs g to k - 3 only.
+            // F = c s^3 g sqrt(g); coefficient k needs g and sqrt(g) = r_{.+1} to k - 3 only.
             if k >= 3 {
-                let j = k - 3;
-                update_root(&mut root[1..], &delta[2..], j);
-                hertz * product_coefficient(&delta[2..], &root[1..], j)
+                indentation_root(&mut root, &delta, k - 2, true);
+                hertz * product_coefficient(&delta[2..], &root[1..], k - 3)
             } else {
                 0.0
             }
         } else {
-            update_root(&mut root, &delta, k);
+            indentation_root(&mut root, &delta, k, false);
             hertz * product_coefficient(&delta, &root, k)
         };
         if !force[k].is_finite() {
@@ -197,19 +223,10 @@ pub(crate) fn contact_tangent_series(
         .zip(state.coefficients().chunks_exact(n))
         .enumerate()
     {
-        *d = -(separation_coefficient(separation, clock, k)
-            + row.chunks_exact(2).map(|qv| qv[0]).sum::<f64>());
+        *d = indentation_coefficient(separation, clock, row, k);
     }
-    if a != 0.0 {
-        for k in 0..p {
-            update_root(&mut root, &delta, k);
-        }
-    } else {
-        // r = s sqrt(g), g_j = delta_{j+2}: r_k = sqrt(g)_{k-1}.
-        for j in 0..p.saturating_sub(1) {
-            update_root(&mut root[1..], &delta[2..], j);
-        }
-        root[0] = 0.0;
+    for m in 0..p {
+        indentation_root(&mut root, &delta, m, a == 0.0);
     }
     let slope = -1.5 * hertz;
     let columns = tangents.dim() / n;

@@ -5,8 +5,8 @@
 //! of high order replaces many Runge-Kutta stages: a step is as long as the series converges
 //! fast enough for the tolerance, and the polynomial itself is the step's dense output, exact
 //! to the same order everywhere in the step. The series is taken in the step's clock variable
-//! `s` (time, or the square root of the time from a crossing): on a square-root clock the solution next to a Hertz contact's
-//! onset or release is analytic in `s`, though not in time.
+//! `s` (time, or the square root of the time from a crossing): on a square-root clock the
+//! solution next to a Hertz contact's onset or release is analytic in `s`, though not in time.
 //!
 //! Status: systems state their series through [`crate::HybridSystem::taylor_series`] and
 //! [`crate::HybridSystem::taylor_tangents`] (the AFM contact does, tested against DOP853), but
