@@ -109,6 +109,7 @@ use crate::extrema::Clearance;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
 use crate::system::{side_sign, Direction, HybridSystem, Mode, MAX_SURFACES};
+use crate::taylor::{first_zero, ClockPolynomial, TaylorStep, TAYLOR_ORDER};
 use crate::workspace::{Buffers, SolverWorkspace};
 
 /// Why [`Solver::step`] returned.
@@ -137,6 +138,8 @@ pub struct Statistics {
     pub rhs_evaluations: usize,
     /// Events fired.
     pub events: usize,
+    /// Accepted Taylor-series steps (included in `steps`).
+    pub series_steps: usize,
     /// Steps sampled inside (at `samples_per_step` interior points) for extrema and brief
     /// dips; the others were proven clear of the surfaces or settled on their interpolant and
     /// sampled at their ends only (see the module docs).
@@ -152,6 +155,8 @@ enum StepKind {
     RungeKutta,
     /// An exact-flow step.
     Exact,
+    /// A Taylor-series step (the series is its dense output).
+    Taylor,
 }
 
 /// A stepper for a [`HybridSystem`]: integrates mode by mode, stops at every event, and carries
@@ -191,6 +196,11 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// Whether every switching function is affine (gradients and drifts in the buffers), so
     /// that a Runge-Kutta step may be proven settled on its interpolant.
     affine_switching: bool,
+    /// The crossing of the mode's half-power surface that the last Taylor step's series
+    /// predicts (its first zero up to [`RELEASE_LOOKAHEAD`] reaches past the step).
+    predicted_crossing: Option<f64>,
+    /// The time length of the last Taylor step.
+    last_series_step: f64,
     statistics: Statistics,
 }
 
@@ -290,6 +300,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             full_dense: false,
             proven_clear: false,
             affine_switching,
+            predicted_crossing: None,
+            last_series_step: 0.0,
             statistics: Statistics::default(),
             settings,
         };
@@ -332,6 +344,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.steps_in_mode = 0;
         self.first_same_as_last = false;
         self.entered = None;
+        self.predicted_crossing = None;
+        self.last_series_step = 0.0;
         self.clock = Clock::Time;
         self.kind = StepKind::None;
         self.step_start = t0;
@@ -391,6 +405,16 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             StepKind::RungeKutta => {
                 let theta = (self.clock.sigma(t) - self.sigma_start) / self.buffers.rk.h;
                 self.buffers.rk.interpolate(&self.buffers.z_start, theta, x);
+            }
+            StepKind::Taylor => {
+                let s = self.clock.sigma(t) - self.sigma_start;
+                if m == self.n {
+                    self.buffers.taylor.state.evaluate(s, x);
+                } else {
+                    let mut full = vec![0.0; self.n];
+                    self.buffers.taylor.state.evaluate(s, &mut full);
+                    x.copy_from_slice(&full[..m]);
+                }
             }
             StepKind::Exact => {
                 if m == self.n {
@@ -479,6 +503,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.proven_clear = false;
         let t1 = if self.system.has_exact_flow(mode) {
             self.exact_step(t_end)?
+        } else if let Some(t1) = self.taylor_step(t_end)? {
+            t1
         } else {
             self.runge_kutta_step(t_end)?
         };
@@ -502,7 +528,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         });
         // A Runge-Kutta step with affine switching functions may be proven settled on its
         // interpolant, whatever the height.
-        let polynomial = self.affine_switching && self.kind == StepKind::RungeKutta;
+        let polynomial = self.affine_switching
+            && matches!(self.kind, StepKind::RungeKutta | StepKind::Taylor);
         let clear = (self.settings.extremum_height.is_finite() || polynomial || bounded) && {
             self.buffers.samples.sample_ends(
                 self.system,
@@ -524,13 +551,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let system = self.system;
             let n = self.n;
             let kind = self.kind;
-            let rk = &self.buffers.rk;
+            let dense = (&self.buffers.rk, &self.buffers.taylor);
             let z_start = &self.buffers.z_start;
             let z_new = &self.buffers.z_new;
             let clock = (self.clock, self.sigma_start);
             let mut state_at = |t: f64, out: &mut [f64]| {
                 state_in_step(
-                    system, kind, mode, rk, clock, z_start, z_new, t0, t1, n, t, out,
+                    system, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, out,
                 );
             };
             // Exact steps: every interior state from one call (a linear flow reuses its
@@ -675,12 +702,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     fn interpolant_settled(&self, mode: Mode) -> bool {
         let n = self.n;
         let p = self.buffers.samples.points();
-        let height = self.settings.extremum_height;
         let rk = &self.buffers.rk;
         // t(theta) - t0 = linear theta + quadratic theta^2.
-        let (linear, quadratic) = match self.clock {
-            Clock::Time => (rk.h, 0.0),
-            Clock::SquareRoot { .. } => {
+        let (linear, quadratic) = match (self.kind, self.clock) {
+            (StepKind::Taylor, _) => {
+                let (clock, length) = (&self.buffers.taylor.clock, self.buffers.taylor.length);
+                (clock.rate * length, clock.curvature * length * length)
+            }
+            (_, Clock::Time) => (rk.h, 0.0),
+            (_, Clock::SquareRoot { .. }) => {
                 let (sigma0, dsigma) = (self.sigma_start, rk.h);
                 let sign = (sigma0 + 0.5 * dsigma).signum();
                 (sign * 2.0 * sigma0 * dsigma, sign * dsigma * dsigma)
@@ -688,26 +718,62 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         };
         (0..self.surfaces).all(|k| {
             let samples = &self.buffers.samples;
-            let mut power = rk.dense_polynomial(&self.buffers.affine_gradients[k * n..(k + 1) * n]);
-            power[0] = samples.values[k * p];
+            let gradient = &self.buffers.affine_gradients[k * n..(k + 1) * n];
             let drift = self.buffers.affine_drifts[k];
-            power[1] += drift * linear;
-            power[2] += drift * quadratic;
-            // Above the surface (positive side) and the height throughout: nothing wanted.
-            if side_sign(mode, k) > 0.0
-                && height.is_finite()
-                && stays_above(&power, height.max(0.0))
-            {
-                return true;
+            let ends = (
+                samples.values[k * p],
+                samples.rates[k * p],
+                samples.rates[k * p + p - 1],
+            );
+            if self.kind == StepKind::Taylor {
+                let taylor = &self.buffers.taylor;
+                let mut power = [0.0; TAYLOR_ORDER + 1];
+                taylor.state.weighted_sum(gradient, &mut power);
+                let mut scale = 1.0;
+                for c in power.iter_mut() {
+                    *c *= scale;
+                    scale *= taylor.length;
+                }
+                self.polynomial_settled::<{ TAYLOR_ORDER + 1 }, TAYLOR_ORDER>(
+                    mode,
+                    k,
+                    power,
+                    (linear, quadratic, drift),
+                    ends,
+                )
+            } else {
+                let power = rk.dense_polynomial(gradient);
+                self.polynomial_settled::<8, 7>(mode, k, power, (linear, quadratic, drift), ends)
             }
-            let mut derivative = [0.0; 7];
-            for (j, d) in derivative.iter_mut().enumerate() {
-                *d = (j + 1) as f64 * power[j + 1];
-            }
-            let (start_rate, end_rate) = (samples.rates[k * p], samples.rates[k * p + p - 1]);
-            strict_sign(&derivative)
-                .is_some_and(|sign| sign * start_rate > 0.0 && sign * end_rate > 0.0)
         })
+    }
+
+    /// [`Solver::interpolant_settled`] for surface `k` whose interpolant over the step, less
+    /// its value at the start and its drift term, has the power-basis coefficients `power` in
+    /// the clock fraction (degree `D - 1`; `E = D - 1` coefficients for its derivative);
+    /// `ends` = the value at the start and the rates at both ends.
+    fn polynomial_settled<const D: usize, const E: usize>(
+        &self,
+        mode: Mode,
+        k: usize,
+        mut power: [f64; D],
+        (linear, quadratic, drift): (f64, f64, f64),
+        (start_value, start_rate, end_rate): (f64, f64, f64),
+    ) -> bool {
+        let height = self.settings.extremum_height;
+        power[0] = start_value;
+        power[1] += drift * linear;
+        power[2] += drift * quadratic;
+        // Above the surface (positive side) and the height throughout: nothing wanted.
+        if side_sign(mode, k) > 0.0 && height.is_finite() && stays_above(&power, height.max(0.0)) {
+            return true;
+        }
+        let mut derivative = [0.0; E];
+        for (j, d) in derivative.iter_mut().enumerate() {
+            *d = (j + 1) as f64 * power[j + 1];
+        }
+        strict_sign(&derivative)
+            .is_some_and(|sign| sign * start_rate > 0.0 && sign * end_rate > 0.0)
     }
 
     /// The system's bound `M_k` on `|h_k''|` over the step `[t0, t1]` for every surface
@@ -843,6 +909,179 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 }
             }
         }
+    }
+
+    /// A Taylor-series step ([`crate::taylor`]) where the system gives series of the mode's
+    /// solution to [`TAYLOR_ORDER`]; `None` (nothing done: the caller takes a Runge-Kutta step)
+    /// where it gives none or cannot form one here. Writes `z_new`.
+    ///
+    /// The step is as long as the series' last two terms stay below the tolerance
+    /// ([`TaylorStep::reach`]), on the clock in which the solution is analytic up to its
+    /// nearest non-smooth point: the square root of the time since the crossing of the mode's
+    /// half-power surface that entered it, the square root of the time to the crossing the last
+    /// series predicts (its first zero within [`RELEASE_LOOKAHEAD`] reaches) when that is the
+    /// nearer, else time. A step on the latter lands on its reference, just past the crossing
+    /// (re-centred on the zero of its own series when that lies farther than the overshoot), so
+    /// the step holds the crossing, which the event location then finds on the series.
+    fn taylor_step(&mut self, t_end: f64) -> Result<Option<f64>, HybridError> {
+        let system = self.system;
+        let mode = self.mode;
+        if system.taylor_order_limit(mode) < TAYLOR_ORDER {
+            return Ok(None);
+        }
+        let half_power = system.half_power_surface(mode);
+        if half_power.is_some() && !self.affine_switching {
+            return Ok(None);
+        }
+        self.check_attempts()?;
+        let (t0, n) = (self.t, self.n);
+        let (rtol, atol) = (
+            self.settings.relative_tolerance,
+            self.settings.absolute_tolerance,
+        );
+        let onset = match (half_power, self.entered) {
+            (Some(k), Some((entered, t_event))) if k == entered => Some(t_event),
+            _ => None,
+        };
+        let ahead = self
+            .predicted_crossing
+            .filter(|&t_cross| t_cross > t0 && self.steps_in_mode > 0);
+        let mut clock = match (ahead, onset) {
+            (Some(t_cross), Some(t_event)) if t_cross - t0 <= t0 - t_event => {
+                Clock::SquareRoot { reference: t_cross }
+            }
+            (Some(t_cross), None) => Clock::SquareRoot { reference: t_cross },
+            (_, Some(t_event)) => Clock::SquareRoot { reference: t_event },
+            (None, None) => Clock::Time,
+        };
+        let mut recentred = 0;
+        let (sigma0, length, t1) = loop {
+            let sigma0 = clock.sigma(t0);
+            let polynomial = match clock {
+                Clock::Time => ClockPolynomial {
+                    start: t0,
+                    rate: 1.0,
+                    curvature: 0.0,
+                },
+                Clock::SquareRoot { .. } => ClockPolynomial {
+                    start: t0,
+                    rate: 2.0 * sigma0.abs(),
+                    curvature: if sigma0 < 0.0 { -1.0 } else { 1.0 },
+                },
+            };
+            let taylor = &mut self.buffers.taylor;
+            if !taylor.expand(system, mode, polynomial, &self.buffers.z[..n]) {
+                return Ok(None);
+            }
+            let mut reach = TaylorStep::reach(&taylor.state, rtol, atol);
+            if self.sensitivity.transition() {
+                taylor.expand_tangents(
+                    system,
+                    mode,
+                    &self.buffers.z[n..],
+                    self.sensitivity.parameter(),
+                );
+                if let Some(tolerance) = self.settings.sensitivity_tolerance {
+                    reach = reach.min(TaylorStep::reach(&taylor.tangents, tolerance, tolerance));
+                }
+            }
+            // On a clock centred ahead, the step ends at its reference at the latest.
+            let landing = sigma0 < 0.0 && reach >= -sigma0;
+            if sigma0 < 0.0 {
+                reach = reach.min(-sigma0);
+            }
+            // The half-power surface's first zero along the series: within the step, the
+            // crossing the step must hold; beyond it, the prediction for the next step.
+            let crossing = half_power.and_then(|k| {
+                let upto = if sigma0 < 0.0 {
+                    -sigma0
+                } else {
+                    RELEASE_LOOKAHEAD * reach
+                };
+                self.surface_zero(k, upto).map(|s| polynomial.time(s))
+            });
+            // A crossing inside the reach of a series not centred on it: centre one there.
+            let inside = crossing.filter(|&t_cross| t_cross <= clock.time(sigma0 + reach));
+            if let (Some(t_cross), true) = (inside, sigma0 >= 0.0 || clock == Clock::Time) {
+                if recentred < MAX_RETARGETS {
+                    recentred += 1;
+                    clock = Clock::SquareRoot {
+                        reference: t0 + (t_cross - t0) * (1.0 + ROOT_OVERSHOOT),
+                    };
+                    continue;
+                }
+            }
+            if let (Clock::SquareRoot { reference }, Some(t_cross)) = (clock, crossing) {
+                let off_centre = reference - t_cross > 10.0 * ROOT_OVERSHOOT * (reference - t0);
+                if landing && off_centre && recentred < MAX_RETARGETS {
+                    recentred += 1;
+                    clock = Clock::SquareRoot {
+                        reference: t0 + (t_cross - t0) * (1.0 + ROOT_OVERSHOOT),
+                    };
+                    continue;
+                }
+            }
+            if landing && crossing.is_none() {
+                // The crossing was predicted but lies past the reference: leave the approach
+                // to the Runge-Kutta step's own landing.
+                return Ok(None);
+            }
+            self.predicted_crossing = crossing;
+            let t_reach = clock.time(sigma0 + reach);
+            let max_step = self.settings.max_step;
+            break if t_reach >= t_end {
+                (sigma0, clock.sigma(t_end) - sigma0, t_end)
+            } else if t_reach - t0 > max_step {
+                let length = clock.clock_step(t0, max_step);
+                (sigma0, length, clock.time(sigma0 + length))
+            } else {
+                (sigma0, reach, t_reach)
+            };
+        };
+        // A series whose reach collapses (a start next to a non-smooth point it is not centred
+        // on) would crawl: the Runge-Kutta step's landings handle that.
+        if t1 < t_end && t1 - t0 < MIN_SERIES_FRACTION * self.last_series_step {
+            return Ok(None);
+        }
+        let taylor = &mut self.buffers.taylor;
+        taylor.length = length;
+        let (x1, tangents) = self.buffers.z_new.split_at_mut(n);
+        taylor.state.evaluate(length, x1);
+        if !tangents.is_empty() {
+            taylor.tangents_at(length, tangents);
+        }
+        if self.buffers.z_new.iter().any(|v| !v.is_finite()) {
+            return Err(HybridError::NonFiniteState { t: t1 });
+        }
+        self.clock = clock;
+        self.sigma_start = sigma0;
+        self.kind = StepKind::Taylor;
+        self.first_same_as_last = false;
+        self.proposed_step = Some(t1 - t0);
+        self.last_series_step = t1 - t0;
+        self.steps_in_mode += 1;
+        self.statistics.steps += 1;
+        self.statistics.series_steps += 1;
+        Ok(Some(t1))
+    }
+
+    /// The first zero in `(0, upto]` of surface `k` (affine) along the last Taylor series, in
+    /// its clock offset.
+    fn surface_zero(&self, k: usize, upto: f64) -> Option<f64> {
+        let n = self.n;
+        let taylor = &self.buffers.taylor;
+        let mut power = [0.0; TAYLOR_ORDER + 1];
+        taylor
+            .state
+            .weighted_sum(&self.buffers.affine_gradients[k * n..(k + 1) * n], &mut power);
+        let clock = &taylor.clock;
+        power[0] = self
+            .system
+            .switching(k, clock.start, &self.buffers.z[..n]);
+        let drift = self.buffers.affine_drifts[k];
+        power[1] += drift * clock.rate;
+        power[2] += drift * clock.curvature;
+        first_zero(&power, upto)
     }
 
     /// One accepted DOP853 step (with as many rejected attempts as needed); returns the end
@@ -1362,14 +1601,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let system = self.system;
             let n = self.n;
             let kind = self.kind;
-            let rk = &self.buffers.rk;
+            let dense = (&self.buffers.rk, &self.buffers.taylor);
             let z_start = &self.buffers.z_start;
             let z_new = &self.buffers.z_new;
             let clock = (self.clock, self.sigma_start);
             let x = &mut self.buffers.x;
             let mut g = |t: f64| {
                 state_in_step(
-                    system, kind, mode, rk, clock, z_start, z_new, t0, t1, n, t, x,
+                    system, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, x,
                 );
                 side * system.switching(k, t, x)
             };
@@ -1450,6 +1689,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 self.buffers
                     .rk
                     .interpolate(&self.buffers.z_start, theta, &mut self.buffers.z);
+            }
+            StepKind::Taylor => {
+                let n = self.n;
+                let s = self.clock.sigma(t) - self.sigma_start;
+                let (x, tangents) = self.buffers.z.split_at_mut(n);
+                self.buffers.taylor.state.evaluate(s, x);
+                if !tangents.is_empty() {
+                    self.buffers.taylor.tangents_at(s, tangents);
+                }
             }
             StepKind::Exact => {
                 // Reuse z_new as scratch: the step is being truncated.
@@ -1655,6 +1903,13 @@ const PROBE_OVERSHOOT: f64 = 0.05;
 /// 1e-6 that Newton and the Floquet multipliers are granted).
 const ROOT_CLOCK_SPAN: f64 = 1.0;
 
+/// How many of its own reaches past a Taylor step its series is searched for the next crossing
+/// of the half-power surface (the series converges out to about four reaches).
+const RELEASE_LOOKAHEAD: f64 = 3.0;
+
+/// A Taylor step shorter than this fraction of the previous one gives way to Runge-Kutta.
+const MIN_SERIES_FRACTION: f64 = 1e-3;
+
 /// Points at which a rejected trial's dense output is sampled to bracket the crossing it
 /// passed.
 const TRIAL_SAMPLES: usize = 16;
@@ -1811,7 +2066,7 @@ fn state_in_step<S: HybridSystem + ?Sized>(
     system: &S,
     kind: StepKind,
     mode: Mode,
-    rk: &Dop853,
+    (rk, taylor): (&Dop853, &TaylorStep),
     (clock, sigma0): (Clock, f64),
     z_start: &[f64],
     z_new: &[f64],
@@ -1831,6 +2086,7 @@ fn state_in_step<S: HybridSystem + ?Sized>(
     }
     match kind {
         StepKind::RungeKutta => rk.interpolate(z_start, (clock.sigma(t) - sigma0) / rk.h, out),
+        StepKind::Taylor => taylor.state.evaluate(clock.sigma(t) - sigma0, out),
         StepKind::Exact => {
             system.exact_flow(mode, t0, &z_start[..n], t - t0, out, None, None);
         }

@@ -15,6 +15,7 @@ use crate::extrema::Samples;
 use crate::saltation::Saltation;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::{SensitivityMethod, Settings};
+use crate::taylor::TaylorStep;
 
 /// The buffers a [`crate::Solver`] allocates for a state of dimension `n`, a number of switching
 /// surfaces, a [`Sensitivity`] and the sampling and error-control settings that size them.
@@ -64,6 +65,8 @@ pub(crate) struct Buffers {
     /// The variational integration apart from the state's steps, with
     /// [`SensitivityMethod::Decoupled`] and a tracked transition.
     pub tangents: Option<DecoupledTangents>,
+    /// The last Taylor-series step (in modes whose system gives series).
+    pub taylor: TaylorStep,
     pub x_ahead: Vec<f64>,
     pub grid: Vec<f64>,
     /// `f(t, x)` at the start of a step, in time units (for the crossing prediction).
@@ -123,6 +126,7 @@ impl Buffers {
             field: VariationalField::new(n, stepped),
             rk: Dop853::new(stepped.augmented_dim(n), n, settings.sensitivity_tolerance),
             tangents: decoupled.then(|| DecoupledTangents::new(n, sensitivity)),
+            taylor: TaylorStep::new(n, (dim - n) / n.max(1)),
             x_ahead: vec![0.0; n],
             grid: vec![0.0; (settings.samples_per_step + 1) * n],
             velocity: vec![0.0; n],

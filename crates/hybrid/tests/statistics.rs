@@ -38,6 +38,7 @@ fn hertz_contact_statistics_are_pinned() {
             exact_steps: 0,
             rhs_evaluations: 2935,
             events: 5,
+            series_steps: 0,
             sampled_steps: 180,
         }
     );
@@ -97,6 +98,7 @@ fn bouncing_ball_statistics_are_pinned() {
             exact_steps: 0,
             rhs_evaluations: 382,
             events: 20,
+            series_steps: 0,
             sampled_steps: 24,
         }
     );
