@@ -2,6 +2,8 @@
 //! force integrals) are integrated step by step, where the dense output (or the exact flow) is a
 //! smooth function of time, so a few nodes per step reach rounding accuracy.
 
+use hybrid::Clock;
+
 use crate::phase;
 
 /// A symmetric Gauss-Legendre rule on `[-1, 1]`: its positive nodes and their weights (each
@@ -46,26 +48,31 @@ impl GaussLegendre {
             .map(move |(node, weight)| (half * node, half * weight))
     }
 
-    /// The rule's nodes on `[a, b]` with the drive phase there: `(t, weight, (sin w t,
-    /// cos w t))` for every node, the pair `mid -+ offset` in turn. The phase comes by angle
-    /// addition from the middle (`phase::sin_cos` at the middle and at each offset: one
-    /// evaluation per pair of nodes, plus one).
-    pub fn drive_nodes(
+    /// The rule's nodes on the part `[a, b]` of a solver step whose states are polynomial in
+    /// `clock`'s reading `sigma` (hybrid's `Solver::last_step_clock`), with the drive phase
+    /// there: `(t, weight, (sin w t, cos w t))` for every node. The nodes are the rule's on
+    /// `[sigma(a), sigma(b)]` and the weights carry `dt/dsigma`, so that an integrand smooth in
+    /// `sigma` but not in `t` (the Hertz force `~ (t - t_c)^{3/2}` from a contact's onset or up
+    /// to its release, on the square-root clock) is integrated to the rule's order; on the time
+    /// clock they are the rule's nodes on `[a, b]`.
+    pub fn clock_drive_nodes(
         &self,
+        clock: Clock,
         a: f64,
         b: f64,
         angular_frequency: f64,
     ) -> impl Iterator<Item = (f64, f64, (f64, f64))> + '_ {
-        let middle = 0.5 * (a + b);
-        let (sin_m, cos_m) = phase::sin_cos(angular_frequency * middle);
-        self.pairs(a, b).flat_map(move |(offset, weight)| {
-            let (sin_d, cos_d) = phase::sin_cos(angular_frequency * offset);
-            [(middle - offset, -1.0), (middle + offset, 1.0)].map(|(t, sign)| {
-                let sin = sin_m * cos_d + sign * cos_m * sin_d;
-                let cos = cos_m * cos_d - sign * sin_m * sin_d;
-                (t, weight, (sin, cos))
+        let (sigma_a, sigma_b) = (clock.sigma(a), clock.sigma(b));
+        let middle = 0.5 * (sigma_a + sigma_b);
+        self.pairs(sigma_a, sigma_b)
+            .flat_map(move |(offset, weight)| {
+                [middle - offset, middle + offset].map(|sigma| (sigma, weight))
             })
-        })
+            .map(move |(sigma, weight)| {
+                let t = clock.time(sigma).clamp(a, b);
+                let drive = phase::sin_cos(angular_frequency * t);
+                (t, weight * clock.rate(sigma), drive)
+            })
     }
 }
 
@@ -93,13 +100,13 @@ mod tests {
         }
     }
 
-    /// The drive phases by angle addition are those of the library's `sin_cos` at each node to
-    /// a few ulps, the nodes are those of `pairs`, and the weights integrate 1 to `b - a`.
+    /// On the time clock the nodes are those of `pairs` with the library's `sin_cos` there, and
+    /// the weights integrate 1 to `b - a`.
     #[test]
-    fn drive_nodes_carry_the_phase_at_each_node() {
+    fn time_clock_nodes_carry_the_phase_at_each_node() {
         let (a, b, w) = (123.456, 123.789, 0.0584);
         for rule in [GAUSS_LEGENDRE_8, GAUSS_LEGENDRE_4] {
-            let nodes: Vec<_> = rule.drive_nodes(a, b, w).collect();
+            let nodes: Vec<_> = rule.clock_drive_nodes(Clock::Time, a, b, w).collect();
             assert_eq!(nodes.len(), 2 * rule.pairs(a, b).count());
             let total: f64 = nodes.iter().map(|node| node.1).sum();
             assert!((total - (b - a)).abs() < 1e-15);
@@ -111,6 +118,41 @@ mod tests {
                     "{t}"
                 );
             }
+        }
+    }
+
+    /// On a square-root clock from a contact onset `t_c = a`, the force's shape `(t - t_c)^{3/2}`
+    /// is `sigma^3` and integrates exactly (to `(2/5) (b - t_c)^{5/2}`); the same rule in `t`
+    /// misses by ~1e-5 relative. Also on a clock centred past the interval (a release ahead).
+    #[test]
+    fn square_root_clock_nodes_integrate_the_onset_power_exactly() {
+        let (a, b) = (2.0, 2.7);
+        let onset = Clock::SquareRoot { reference: a };
+        let release = Clock::SquareRoot {
+            reference: b + 0.01,
+        };
+        for rule in [GAUSS_LEGENDRE_8, GAUSS_LEGENDRE_4] {
+            let on_clock: f64 = rule
+                .clock_drive_nodes(onset, a, b, 1.0)
+                .map(|(t, weight, _)| weight * (t - a).powf(1.5))
+                .sum();
+            let exact = 0.4 * (b - a).powf(2.5);
+            assert!(
+                (on_clock - exact).abs() < 1e-14 * exact,
+                "{on_clock} vs {exact}"
+            );
+            let in_time: f64 = rule
+                .clock_drive_nodes(Clock::Time, a, b, 1.0)
+                .map(|(t, weight, _)| weight * (t - a).powf(1.5))
+                .sum();
+            assert!((in_time - exact).abs() > 1e-7 * exact);
+            let end = b + 0.01;
+            let ahead: f64 = rule
+                .clock_drive_nodes(release, a, b, 1.0)
+                .map(|(t, weight, _)| weight * (end - t).powf(1.5))
+                .sum();
+            let exact = 0.4 * ((end - a).powf(2.5) - (end - b).powf(2.5));
+            assert!((ahead - exact).abs() < 1e-14 * exact, "{ahead} vs {exact}");
         }
     }
 }

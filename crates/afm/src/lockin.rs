@@ -154,7 +154,12 @@ impl CycleLockIn {
     /// relative for a step `h`, about 2e-8 even for a step of a quarter drive period (contact
     /// steps are far shorter).
     fn quadrature(&mut self, solver: &Solver<TappingModel>, model: &TappingModel, a: f64, b: f64) {
-        for (t, weight, (sin, cos)) in GAUSS_LEGENDRE_4.drive_nodes(a, b, self.angular_frequency) {
+        for (t, weight, (sin, cos)) in GAUSS_LEGENDRE_4.clock_drive_nodes(
+            solver.last_step_clock(),
+            a,
+            b,
+            self.angular_frequency,
+        ) {
             solver.interpolate(t, &mut self.state);
             let u = model.photodiode(&self.state);
             self.cosine += weight * u * cos;

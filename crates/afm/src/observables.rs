@@ -166,8 +166,12 @@ impl PeriodObserver {
                 }
             } else {
                 self.close_free_flight(a);
-                for (t, weight, drive) in GAUSS_LEGENDRE_8.drive_nodes(a, b, self.angular_frequency)
-                {
+                for (t, weight, drive) in GAUSS_LEGENDRE_8.clock_drive_nodes(
+                    solver.last_step_clock(),
+                    a,
+                    b,
+                    self.angular_frequency,
+                ) {
                     self.accumulate(solver, model, t, drive, weight);
                 }
             }

@@ -14,7 +14,7 @@
 
 /// How a Runge-Kutta step measures its progress.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Clock {
+pub enum Clock {
     /// `sigma = t`.
     Time,
     /// `sigma = sign(t - reference) sqrt(|t - reference|)`: `t = reference + sigma |sigma|`.
@@ -57,7 +57,7 @@ impl Clock {
 
     /// The time step from `t0` that a clock step of `dsigma` from `sigma(t0)` covers.
     #[inline]
-    pub fn time_step(self, t0: f64, dsigma: f64) -> f64 {
+    pub(crate) fn time_step(self, t0: f64, dsigma: f64) -> f64 {
         match self {
             Clock::Time => dsigma,
             Clock::SquareRoot { .. } => self.time(self.sigma(t0) + dsigma) - t0,
@@ -66,7 +66,7 @@ impl Clock {
 
     /// The clock step from `t0` that covers the time step `dt > 0`.
     #[inline]
-    pub fn clock_step(self, t0: f64, dt: f64) -> f64 {
+    pub(crate) fn clock_step(self, t0: f64, dt: f64) -> f64 {
         match self {
             Clock::Time => dt,
             Clock::SquareRoot { .. } => self.sigma(t0 + dt) - self.sigma(t0),

@@ -26,7 +26,7 @@
 #![warn(missing_docs)]
 
 mod bernstein;
-mod clock;
+pub mod clock;
 mod decoupled_tangents;
 mod dop853;
 pub mod error;
@@ -43,6 +43,7 @@ mod tableau;
 pub mod taylor;
 pub mod workspace;
 
+pub use clock::Clock;
 pub use error::HybridError;
 pub use event::{Event, Extremum, ExtremumKind};
 pub use flow_map::{flow_map, flow_map_observed, FlowMap};

@@ -394,6 +394,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         (self.step_start, self.step_end)
     }
 
+    /// The independent variable of the last step: its states are a polynomial (the dense
+    /// output or the Taylor series) in this clock's reading, not necessarily in time, so a
+    /// quadrature over the step is accurate in the clock (nodes in `sigma`, weights times
+    /// [`Clock::rate`]). Exact-flow steps report [`Clock::Time`].
+    pub fn last_step_clock(&self) -> Clock {
+        match self.kind {
+            StepKind::RungeKutta | StepKind::Taylor => self.clock,
+            StepKind::Exact | StepKind::None => Clock::Time,
+        }
+    }
+
     /// The state at time `t` inside the last step, written into `x` (length `n`; a shorter
     /// slice receives the leading components): the 7th-order DOP853 dense output, or the exact
     /// flow from the step start. Before the first step, the current state.
@@ -528,8 +539,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         });
         // A Runge-Kutta step with affine switching functions may be proven settled on its
         // interpolant, whatever the height.
-        let polynomial = self.affine_switching
-            && matches!(self.kind, StepKind::RungeKutta | StepKind::Taylor);
+        let polynomial =
+            self.affine_switching && matches!(self.kind, StepKind::RungeKutta | StepKind::Taylor);
         let clear = (self.settings.extremum_height.is_finite() || polynomial || bounded) && {
             self.buffers.samples.sample_ends(
                 self.system,
@@ -1071,13 +1082,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let n = self.n;
         let taylor = &self.buffers.taylor;
         let mut power = [0.0; TAYLOR_ORDER + 1];
-        taylor
-            .state
-            .weighted_sum(&self.buffers.affine_gradients[k * n..(k + 1) * n], &mut power);
+        taylor.state.weighted_sum(
+            &self.buffers.affine_gradients[k * n..(k + 1) * n],
+            &mut power,
+        );
         let clock = &taylor.clock;
-        power[0] = self
-            .system
-            .switching(k, clock.start, &self.buffers.z[..n]);
+        power[0] = self.system.switching(k, clock.start, &self.buffers.z[..n]);
         let drift = self.buffers.affine_drifts[k];
         power[1] += drift * clock.rate;
         power[2] += drift * clock.curvature;

@@ -151,22 +151,23 @@ impl Accumulator {
         let (a, b) = solver.last_step();
         let b = b.min(self.period);
         if b > a {
-            let middle = 0.5 * (a + b);
-            for (offset, w) in GAUSS_LEGENDRE_8.pairs(a, b) {
-                for t in [middle - offset, middle + offset] {
-                    solver.interpolate(t, &mut self.state);
-                    let (sin, cos) = (self.angular_frequency * t).sin_cos();
-                    let q1 = self.state[0];
-                    self.q1_fourier[0] += w * q1 * cos;
-                    self.q1_fourier[1] += w * q1 * sin;
-                    let force = model.hertz().force(model.gap(t, &self.state));
-                    self.force[0] += w * force;
-                    self.force[1] += w * force * cos;
-                    self.force[2] += w * force * sin;
-                    if let Some(fragment) = self.fragments.last_mut().filter(|f| f.end.is_none()) {
-                        fragment.impulse += w * force;
-                        fragment.moment += w * force * t;
-                    }
+            for (t, w, (sin, cos)) in GAUSS_LEGENDRE_8.clock_drive_nodes(
+                solver.last_step_clock(),
+                a,
+                b,
+                self.angular_frequency,
+            ) {
+                solver.interpolate(t, &mut self.state);
+                let q1 = self.state[0];
+                self.q1_fourier[0] += w * q1 * cos;
+                self.q1_fourier[1] += w * q1 * sin;
+                let force = model.hertz().force(model.gap(t, &self.state));
+                self.force[0] += w * force;
+                self.force[1] += w * force * cos;
+                self.force[2] += w * force * sin;
+                if let Some(fragment) = self.fragments.last_mut().filter(|f| f.end.is_none()) {
+                    fragment.impulse += w * force;
+                    fragment.moment += w * force * t;
                 }
             }
         }
