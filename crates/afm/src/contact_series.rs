@@ -212,7 +212,7 @@ pub(crate) fn contact_tangent_series(
     parameter_column: bool,
     gaps: &mut Vec<f64>,
 ) {
-    let p = state.order();
+    let p = tangents.order().min(state.order());
     let n = state.dim();
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
     // The indentation's square root to order p - 1 (all the recurrence below uses).

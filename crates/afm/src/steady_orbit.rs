@@ -480,15 +480,18 @@ fn observables_at(
 }
 
 /// The loosest tolerance (relative and absolute) of the first Newton map of
-/// [`shoot_observed`]: the sweep's default, whose readings differ from a run at 1e-13 by
-/// ~1e-8 in `A/A0`.
-const FIRST_ITERATE_TOLERANCE: f64 = 1e-8;
+/// [`shoot_observed`]. At 1e-8 (the sweep's default) the Taylor-series steps in contact left a
+/// state error of ~2e-8 nm at A/A0 = 0.9, enough to fail Newton's quadratic prediction after
+/// the next iteration and cost one more period map with the monodromy; at 1e-9 the first map
+/// costs about the same (its contact steps are as long as the tangent series' own tolerance
+/// allows) and the orbit from its neighbour needs no extra map.
+const FIRST_ITERATE_TOLERANCE: f64 = 1e-9;
 
 /// A first Newton map at [`FIRST_ITERATE_TOLERANCE`] whose residual is below this (nm) is
 /// computed again at full tolerance: the loose map's own error is part of such a residual (its
-/// residual at converged Fig. 1 orbits measured 2e-7 to 6e-7 nm), and the start is close enough
-/// for full-tolerance Newton (after the transient periods of a cold start, typically). From a
-/// neighbouring orbit on the branch 0.01 nm away, the residual is 3e-4 to 2e-2 nm.
+/// residual at converged Fig. 1 orbits measured 2e-11 to 2e-8 nm), and the start is close
+/// enough for full-tolerance Newton (after the transient periods of a cold start, typically).
+/// From a neighbouring orbit on the branch 0.01 nm away, the residual is 3e-4 to 2e-2 nm.
 const LOOSE_RESIDUAL_FLOOR: f64 = 1e3 * FIRST_ITERATE_TOLERANCE;
 
 /// `settings` for the period maps of [`shoot_observed`]: the monodromy integrated apart from

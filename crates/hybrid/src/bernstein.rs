@@ -39,6 +39,11 @@ const ROUNDING_FACTOR: f64 = 1024.0 * f64::EPSILON;
 /// the coefficients.
 pub(crate) fn stays_above<const D: usize>(power: &[f64; D], floor: f64) -> bool {
     let margin = rounding_margin(power);
+    // The constant term dominating the rest proves it without the conversion (every Bernstein
+    // coefficient is at least `a_0 - sum_{j>0} |a_j|`).
+    if power[0] - spread(power) > floor + margin {
+        return true;
+    }
     bernstein_coefficients(power)
         .iter()
         .all(|&b| b > floor + margin)
@@ -48,6 +53,11 @@ pub(crate) fn stays_above<const D: usize>(power: &[f64; D], floor: f64) -> bool 
 /// keep strictly on all of `[0, 1]`, if its Bernstein coefficients prove one; `None` if not.
 pub(crate) fn strict_sign<const D: usize>(power: &[f64; D]) -> Option<f64> {
     let margin = rounding_margin(power);
+    // A dominant constant term proves the sign without the conversion (every Bernstein
+    // coefficient lies within `sum_{j>0} |a_j|` of `a_0`).
+    if power[0].abs() - spread(power) > margin {
+        return Some(power[0].signum());
+    }
     let bernstein = bernstein_coefficients(power);
     if bernstein.iter().all(|&b| b > margin) {
         Some(1.0)
@@ -56,6 +66,11 @@ pub(crate) fn strict_sign<const D: usize>(power: &[f64; D]) -> Option<f64> {
     } else {
         None
     }
+}
+
+/// `sum_{j>0} |a_j|`: how far the polynomial can move from its constant term on `[0, 1]`.
+fn spread<const D: usize>(power: &[f64; D]) -> f64 {
+    power[1..].iter().map(|a| a.abs()).sum()
 }
 
 fn rounding_margin<const D: usize>(power: &[f64; D]) -> f64 {

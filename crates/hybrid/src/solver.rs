@@ -107,9 +107,12 @@ use crate::event::{Event, Extremum};
 use crate::event_location::{crossing_guess, locate_sign_change, Bracket, CubicHermite};
 use crate::extrema::Clearance;
 use crate::sensitivity::{Sensitivity, VariationalField};
-use crate::settings::Settings;
+use crate::settings::{SensitivityMethod, Settings};
 use crate::system::{side_sign, Direction, HybridSystem, Mode, MAX_SURFACES};
-use crate::taylor::{first_zero, ClockPolynomial, TaylorStep, TAYLOR_ORDER};
+use crate::taylor::{
+    first_zero, ClockPolynomial, TaylorStep, DECOUPLED_TANGENT_ORDER, DECOUPLED_TANGENT_TOLERANCE,
+    TAYLOR_ORDER,
+};
 use crate::workspace::{Buffers, SolverWorkspace};
 
 /// Why [`Solver::step`] returned.
@@ -986,13 +989,27 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
             let mut reach = TaylorStep::reach(&taylor.state, rtol, atol);
             if self.sensitivity.transition() {
+                let (order, tolerance) = match self.settings.sensitivity_method {
+                    SensitivityMethod::Coupled => {
+                        (TAYLOR_ORDER, self.settings.sensitivity_tolerance)
+                    }
+                    SensitivityMethod::Decoupled => (
+                        DECOUPLED_TANGENT_ORDER,
+                        Some(
+                            self.settings
+                                .sensitivity_tolerance
+                                .unwrap_or(DECOUPLED_TANGENT_TOLERANCE),
+                        ),
+                    ),
+                };
+                taylor.set_tangent_order(order);
                 taylor.expand_tangents(
                     system,
                     mode,
                     &self.buffers.z[n..],
                     self.sensitivity.parameter(),
                 );
-                if let Some(tolerance) = self.settings.sensitivity_tolerance {
+                if let Some(tolerance) = tolerance {
                     reach = reach.min(TaylorStep::reach(&taylor.tangents, tolerance, tolerance));
                 }
             }
