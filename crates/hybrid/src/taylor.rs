@@ -14,6 +14,7 @@
 //! contact of the Biolever on mica against ~30 DOP853 attempts, yet no fewer instructions per
 //! period map than DOP853 until the series themselves get cheaper.
 
+use crate::settings::{SensitivityMethod, Settings};
 use crate::system::{HybridSystem, Mode};
 
 /// The time along a step as a polynomial in the step's clock offset `s` (the clock reading
@@ -142,6 +143,21 @@ impl TaylorSeries {
 /// (orders 16 / 24 / 30: 12 / 6 / 5 steps, each dearer as the order squared).
 pub(crate) const TAYLOR_ORDER: usize = 20;
 
+/// The order of the tangent series and the tolerance on their last two terms (limiting the
+/// step with the state's) under `settings`: the state's order and `sensitivity_tolerance` for
+/// [`SensitivityMethod::Coupled`] (the tangents as accurate as the state's series);
+/// [`DECOUPLED_TANGENT_ORDER`] and [`DECOUPLED_TANGENT_TOLERANCE`] for
+/// [`SensitivityMethod::Decoupled`].
+pub(crate) fn tangent_control(settings: &Settings) -> (usize, Option<f64>) {
+    match settings.sensitivity_method {
+        SensitivityMethod::Coupled => (TAYLOR_ORDER, settings.sensitivity_tolerance),
+        // (Decoupled settings have no sensitivity_tolerance: validation refuses one.)
+        SensitivityMethod::Decoupled => {
+            (DECOUPLED_TANGENT_ORDER, Some(DECOUPLED_TANGENT_TOLERANCE))
+        }
+    }
+}
+
 /// The order of the tangent series on the steps of a [`crate::SensitivityMethod::Decoupled`]
 /// integration (the state's stays [`TAYLOR_ORDER`]): enough for Newton (the monodromy over a
 /// period of the Biolever on mica within ~1e-6 relative), at about half the cost.
@@ -170,11 +186,12 @@ pub(crate) struct TaylorStep {
 }
 
 impl TaylorStep {
-    /// Storage for `n` states and `columns` tangent columns (0: none).
-    pub fn new(n: usize, columns: usize) -> Self {
+    /// Storage for `n` states and `columns` tangent columns (0: none), the tangents to the
+    /// order [`tangent_control`] gives for `settings`.
+    pub fn new(n: usize, columns: usize, settings: &Settings) -> Self {
         Self {
             state: TaylorSeries::new(n, TAYLOR_ORDER),
-            tangents: TaylorSeries::new(n * columns, TAYLOR_ORDER),
+            tangents: TaylorSeries::new(n * columns, tangent_control(settings).0),
             clock: ClockPolynomial {
                 start: 0.0,
                 rate: 1.0,
@@ -262,10 +279,11 @@ impl TaylorStep {
 }
 
 /// The first zero in `(0, upto]` of the polynomial with power-basis coefficients `power`, if
-/// its sign changes there: bracketed on 32 samples, then bisection safeguarding Newton's method
-/// to the last bits.
+/// its sign changes there: bracketed on 16 samples, then bisection safeguarding Newton's method
+/// to the last bits. Two zeros between neighbouring samples go unseen: the solver uses this
+/// only to choose a step's clock, and finds crossings inside a step by its own tests.
 pub(crate) fn first_zero(power: &[f64], upto: f64) -> Option<f64> {
-    const SAMPLES: usize = 32;
+    const SAMPLES: usize = 16;
     let value = |s: f64| power.iter().rev().fold(0.0, |acc, &c| acc * s + c);
     let slope = |s: f64| {
         power

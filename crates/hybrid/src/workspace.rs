@@ -126,7 +126,7 @@ impl Buffers {
             field: VariationalField::new(n, stepped),
             rk: Dop853::new(stepped.augmented_dim(n), n, settings.sensitivity_tolerance),
             tangents: decoupled.then(|| DecoupledTangents::new(n, sensitivity)),
-            taylor: TaylorStep::new(n, (dim - n) / n.max(1)),
+            taylor: TaylorStep::new(n, (dim - n) / n.max(1), settings),
             x_ahead: vec![0.0; n],
             grid: vec![0.0; (settings.samples_per_step + 1) * n],
             velocity: vec![0.0; n],
