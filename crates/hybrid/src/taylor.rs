@@ -101,13 +101,34 @@ impl TaylorSeries {
 
     /// `y(s)` into `out` (length `dim`), by Horner's rule.
     pub fn evaluate(&self, s: f64, out: &mut [f64]) {
-        let dim = self.dim;
-        out.copy_from_slice(&self.coefficients[self.order * dim..]);
-        for row in self.coefficients.chunks_exact(dim).rev().skip(1) {
-            for (o, &c) in out.iter_mut().zip(row) {
-                *o = *o * s + c;
+        // The common small dimensions as constants, so that the row loop unrolls into
+        // registers (the state of one or two modes, their tangents with and without dx/dp).
+        match self.dim {
+            2 => self.evaluate_fixed::<2>(s, out),
+            4 => self.evaluate_fixed::<4>(s, out),
+            16 => self.evaluate_fixed::<16>(s, out),
+            20 => self.evaluate_fixed::<20>(s, out),
+            dim => {
+                out.copy_from_slice(&self.coefficients[self.order * dim..]);
+                for row in self.coefficients.chunks_exact(dim).rev().skip(1) {
+                    for (o, &c) in out.iter_mut().zip(row) {
+                        *o = *o * s + c;
+                    }
+                }
             }
         }
+    }
+
+    /// [`TaylorSeries::evaluate`] for `dim == D`.
+    #[inline(always)]
+    fn evaluate_fixed<const D: usize>(&self, s: f64, out: &mut [f64]) {
+        let mut value = [0.0; D];
+        for row in self.coefficients.chunks_exact(D).rev() {
+            for (v, &c) in value.iter_mut().zip(row) {
+                *v = *v * s + c;
+            }
+        }
+        out.copy_from_slice(&value);
     }
 
     /// `dy/ds` at `s` into `out` (length `dim`).
@@ -131,7 +152,23 @@ impl TaylorSeries {
     /// The polynomial `sum_k (w . c_k) s^k` of the weighted sum `w . y(s)` of the components
     /// (`w` of length `dim`), into `out` (length `order + 1`).
     pub fn weighted_sum(&self, weights: &[f64], out: &mut [f64]) {
-        for (o, row) in out.iter_mut().zip(self.coefficients.chunks_exact(self.dim)) {
+        // The common small dimensions as constants, so that the dot products unroll.
+        match (self.dim, weights.len()) {
+            (2, 2) => Self::weighted_sum_rows::<2>(&self.coefficients, weights, out),
+            (4, 4) => Self::weighted_sum_rows::<4>(&self.coefficients, weights, out),
+            _ => {
+                for (o, row) in out.iter_mut().zip(self.coefficients.chunks_exact(self.dim)) {
+                    *o = row.iter().zip(weights).map(|(c, w)| c * w).sum();
+                }
+            }
+        }
+    }
+
+    /// [`TaylorSeries::weighted_sum`] of rows of `D` coefficients (`weights` of length `D`).
+    #[inline(always)]
+    fn weighted_sum_rows<const D: usize>(coefficients: &[f64], weights: &[f64], out: &mut [f64]) {
+        let weights = &weights[..D];
+        for (o, row) in out.iter_mut().zip(coefficients.chunks_exact(D)) {
             *o = row.iter().zip(weights).map(|(c, w)| c * w).sum();
         }
     }
@@ -282,7 +319,7 @@ impl TaylorStep {
 /// its sign changes there: bracketed on 16 samples, then bisection safeguarding Newton's method
 /// to the last bits. Two zeros between neighbouring samples go unseen: the solver uses this
 /// only to choose a step's clock, and finds crossings inside a step by its own tests.
-pub(crate) fn first_zero(power: &[f64], upto: f64) -> Option<f64> {
+pub(crate) fn first_zero<const D: usize>(power: &[f64; D], upto: f64) -> Option<f64> {
     const SAMPLES: usize = 16;
     let value = |s: f64| power.iter().rev().fold(0.0, |acc, &c| acc * s + c);
     let slope = |s: f64| {
