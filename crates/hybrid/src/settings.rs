@@ -6,8 +6,8 @@ use crate::error::HybridError;
 /// [`crate::Solver::new`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
-    /// Relative local error tolerance of the DOP853 steps (applied to the state, not to the
-    /// sensitivities). Allowed: `1e-16 ..= 1` (finite). Default `1e-12`.
+    /// Relative local error tolerance of the DOP853 and Taylor-series steps (applied to the
+    /// state, not to the sensitivities). Allowed: `1e-16 ..= 1` (finite). Default `1e-12`.
     pub relative_tolerance: f64,
     /// Absolute local error tolerance, in state units. Allowed: `> 0`, finite. Default `1e-12`.
     pub absolute_tolerance: f64,
@@ -70,6 +70,11 @@ pub struct Settings {
     /// by the curvature bound or an affine `h_k`'s interpolant, is not sampled inside at any
     /// height: it holds no extremum.) Allowed: `>= 0` (infinity allowed).
     pub extremum_height: f64,
+    /// Whether a mode whose system gives the Taylor series of its solution
+    /// ([`crate::HybridSystem::taylor_series`]) is stepped by series (order 20 in the step's
+    /// clock, see the solver's module documentation) rather than DOP853. Default `true`;
+    /// `false` gives the Runge-Kutta integration everywhere (a reference to compare against).
+    pub taylor_series: bool,
 }
 
 /// How the variational equations (transition matrix and parameter sensitivity) are
@@ -114,6 +119,7 @@ impl Default for Settings {
             sensitivity_tolerance: None,
             sensitivity_method: SensitivityMethod::Coupled,
             extremum_height: f64::INFINITY,
+            taylor_series: true,
         }
     }
 }

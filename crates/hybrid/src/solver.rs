@@ -1,5 +1,5 @@
 //! The hybrid solver: one step at a time ([`Solver::step`] is the primitive), Runge-Kutta
-//! (DOP853) or exact-flow steps, never across a switching surface.
+//! (DOP853), Taylor-series or exact-flow steps, never across a switching surface.
 //!
 //! # Events and the rules that keep them unique
 //!
@@ -42,7 +42,7 @@
 //!   is rigorous.
 //! * Steps settled on their interpolant. Where every `h_k` is affine in the state and time
 //!   ([`HybridSystem::switching_is_affine`]), its interpolant over a Runge-Kutta step is a
-//!   polynomial of degree 7 in the step's clock, and the Bernstein coefficients of it and of
+//!   polynomial of degree 7 in the step's clock (20 over a Taylor step: the series itself), and the Bernstein coefficients of it and of
 //!   its derivative bound them on the whole step (`crate::bernstein`). A step on which every
 //!   `h_k` is proven strictly monotone (both end rates of that sign too), or above the surface
 //!   and the extremum height, is sampled at its ends only: it holds no extremum the samples
@@ -90,6 +90,26 @@
 //!   locates it on its own dense output when the kink makes it fail. A rejected trial that
 //!   passed a crossing of the surface is likewise located on its dense output and the clock
 //!   re-centred there.
+//!
+//! # Taylor-series steps
+//!
+//! Where the system gives the Taylor series of the mode's solution
+//! ([`HybridSystem::taylor_series`]; the AFM model in Hertz contact), a step is one series of
+//! order 20 in the step's clock offset (`crate::taylor`), as long as its last two terms stay
+//! below the tolerance (Jorba and Zou 2005); the tangents come from the system's tangent series
+//! along it ([`HybridSystem::taylor_tangents`]). The clock is the one in which the solution is
+//! analytic up to its nearest non-smooth point: the square-root clock from the crossing that
+//! entered the mode, until the crossing out of it that the last series predicts (its first
+//! zero of the half-power surface within two reaches) is nearer; then the square-root clock
+//! centred `ROOT_OVERSHOOT` past that predicted crossing, re-centred on the zero of its own
+//! series when they differ, so that the step landing on its reference holds the crossing, which
+//! is then located on the series like any other. The series is the step's dense output, and
+//! its polynomial in the switching function carries the Bernstein tests above. A system that
+//! gives no series, a series that cannot be formed (a grazing touch), a crossing predicted past
+//! the reference, or a reach collapsing below `1e-3` of the last series step hands the step to
+//! DOP853. Measured on one period at `A/A0 = 0.5` (Biolever on mica, three impacts, tolerance
+//! 1e-12): 24 series steps and 2 DOP853 steps for the three contacts, where DOP853 alone took
+//! 74 accepted and 21 rejected steps (1357 evaluations of the field).
 //!
 //! Measured on one period of the Biolever on mica (`cargo run --release -p afm --example
 //! monodromy_error`, state-only error control): at `A/A0 = 0.95` 461 RHS evaluations instead of
@@ -937,7 +957,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     fn taylor_step(&mut self, t_end: f64) -> Result<Option<f64>, HybridError> {
         let system = self.system;
         let mode = self.mode;
-        if system.taylor_order_limit(mode) < TAYLOR_ORDER {
+        if !self.settings.taylor_series || system.taylor_order_limit(mode) < TAYLOR_ORDER {
             return Ok(None);
         }
         let half_power = system.half_power_surface(mode);

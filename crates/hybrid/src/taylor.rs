@@ -8,11 +8,13 @@
 //! `s` (time, or the square root of the time from a crossing): on a square-root clock the
 //! solution next to a Hertz contact's onset or release is analytic in `s`, though not in time.
 //!
-//! Status: systems state their series through [`crate::HybridSystem::taylor_series`] and
-//! [`crate::HybridSystem::taylor_tangents`] (the AFM contact does, tested against DOP853), but
-//! the solver does not take Taylor steps yet: a first integration took 8 series steps per
-//! contact of the Biolever on mica against ~30 DOP853 attempts, yet no fewer instructions per
-//! period map than DOP853 until the series themselves get cheaper.
+//! The solver takes a Taylor step wherever the system gives series of the mode's solution
+//! ([`crate::HybridSystem::taylor_order_limit`] at least 20, the order of the state's series;
+//! the AFM model does in Hertz contact), and Runge-Kutta steps elsewhere (see the solver's
+//! module documentation). The tangents (transition matrix and `dx/dp`) are expanded along the
+//! state's series by the system's [`crate::HybridSystem::taylor_tangents`], to the state's
+//! order, or to order 14 under a [`SensitivityMethod::Decoupled`] integration, whose steps then
+//! also keep the tangents' last two terms below 1e-6.
 
 use crate::settings::{SensitivityMethod, Settings};
 use crate::system::{HybridSystem, Mode};
