@@ -10,23 +10,29 @@
 //! extremum, without sampling it.
 
 /// The Bernstein coefficients on `[0, 1]` of the polynomial with power-basis coefficients
-/// `power` (`power[j]` multiplies `theta^j`; degree `D - 1`).
-pub(crate) fn bernstein_coefficients<const D: usize>(power: &[f64; D]) -> [f64; D] {
-    let degree = D - 1;
+/// `power` (`power[j]` multiplies `theta^j`; degree `D - 1`). The tests check the conversion on
+/// the whole array; the bounds below compute the coefficients one at a time, stopping early.
+#[cfg(test)]
+fn bernstein_coefficients<const D: usize>(power: &[f64; D]) -> [f64; D] {
     let mut bernstein = [0.0; D];
     for (i, b) in bernstein.iter_mut().enumerate() {
-        let mut sum = 0.0;
-        // C(i, j) / C(d, j) for j = 0..=i, built up from j = 0 (ratio 1).
-        let mut ratio = 1.0;
-        for (j, &a) in power.iter().enumerate().take(i + 1) {
-            if j > 0 {
-                ratio *= (i + 1 - j) as f64 / (degree + 1 - j) as f64;
-            }
-            sum += ratio * a;
-        }
-        *b = sum;
+        *b = bernstein_coefficient(power, i);
     }
     bernstein
+}
+
+/// Bernstein coefficient `i` of [`bernstein_coefficients`].
+#[inline]
+fn bernstein_coefficient<const D: usize>(power: &[f64; D], i: usize) -> f64 {
+    let degree = D - 1;
+    let mut sum = power[0];
+    // C(i, j) / C(d, j) for j = 0..=i, built up from j = 0 (ratio 1).
+    let mut ratio = 1.0;
+    for (j, &a) in power.iter().enumerate().take(i + 1).skip(1) {
+        ratio *= (i + 1 - j) as f64 / (degree + 1 - j) as f64;
+        sum += ratio * a;
+    }
+    sum
 }
 
 /// The bound on the rounding of [`bernstein_coefficients`]: each coefficient is a sum of at most
@@ -44,9 +50,7 @@ pub(crate) fn stays_above<const D: usize>(power: &[f64; D], floor: f64) -> bool 
     if power[0] - spread(power) > floor + margin {
         return true;
     }
-    bernstein_coefficients(power)
-        .iter()
-        .all(|&b| b > floor + margin)
+    (0..D).all(|i| bernstein_coefficient(power, i) > floor + margin)
 }
 
 /// The sign (`1` or `-1`) the polynomial with power-basis coefficients `power` is proven to
@@ -58,14 +62,11 @@ pub(crate) fn strict_sign<const D: usize>(power: &[f64; D]) -> Option<f64> {
     if power[0].abs() - spread(power) > margin {
         return Some(power[0].signum());
     }
-    let bernstein = bernstein_coefficients(power);
-    if bernstein.iter().all(|&b| b > margin) {
-        Some(1.0)
-    } else if bernstein.iter().all(|&b| b < -margin) {
-        Some(-1.0)
-    } else {
-        None
-    }
+    // Coefficient by coefficient, stopping at the first that leaves `b_0`'s side.
+    let sign = power[0].signum();
+    (0..D)
+        .all(|i| sign * bernstein_coefficient(power, i) > margin)
+        .then_some(sign)
 }
 
 /// `sum_{j>0} |a_j|`: how far the polynomial can move from its constant term on `[0, 1]`.
