@@ -35,28 +35,30 @@ fn separation_coefficient(separation: &Separation, clock: &ClockPolynomial, k: u
     }
 }
 
-/// Coefficient `k` of the product of two series: `sum_{j=0}^{k} a_j b_{k-j}`.
+/// Coefficient `m` of the product of two series from their coefficients `0..=m`, `a` and `b`
+/// (`b` at least as long as `a`, of length `m + 1`): `sum_{j=0}^{m} a_j b_{m-j}`.
 #[inline]
-fn product_coefficient(a: &[f64], b: &[f64], k: usize) -> f64 {
-    a[..=k]
-        .iter()
-        .zip(b[..=k].iter().rev())
+fn convolution(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b[..a.len()].iter().rev())
         .map(|(x, y)| x * y)
         .sum()
 }
 
 /// Coefficient `k` of `r = sqrt(y)` from `y`'s coefficients to `k` and `r`'s to `k - 1`
-/// (`r_0 = sqrt(y_0)` at `k = 0`): `2 r_0 r_k = y_k - sum_{j=1}^{k-1} r_j r_{k-j}`.
-#[inline]
+/// (`r_0 = sqrt(y_0)` at `k = 0`): `2 r_0 r_k = y_k - sum_{j=1}^{k-1} r_j r_{k-j}`, the sum
+/// being symmetric in `j <-> k - j`: twice `sum_{j=1}^{h} r_j r_{k-j}` (`h = floor((k - 1)/2)`),
+/// plus `r_{k/2}^2` for even `k`.
+#[inline(always)]
 fn update_root(root: &mut [f64], y: &[f64], k: usize) {
     root[k] = if k == 0 {
         y[0].sqrt()
     } else {
-        let middle = if k >= 2 {
-            product_coefficient(&root[1..], &root[1..], k - 2)
-        } else {
-            0.0
-        };
+        let h = (k - 1) / 2;
+        let mut middle = 2.0 * convolution(&root[1..=h], &root[k - h..k]);
+        if k.is_multiple_of(2) {
+            middle += root[k / 2] * root[k / 2];
+        }
         (y[k] - middle) / (2.0 * root[0])
     };
 }
@@ -146,13 +148,13 @@ pub(crate) fn contact_state_series(
             // F = c s^3 g sqrt(g); coefficient k needs g and sqrt(g) = r_{.+1} to k - 3 only.
             if k >= 3 {
                 indentation_root(&mut root, &delta, k - 2, true);
-                hertz * product_coefficient(&delta[2..], &root[1..], k - 3)
+                hertz * convolution(&delta[2..k], &root[1..k - 1])
             } else {
                 0.0
             }
         } else {
             indentation_root(&mut root, &delta, k, false);
-            hertz * product_coefficient(&delta, &root, k)
+            hertz * convolution(&delta[..=k], &root[..=k])
         };
         if !force[k].is_finite() {
             return false;
