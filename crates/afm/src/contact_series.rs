@@ -7,7 +7,10 @@
 //! F_ts - w_i^2 q_i - (w_i/Q_i) v_i` (MODEL.md section 1), and `F_ts = c delta^{3/2} = c delta
 //! r`, `r = sqrt(delta)`. Coefficient `k` of every product is a convolution, `r_k` follows
 //! from `r^2 = delta` and `cos(w t(s))`, `sin(w t(s))` from their derivatives `-/+ w tau sin,
-//! cos`: `O(k)` work for coefficient `k` (Moore 1966; Jorba and Zou 2005).
+//! cos`: `O(k)` work for coefficient `k` (Moore 1966; Jorba and Zou 2005). `tau = a + 2 b s`
+//! (`a` the clock's rate, `b` its curvature) has two coefficients, so coefficient `k` of `tau
+//! y` is `a y_k + 2 b y_{k-1}`; `R` being linear in `cos`, `F_ts`, `q_i`, `v_i`, the
+//! recurrences form `tau R` from those products rather than `R` at two powers.
 //!
 //! At the start of contact on the square-root clock centred there (`tau(0) = 0`), `delta` has a
 //! double zero, `delta = s^2 g(s)`: then `r = s sqrt(g)` and `F_ts = c s^3 g sqrt(g)`, whose
@@ -24,15 +27,16 @@ use crate::Separation;
 /// intermediate series on the stack).
 pub const MAX_ORDER: usize = 40;
 
-/// The separation `Z(t(s))`'s coefficient `k` (`Z` constant or a linear ramp).
+/// The separation `Z(t(s))`'s coefficients `0..=2` (`Z` constant or a linear ramp in `t`, `t`
+/// quadratic in `s`: the higher ones vanish).
 #[inline]
-fn separation_coefficient(separation: &Separation, clock: &ClockPolynomial, k: usize) -> f64 {
-    match k {
-        0 => separation.at(clock.start),
-        1 => separation.rate() * clock.rate,
-        2 => separation.rate() * clock.curvature,
-        _ => 0.0,
-    }
+fn separation_coefficients(separation: &Separation, clock: &ClockPolynomial) -> [f64; 3] {
+    let rate = separation.rate();
+    [
+        separation.at(clock.start),
+        rate * clock.rate,
+        rate * clock.curvature,
+    ]
 }
 
 /// Coefficient `m` of the product of two series from their coefficients `0..=m`, `a` and `b`
@@ -64,16 +68,11 @@ fn update_root(root: &mut [f64], y: &[f64], k: usize) {
 }
 
 /// Coefficient `k` of the indentation `delta = -(Z(t(s)) + sum_i q_i)` from the state's
-/// coefficient row `k` (`[q_1, v_1, ...]`).
+/// coefficient row `k` (`[q_1, v_1, ...]`) and `Z(t(s))`'s coefficients `separation`.
 #[inline]
-fn indentation_coefficient(
-    separation: &Separation,
-    clock: &ClockPolynomial,
-    row: &[f64],
-    k: usize,
-) -> f64 {
-    -(separation_coefficient(separation, clock, k)
-        + row.chunks_exact(2).map(|qv| qv[0]).sum::<f64>())
+fn indentation_coefficient(separation: &[f64; 3], row: &[f64], k: usize) -> f64 {
+    let gap: f64 = row.chunks_exact(2).map(|qv| qv[0]).sum();
+    -(separation.get(k).copied().unwrap_or(0.0) + gap)
 }
 
 /// Coefficient `m` of `r = sqrt(delta)` from `delta`'s coefficients and `r`'s below `m`. Off
@@ -91,32 +90,16 @@ fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
     }
 }
 
-/// `(w_i^2 F_i / k_i) cos + (w_i^2/k_i) F - w_i^2 q_i - (w_i/Q_i) v_i` for every mode `i` of the
-/// state row `row` (`[q_1, v_1, ...]`), Eq. 1's acceleration given the drive factor and the
-/// force.
-#[inline]
-fn accelerations<'a>(
-    modes: &'a [ModalConstants],
-    drive: f64,
-    force: f64,
-    row: &'a [f64],
-) -> impl Iterator<Item = f64> + 'a {
-    modes.iter().zip(row.chunks_exact(2)).map(move |(m, qv)| {
-        m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
-            - m.omega_squared * qv[0]
-            - m.damping * qv[1]
-    })
-}
-
 /// The Taylor coefficients of the contact flow of Eq. 1 (`N` modes `modes`, Hertz coefficient
 /// `hertz` in nN/nm^{3/2}, drive `w` rad/us, separation `separation`) in the clock offset `s` of
 /// `clock`, through the state held in the constant terms of `series` (`2N` components, `q_i`,
 /// `q_i'` in nm, nm/us); `false` (series unusable) if the order exceeds [`MAX_ORDER`], the
-/// state is outside the sample (`d >= 0`) where the clock runs at a finite rate, or the
+/// state is outside the sample (`d >= 0`) where the clock runs at a finite rate, the
 /// indentation does not grow from the surface at an onset (a grazing touch, not analytic in
-/// `s`). A clock whose rate is zero at the start (`tau(0) = 0`) is the square-root clock
-/// centred on the crossing that entered contact (the only place a step starts from one): the
-/// state there is taken to be on the surface (`delta_0 = 0`, whatever its rounding).
+/// `s`), or a coefficient is not finite. A clock whose rate is zero at the start (`tau(0) = 0`)
+/// is the square-root clock centred on the crossing that entered contact (the only place a step
+/// starts from one): the state there is taken to be on the surface (`delta_0 = 0`, whatever its
+/// rounding).
 pub(crate) fn contact_state_series(
     modes: &[ModalConstants],
     hertz: f64,
@@ -125,11 +108,34 @@ pub(crate) fn contact_state_series(
     clock: &ClockPolynomial,
     series: &mut TaylorSeries,
 ) -> bool {
-    let p = series.order();
-    let n = series.dim();
-    if p > MAX_ORDER || n != 2 * modes.len() {
+    if series.order() > MAX_ORDER || series.dim() != 2 * modes.len() {
         return false;
     }
+    let separation = separation_coefficients(separation, clock);
+    // The common mode counts as constants, so that the loops over modes unroll.
+    let mut run =
+        |modes| state_recurrence(modes, hertz, drive_frequency, &separation, clock, series);
+    match modes.len() {
+        1 => run(&modes[..1]),
+        2 => run(&modes[..2]),
+        3 => run(&modes[..3]),
+        _ => run(modes),
+    }
+}
+
+/// The recurrence of [`contact_state_series`] (`Z(t(s))`'s coefficients `separation`), inlined
+/// into each call so that a constant mode count unrolls its loops over modes.
+#[inline(always)]
+fn state_recurrence(
+    modes: &[ModalConstants],
+    hertz: f64,
+    drive_frequency: f64,
+    separation: &[f64; 3],
+    clock: &ClockPolynomial,
+    series: &mut TaylorSeries,
+) -> bool {
+    let p = series.order();
+    let n = 2 * modes.len();
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
     let onset = a == 0.0;
     let mut cos = [0.0; MAX_ORDER + 1];
@@ -139,10 +145,14 @@ pub(crate) fn contact_state_series(
     let mut force = [0.0; MAX_ORDER + 1];
     (sin[0], cos[0]) = phase::sin_cos(drive_frequency * clock.start);
     let x = series.coefficients_mut();
+    // The sum of every coefficient and force, finite only if each of them is (or rejecting
+    // coefficients near f64::MAX, of no use either).
+    let mut total: f64 = x[..n].iter().sum();
     for k in 0..p {
         let (done, rest) = x.split_at_mut((k + 1) * n);
-        let row = &done[k * n..];
-        delta[k] = indentation_coefficient(separation, clock, row, k);
+        let (earlier, row) = done.split_at(k * n);
+        let next = &mut rest[..n];
+        delta[k] = indentation_coefficient(separation, row, k);
         force[k] = if onset {
             // delta_0 = delta_1 = 0: delta = s^2 g (g_j = delta_{j+2}), r = s sqrt(g),
             // F = c s^3 g sqrt(g); coefficient k needs g and sqrt(g) = r_{.+1} to k - 3 only.
@@ -156,44 +166,37 @@ pub(crate) fn contact_state_series(
             indentation_root(&mut root, &delta, k, false);
             hertz * convolution(&delta[..=k], &root[..=k])
         };
-        if !force[k].is_finite() {
-            return false;
-        }
-        let next = &mut rest[..n];
+        total += force[k];
+        // y' = tau z: y_{k+1} = (a z_k + b2 z_{k-1}) / (k + 1), z_{-1} = 0 (the coefficient
+        // below k is row k itself at k = 0, times zero).
         let scale = 1.0 / (k + 1) as f64;
-        for ((out, qv), r) in next
-            .chunks_exact_mut(2)
-            .zip(row.chunks_exact(2))
-            .zip(accelerations(modes, cos[k], force[k], row))
-        {
-            out[0] = a * qv[1];
-            out[1] = a * r;
-        }
-        if k > 0 && b2 != 0.0 {
-            let previous = &done[(k - 1) * n..k * n];
-            for ((out, qv), r) in next
-                .chunks_exact_mut(2)
-                .zip(previous.chunks_exact(2))
-                .zip(accelerations(modes, cos[k - 1], force[k - 1], previous))
-            {
-                out[0] += b2 * qv[1];
-                out[1] += b2 * r;
-            }
-        }
-        for v in next.iter_mut() {
-            *v *= scale;
-        }
+        let rate = a * scale;
+        let (curvature, below, previous) = if k > 0 {
+            (b2 * scale, k - 1, &earlier[(k - 1) * n..])
+        } else {
+            (0.0, 0, row)
+        };
         // The drive phase: (cos)' = -w tau sin, (sin)' = w tau cos.
-        let w = drive_frequency * scale;
-        let (mut dc, mut ds) = (a * sin[k], a * cos[k]);
-        if k > 0 {
-            dc += b2 * sin[k - 1];
-            ds += b2 * cos[k - 1];
+        let tau_cos = rate * cos[k] + curvature * cos[below];
+        let tau_sin = rate * sin[k] + curvature * sin[below];
+        let tau_force = rate * force[k] + curvature * force[below];
+        cos[k + 1] = -drive_frequency * tau_sin;
+        sin[k + 1] = drive_frequency * tau_cos;
+        for ((m, out), (qv, previous_qv)) in modes
+            .iter()
+            .zip(next.chunks_exact_mut(2))
+            .zip(row.chunks_exact(2).zip(previous.chunks_exact(2)))
+        {
+            let tau_q = rate * qv[0] + curvature * previous_qv[0];
+            let tau_v = rate * qv[1] + curvature * previous_qv[1];
+            out[0] = tau_v;
+            out[1] = m.drive_acceleration * tau_cos + m.omega_squared_over_stiffness * tau_force
+                - m.omega_squared * tau_q
+                - m.damping * tau_v;
+            total += out[0] + out[1];
         }
-        cos[k + 1] = -w * dc;
-        sin[k + 1] = w * ds;
     }
-    x.iter().all(|c| c.is_finite())
+    total.is_finite()
 }
 
 /// The Taylor coefficients of the tangent matrix `V` (`2N` rows: the transition matrix's
@@ -217,6 +220,7 @@ pub(crate) fn contact_tangent_series(
     let p = tangents.order().min(state.order());
     let n = state.dim();
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
+    let separation = separation_coefficients(separation, clock);
     // The indentation's square root to order p - 1 (all the recurrence below uses).
     let mut delta = [0.0; MAX_ORDER + 1];
     let mut root = [0.0; MAX_ORDER + 1];
@@ -225,7 +229,7 @@ pub(crate) fn contact_tangent_series(
         .zip(state.coefficients().chunks_exact(n))
         .enumerate()
     {
-        *d = indentation_coefficient(separation, clock, row, k);
+        *d = indentation_coefficient(&separation, row, k);
     }
     for m in 0..p {
         indentation_root(&mut root, &delta, m, a == 0.0);
