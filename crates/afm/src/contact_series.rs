@@ -221,10 +221,11 @@ pub(crate) fn contact_tangent_series(
     let n = state.dim();
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
     let separation = separation_coefficients(separation, clock);
-    // The indentation's square root to order p - 1 (all the recurrence below uses).
+    // The indentation's square root to order p - 1 (all the recurrence below uses; on an onset
+    // it needs the indentation to order p).
     let mut delta = [0.0; MAX_ORDER + 1];
     let mut root = [0.0; MAX_ORDER + 1];
-    for (k, (d, row)) in delta
+    for (k, (d, row)) in delta[..=p]
         .iter_mut()
         .zip(state.coefficients().chunks_exact(n))
         .enumerate()
@@ -234,11 +235,16 @@ pub(crate) fn contact_tangent_series(
     for m in 0..p {
         indentation_root(&mut root, &delta, m, a == 0.0);
     }
+    // Highest power first, so that the convolutions below run forward through both series.
+    let mut root_reversed = [0.0; MAX_ORDER];
+    for (reversed, r) in root_reversed.iter_mut().zip(root[..p].iter().rev()) {
+        *reversed = *r;
+    }
     let slope = -1.5 * hertz;
     let columns = tangents.dim() / n;
     let recurrence = TangentRecurrence {
         modes,
-        root: &root[..p],
+        root_reversed: &root_reversed[..p],
         slope,
         rate: a,
         curvature: b2,
@@ -259,8 +265,9 @@ pub(crate) fn contact_tangent_series(
 /// The coefficients of the tangent recurrence of [`contact_tangent_series`].
 struct TangentRecurrence<'a> {
     modes: &'a [ModalConstants],
-    /// The indentation's square root to order `p - 1`.
-    root: &'a [f64],
+    /// The indentation's square root to order `p - 1`, highest power first (`r_{p-1-i}` at
+    /// `i`).
+    root_reversed: &'a [f64],
     /// `-(3/2) c`.
     slope: f64,
     /// `tau = rate + curvature s` (`curvature` is twice the clock's).
@@ -270,83 +277,108 @@ struct TangentRecurrence<'a> {
 }
 
 impl TangentRecurrence<'_> {
-    /// Rows `1..=p` of `v` (row-major `2N x columns` matrices) from row 0.
+    /// Rows `1..=p` of `v` (row-major `2N x columns` matrices) from row 0: with the gap `g =
+    /// sum_j q_j` of each column (plus `dZ/dZ = 1` on the parameter column), `(k + 1) q_{i,k+1}
+    /// = (tau v_i)_k` and `(k + 1) v_{i,k+1} = (w_i^2/k_i) (-(3/2) c) (tau r g)_k - w_i^2 (tau
+    /// q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a convolution. The columns evolve
+    /// independently along the given state series, so the recurrence runs over them in blocks
+    /// of up to [`COLUMN_BLOCK`], each block's sums kept in registers.
     #[inline(always)]
     fn run(&self, columns: usize, v: &mut [f64], scratch: &mut Vec<f64>) {
         let modes = self.modes;
-        let p = self.root.len();
+        let p = self.root_reversed.len();
         let dim = 2 * modes.len() * columns;
         let (a, b2) = (self.rate, self.curvature);
-        // Rows of the gap's coefficients (one per power), the coupling's current row and
-        // every mode's accelerations at the previous power.
-        let accelerations = modes.len() * columns;
-        scratch.resize((p + 1) * columns + columns + accelerations, 0.0);
-        let (gaps, rest) = scratch.split_at_mut((p + 1) * columns);
-        let (coupling, previous_accelerations) = rest.split_at_mut(columns);
+        // Rows of the gap's coefficients (one per power, the gap `sum_i q_i` plus, on the
+        // parameter column, `dZ/dZ = 1`) and the coupling `r gap` at the previous power.
+        scratch.resize((p + 2) * columns, 0.0);
+        let (gaps, previous_coupling) = scratch.split_at_mut((p + 1) * columns);
+        previous_coupling.fill(0.0);
+        let gap = &mut gaps[..columns];
+        gap.fill(0.0);
+        for q in v[..dim].chunks_exact(2 * columns) {
+            for (g, q) in gap.iter_mut().zip(&q[..columns]) {
+                *g += q;
+            }
+        }
+        if self.parameter_column {
+            gap[columns - 1] += 1.0;
+        }
+        let mut power = 0.0;
         for k in 0..p {
             let (done, after) = v.split_at_mut((k + 1) * dim);
-            let row = &done[k * dim..];
+            let (earlier, row) = done.split_at(k * dim);
             let next = &mut after[..dim];
-            let (history, current) = gaps.split_at_mut(k * columns);
-            let gap = &mut current[..columns];
-            gap.copy_from_slice(&row[..columns]);
-            for q in row.chunks_exact(2 * columns).skip(1) {
-                for (g, q) in gap.iter_mut().zip(&q[..columns]) {
-                    *g += q;
-                }
-            }
-            if k == 0 && self.parameter_column {
-                gap[columns - 1] += 1.0;
-            }
-            let r0 = self.root[0];
-            for (c, g) in coupling.iter_mut().zip(gap.iter()) {
-                *c = r0 * g;
-            }
-            for (j, earlier) in history.chunks_exact(columns).enumerate() {
-                let r = self.root[k - j];
-                for (c, g) in coupling.iter_mut().zip(earlier) {
-                    *c += r * g;
-                }
-            }
-            let scale = 1.0 / (k + 1) as f64;
-            let previous_row = (k > 0).then(|| &done[(k - 1) * dim..k * dim]);
-            for (i, (((m, qv), out), previous_acceleration)) in modes
-                .iter()
-                .zip(row.chunks_exact(2 * columns))
-                .zip(next.chunks_exact_mut(2 * columns))
-                .zip(previous_accelerations.chunks_exact_mut(columns))
-                .enumerate()
-            {
-                let (q, velocity) = qv.split_at(columns);
-                let (next_q, next_v) = out.split_at_mut(columns);
-                let coupling_gain = m.omega_squared_over_stiffness * self.slope;
-                for c in 0..columns {
-                    let acceleration = coupling_gain * coupling[c]
-                        - m.omega_squared * q[c]
-                        - m.damping * velocity[c];
-                    next_q[c] = a * velocity[c];
-                    next_v[c] = a * acceleration;
-                    if k > 0 {
-                        next_v[c] += b2 * previous_acceleration[c];
-                    }
-                    previous_acceleration[c] = acceleration;
-                }
-                if let Some(previous_row) = previous_row {
-                    let offset = (2 * i + 1) * columns;
-                    for (nq, pv) in next_q
-                        .iter_mut()
-                        .zip(&previous_row[offset..offset + columns])
-                    {
-                        *nq += b2 * pv;
+            let (gaps, next_gap) = gaps.split_at_mut((k + 1) * columns);
+            let next_gap = &mut next_gap[..columns];
+            // y' = tau z: y_{k+1} = (a z_k + b2 z_{k-1}) / (k + 1), z_{-1} = 0 (the
+            // coefficient below k is row k itself at k = 0, times zero).
+            power += 1.0;
+            let rate = a / power;
+            let (curvature, previous) = if k > 0 {
+                (b2 / power, &earlier[(k - 1) * dim..])
+            } else {
+                (0.0, row)
+            };
+            for start in (0..columns).step_by(COLUMN_BLOCK) {
+                let width = COLUMN_BLOCK.min(columns - start);
+                let block = start..start + width;
+                // The coupling's coefficient k, sum_{j=0}^{k} r_{k-j} gap_j, and tau times it.
+                let mut coupling = [0.0; COLUMN_BLOCK];
+                for (gap, r) in gaps
+                    .chunks_exact(columns)
+                    .zip(&self.root_reversed[p - 1 - k..])
+                {
+                    for (c, g) in coupling[..width].iter_mut().zip(&gap[block.clone()]) {
+                        *c += r * g;
                     }
                 }
-                for x in out.iter_mut() {
-                    *x *= scale;
+                let mut tau_coupling = [0.0; COLUMN_BLOCK];
+                for ((t, c), previous) in tau_coupling[..width]
+                    .iter_mut()
+                    .zip(&coupling[..width])
+                    .zip(&mut previous_coupling[block.clone()])
+                {
+                    *t = rate * c + curvature * *previous;
+                    *previous = *c;
                 }
+                // Every mode's new coefficients formed in registers, then stored, and the
+                // gap's next coefficient summed on the way.
+                let mut gap = [0.0; COLUMN_BLOCK];
+                for ((m, out), (qv, previous_qv)) in
+                    modes.iter().zip(next.chunks_exact_mut(2 * columns)).zip(
+                        row.chunks_exact(2 * columns)
+                            .zip(previous.chunks_exact(2 * columns)),
+                    )
+                {
+                    let coupling_gain = m.omega_squared_over_stiffness * self.slope;
+                    let (q, velocity) = qv.split_at(columns);
+                    let (previous_q, previous_velocity) = previous_qv.split_at(columns);
+                    let mut new_q = [0.0; COLUMN_BLOCK];
+                    let mut new_v = [0.0; COLUMN_BLOCK];
+                    for c in 0..width {
+                        let column = start + c;
+                        let tau_q = rate * q[column] + curvature * previous_q[column];
+                        let tau_v = rate * velocity[column] + curvature * previous_velocity[column];
+                        new_q[c] = tau_v;
+                        new_v[c] = coupling_gain * tau_coupling[c]
+                            - m.omega_squared * tau_q
+                            - m.damping * tau_v;
+                        gap[c] += tau_v;
+                    }
+                    let (next_q, next_v) = out.split_at_mut(columns);
+                    next_q[block.clone()].copy_from_slice(&new_q[..width]);
+                    next_v[block.clone()].copy_from_slice(&new_v[..width]);
+                }
+                next_gap[block].copy_from_slice(&gap[..width]);
             }
         }
     }
 }
+
+/// The widest block of tangent columns [`TangentRecurrence::run`] handles at once (`2N + 1`
+/// columns for `N` up to 3 in one).
+const COLUMN_BLOCK: usize = 8;
 
 #[cfg(test)]
 mod tests {
