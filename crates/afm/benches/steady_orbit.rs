@@ -1,7 +1,8 @@
 //! Benchmark of the steady orbit at the paper's Fig. 1 points (Biolever on mica, A0 = 10 nm,
 //! A/A0 = 0.95, 0.90, 0.50): the time to converge it from the orbit at a neighbouring point of
 //! the approach branch (Z + 0.01 nm), and from a cold start (the free orbit plus transients),
-//! and the right-hand-side evaluations per period.
+//! and the work of one period map with the monodromy: right-hand-side evaluations (DOP853
+//! stages), steps (exact-flow, DOP853 and Taylor-series steps) and, of those, series steps.
 //!
 //! Run with `cargo bench -p afm --bench steady_orbit`. Timings are medians over repetitions in
 //! one process, so the ratios between rows are meaningful on a noisy machine; the neighbour
@@ -60,7 +61,7 @@ fn main() {
     let settings = SteadyOrbitSettings::default();
     println!("steady orbit, Biolever on mica, A0 = 10 nm (median of repetitions)");
     println!(
-        "{:>6} {:>12} {:>8} {:>12} {:>12} {:>10} {:>14} {:>14} {:>12}",
+        "{:>6} {:>12} {:>8} {:>12} {:>12} {:>10} {:>14} {:>14} {:>12} {:>12}",
         "A/A0",
         "Z (nm)",
         "impacts",
@@ -69,7 +70,8 @@ fn main() {
         "cold us",
         "Newton iters",
         "RHS evals/T",
-        "steps/T"
+        "steps/T",
+        "series/T"
     );
     for ratio in [0.95, 0.90, 0.50] {
         let search = AmplitudeRatioSearch::new(ratio).expect("ratio");
@@ -105,7 +107,7 @@ fn main() {
         )
         .expect("period map");
         println!(
-            "{:>6.2} {:>12.6} {:>8} {:>12.1} {:>12.1} {:>10.1} {:>14} {:>14} {:>12}",
+            "{:>6.2} {:>12.6} {:>8} {:>12.1} {:>12.1} {:>10.1} {:>14} {:>14} {:>12} {:>12}",
             ratio,
             z,
             target.observables().impacts.len(),
@@ -116,6 +118,7 @@ fn main() {
             period.statistics.rhs_evaluations,
             // `steps` counts the exact-flow steps too.
             period.statistics.steps,
+            period.statistics.series_steps,
         );
     }
 }
