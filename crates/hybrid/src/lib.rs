@@ -21,8 +21,8 @@
 //! sensitivities, `sensitivity_tolerance` trades accuracy of the transition matrix against
 //! steps where the Jacobian is not smooth (Hertz contact), and `sensitivity_method` chooses
 //! between the variational equations carried in the state's Runge-Kutta system (the exact
-//! derivative of the numerical flow) and a cheaper sixth-order integration over the accepted
-//! steps (enough for Newton); see their documentation.
+//! derivative of the numerical flow) and a cheaper integration apart from the state's steps
+//! (enough for Newton); see their documentation.
 #![warn(missing_docs)]
 
 mod bernstein;

@@ -88,15 +88,18 @@ pub enum SensitivityMethod {
     /// of every attempted step.
     #[default]
     Coupled,
-    /// After each accepted step of the state, over that step and on its clock, by Butcher's
+    /// On a Taylor-series step, by the tangents' own series to order 14 under a tolerance of
+    /// 1e-6 on their last two terms (which then also limits the step). After each accepted
+    /// Runge-Kutta step of the state, over that step and on its clock, by Butcher's
     /// 7-stage Runge-Kutta method of order 6, the state at its nodes taken from the step's
     /// dense output: 7 variational evaluations per accepted step and none on rejected ones,
     /// no error control (the state's steps are taken as they come), and an error of order
     /// `(step / time scale)^6` per step. Over one period of the Biolever on mica (A/A0 = 0.95
-    /// and 0.5, default tolerances) the monodromy is within 2.6e-6 and 6.4e-6 relative of a
-    /// tight reference, against 4.2e-8 and 1.1e-7 coupled (`cargo run --release -p afm
-    /// --example monodromy_error`), for 12% fewer instructions in the period map with the
-    /// monodromy at A/A0 = 0.5 (callgrind: 1.44M against 1.64M; 0.92M without it). Enough for Newton iterations, which need the Jacobian only well
+    /// and 0.5, default tolerances; contacts by series) the monodromy is within 9.6e-7 and
+    /// 2.3e-6 relative of a tight DOP853 reference, against 6.1e-9 and 4.3e-8 coupled (`cargo
+    /// run --release -p afm --example monodromy_error`), for 9% fewer instructions in the
+    /// period map with the monodromy at A/A0 = 0.5 (callgrind: 0.68M against 0.74M; 0.43M
+    /// without it). Enough for Newton iterations, which need the Jacobian only well
     /// enough to contract (each iteration then also reduces the error by about that relative
     /// amount instead of only squaring it), and for stability; not where the derivative of the
     /// numerical flow itself is wanted. `sensitivity_tolerance` must be `None`.
