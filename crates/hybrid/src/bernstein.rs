@@ -21,18 +21,36 @@ fn bernstein_coefficients<const D: usize>(power: &[f64; D]) -> [f64; D] {
     bernstein
 }
 
-/// Bernstein coefficient `i` of [`bernstein_coefficients`].
+/// Bernstein coefficient `i` of the polynomial with power-basis coefficients `power` (degree
+/// `D - 1`): `sum_{j <= i} [C(i, j) / C(d, j)] a_j`, the factors from [`conversion_factors`].
 #[inline]
 fn bernstein_coefficient<const D: usize>(power: &[f64; D], i: usize) -> f64 {
+    let factors = const { &conversion_factors::<D>() };
+    factors[i][..=i]
+        .iter()
+        .zip(power)
+        .fold(0.0, |sum, (factor, a)| sum + factor * a)
+}
+
+/// The factors `C(i, j) / C(d, j)` (`d = D - 1`, `j <= i`; zero above the diagonal) of the
+/// power-to-Bernstein conversion, each built up from `j = 0` (factor 1) as
+/// `prod_{m=1}^{j} (i + 1 - m) / (d + 1 - m)`, at compile time.
+const fn conversion_factors<const D: usize>() -> [[f64; D]; D] {
+    let mut factors = [[0.0; D]; D];
     let degree = D - 1;
-    let mut sum = power[0];
-    // C(i, j) / C(d, j) for j = 0..=i, built up from j = 0 (ratio 1).
-    let mut ratio = 1.0;
-    for (j, &a) in power.iter().enumerate().take(i + 1).skip(1) {
-        ratio *= (i + 1 - j) as f64 / (degree + 1 - j) as f64;
-        sum += ratio * a;
+    let mut i = 0;
+    while i < D {
+        let mut ratio = 1.0;
+        factors[i][0] = 1.0;
+        let mut j = 1;
+        while j <= i {
+            ratio *= (i + 1 - j) as f64 / (degree + 1 - j) as f64;
+            factors[i][j] = ratio;
+            j += 1;
+        }
+        i += 1;
     }
-    sum
+    factors
 }
 
 /// The bound on the rounding of [`bernstein_coefficients`]: each coefficient is a sum of at most

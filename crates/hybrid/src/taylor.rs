@@ -345,10 +345,19 @@ pub(crate) fn first_zero<const D: usize>(power: &[f64; D], upto: f64) -> Option<
     if spread < start.abs() {
         return None;
     }
+    // The samples evaluated together (Horner's rule across them), so that the loop vectorises.
+    let mut points = [0.0; SAMPLES];
+    for (j, point) in points.iter_mut().enumerate() {
+        *point = upto * (j + 1) as f64 / SAMPLES as f64;
+    }
+    let mut values = [0.0; SAMPLES];
+    for &c in power.iter().rev() {
+        for (v, &s) in values.iter_mut().zip(&points) {
+            *v = *v * s + c;
+        }
+    }
     let mut lower = 0.0;
-    for j in 1..=SAMPLES {
-        let s = upto * j as f64 / SAMPLES as f64;
-        let v = value(s);
+    for (&s, &v) in points.iter().zip(&values) {
         if v == 0.0 || (v > 0.0) != (start > 0.0) {
             let mut upper = s;
             let mut x = 0.5 * (lower + upper);
