@@ -953,7 +953,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// series predicts (its first zero within [`RELEASE_LOOKAHEAD`] reaches) when that is the
     /// nearer, else time. A step on the latter lands on its reference, just past the crossing
     /// (re-centred on the zero of its own series when that lies farther than the overshoot), so
-    /// the step holds the crossing, which the event location then finds on the series.
+    /// the step holds the crossing, which the event location then finds on the series. With
+    /// sensitivities, the tangents' series come along, to the order and (where set) under the
+    /// tolerance of [`tangent_control`], which then also limits the step.
     fn taylor_step(&mut self, t_end: f64) -> Result<Option<f64>, HybridError> {
         let system = self.system;
         let mode = self.mode;
