@@ -53,7 +53,7 @@ const fn conversion_factors<const D: usize>() -> [[f64; D]; D] {
     factors
 }
 
-/// The bound on the rounding of [`bernstein_coefficients`]: each coefficient is a sum of at most
+/// The bound on the rounding of [`bernstein_coefficient`]: each coefficient is a sum of at most
 /// `D` products of `|a_j|` with factors in `[0, 1]` each rounded a few times, so its error is
 /// below this multiple of `EPSILON * sum_j |a_j|` (generously).
 const ROUNDING_FACTOR: f64 = 1024.0 * f64::EPSILON;
