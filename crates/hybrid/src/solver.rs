@@ -439,13 +439,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
             StepKind::Taylor => {
                 let s = self.clock.sigma(t) - self.sigma_start;
-                if m == self.n {
-                    self.buffers.taylor.state.evaluate(s, x);
-                } else {
-                    let mut full = vec![0.0; self.n];
-                    self.buffers.taylor.state.evaluate(s, &mut full);
-                    x.copy_from_slice(&full[..m]);
-                }
+                self.buffers.taylor.state.evaluate(s, x);
             }
             StepKind::Exact => {
                 if m == self.n {
@@ -721,80 +715,70 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         })
     }
 
-    /// Whether the Runge-Kutta step just taken (sampled at its ends, [`Samples::sample_ends`])
-    /// is proven, on its interpolant, to hold nothing that interior samples would find: for
-    /// every surface either `side h_k` stays above the extremum height (and zero) on the whole
-    /// step, or `h_k` is strictly monotone with both end rates of that sign (no extremum; a
-    /// crossing shows in the signs at the ends). The interpolant of an affine `h_k` is
-    /// `h_k(t0) + g . (x(theta) - x0) + b (t(theta) - t0)`, a polynomial of degree 7 in the
-    /// clock fraction `theta` (`t(theta)` is linear on the time clock and quadratic on a
-    /// square-root clock, whose `sigma` keeps one sign over a step); its range and that of its
-    /// derivative are bounded by their Bernstein coefficients.
+    /// Whether the Runge-Kutta or Taylor step just taken (sampled at its ends,
+    /// [`Samples::sample_ends`]) is proven, on its interpolant, to hold nothing that interior
+    /// samples would find: for every surface either `side h_k` stays above the extremum height
+    /// (and zero) on the whole step, or `h_k` is strictly monotone with both end rates of that
+    /// sign (no extremum; a crossing shows in the signs at the ends). The interpolant of an
+    /// affine `h_k` is `h_k(t0) + g . (x(theta) - x0) + b (t(theta) - t0)`, a polynomial in the
+    /// clock fraction `theta` of degree 7 (DOP853's dense output) or 20 (the series), as
+    /// `t(theta)` is linear on the time clock and quadratic on a square-root clock, whose
+    /// `sigma` keeps one sign over a step; its range and that of its derivative are bounded by
+    /// their Bernstein coefficients.
     fn interpolant_settled(&self, mode: Mode) -> bool {
         let n = self.n;
         let p = self.buffers.samples.points();
-        let rk = &self.buffers.rk;
-        // t(theta) - t0 = linear theta + quadratic theta^2.
-        let (linear, quadratic) = match (self.kind, self.clock) {
-            (StepKind::Taylor, _) => {
-                let (clock, length) = (&self.buffers.taylor.clock, self.buffers.taylor.length);
-                (clock.rate * length, clock.curvature * length * length)
-            }
-            (_, Clock::Time) => (rk.h, 0.0),
-            (_, Clock::SquareRoot { .. }) => {
-                let (sigma0, dsigma) = (self.sigma_start, rk.h);
-                let sign = (sigma0 + 0.5 * dsigma).signum();
-                (sign * 2.0 * sigma0 * dsigma, sign * dsigma * dsigma)
-            }
-        };
         (0..self.surfaces).all(|k| {
             let samples = &self.buffers.samples;
-            let gradient = &self.buffers.affine_gradients[k * n..(k + 1) * n];
-            let drift = self.buffers.affine_drifts[k];
-            let ends = (
+            let (start_value, start_rate, end_rate) = (
                 samples.values[k * p],
                 samples.rates[k * p],
                 samples.rates[k * p + p - 1],
             );
+            let rates = (start_rate, end_rate);
             if self.kind == StepKind::Taylor {
-                let taylor = &self.buffers.taylor;
-                let mut power = [0.0; TAYLOR_ORDER + 1];
-                taylor.state.weighted_sum(gradient, &mut power);
+                // The series' polynomial in the clock offset, in the fraction of the step.
+                let length = self.buffers.taylor.length;
+                let mut power = self.series_surface_polynomial(k, start_value);
                 let mut scale = 1.0;
                 for c in power.iter_mut() {
                     *c *= scale;
-                    scale *= taylor.length;
+                    scale *= length;
                 }
-                self.polynomial_settled::<{ TAYLOR_ORDER + 1 }, TAYLOR_ORDER>(
-                    mode,
-                    k,
-                    power,
-                    (linear, quadratic, drift),
-                    ends,
-                )
+                self.polynomial_settled::<{ TAYLOR_ORDER + 1 }, TAYLOR_ORDER>(mode, k, power, rates)
             } else {
-                let power = rk.dense_polynomial(gradient);
-                self.polynomial_settled::<8, 7>(mode, k, power, (linear, quadratic, drift), ends)
+                // t(theta) - t0 = linear theta + quadratic theta^2.
+                let rk = &self.buffers.rk;
+                let (linear, quadratic) = match self.clock {
+                    Clock::Time => (rk.h, 0.0),
+                    Clock::SquareRoot { .. } => {
+                        let (sigma0, dsigma) = (self.sigma_start, rk.h);
+                        let sign = (sigma0 + 0.5 * dsigma).signum();
+                        (sign * 2.0 * sigma0 * dsigma, sign * dsigma * dsigma)
+                    }
+                };
+                let drift = self.buffers.affine_drifts[k];
+                let mut power =
+                    rk.dense_polynomial(&self.buffers.affine_gradients[k * n..(k + 1) * n]);
+                power[0] = start_value;
+                power[1] += drift * linear;
+                power[2] += drift * quadratic;
+                self.polynomial_settled::<8, 7>(mode, k, power, rates)
             }
         })
     }
 
-    /// [`Solver::interpolant_settled`] for surface `k` whose interpolant over the step, less
-    /// its value at the start and its drift term, has the power-basis coefficients `power` in
-    /// the clock fraction (degree `D - 1`; `E = D - 1` coefficients for its derivative);
-    /// `ends` = the value at the start and the rates at both ends.
+    /// [`Solver::interpolant_settled`] for surface `k` whose interpolant over the step has the
+    /// power-basis coefficients `power` in the clock fraction (degree `D - 1`; `E = D - 1`
+    /// coefficients for its derivative), and the rates `(start, end)` at the step's ends.
     fn polynomial_settled<const D: usize, const E: usize>(
         &self,
         mode: Mode,
         k: usize,
-        mut power: [f64; D],
-        (linear, quadratic, drift): (f64, f64, f64),
-        (start_value, start_rate, end_rate): (f64, f64, f64),
+        power: [f64; D],
+        (start_rate, end_rate): (f64, f64),
     ) -> bool {
         let height = self.settings.extremum_height;
-        power[0] = start_value;
-        power[1] += drift * linear;
-        power[2] += drift * quadratic;
         // Above the surface (positive side) and the height throughout: nothing wanted.
         if side_sign(mode, k) > 0.0 && height.is_finite() && stays_above(&power, height.max(0.0)) {
             return true;
@@ -1008,8 +992,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
             let mut reach = TaylorStep::reach(&taylor.state, rtol, atol);
             if self.sensitivity.transition() {
-                let (order, tolerance) = tangent_control(&self.settings);
-                taylor.set_tangent_order(order);
+                // The tangents' order was fixed with the workspace (it fits these settings).
+                let (_, tolerance) = tangent_control(&self.settings);
                 taylor.expand_tangents(
                     system,
                     mode,
@@ -1020,41 +1004,38 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     reach = reach.min(TaylorStep::reach(&taylor.tangents, tolerance, tolerance));
                 }
             }
-            // On a clock centred ahead, the step ends at its reference at the latest.
-            let landing = sigma0 < 0.0 && reach >= -sigma0;
-            if sigma0 < 0.0 {
+            // On a square-root clock centred ahead, the step ends at its reference at the
+            // latest. (On the time clock `sigma0 = t0` may be negative: it is never ahead.)
+            let ahead = matches!(clock, Clock::SquareRoot { .. }) && sigma0 < 0.0;
+            let landing = ahead && reach >= -sigma0;
+            if ahead {
                 reach = reach.min(-sigma0);
             }
             // The half-power surface's first zero along the series: within the step, the
             // crossing the step must hold; beyond it, the prediction for the next step.
             let crossing = half_power.and_then(|k| {
-                let upto = if sigma0 < 0.0 {
+                let upto = if ahead {
                     -sigma0
                 } else {
                     RELEASE_LOOKAHEAD * reach
                 };
                 self.surface_zero(k, upto).map(|s| polynomial.time(s))
             });
-            // A crossing inside the reach of a series not centred on it: centre one there.
-            let inside = crossing.filter(|&t_cross| t_cross <= clock.time(sigma0 + reach));
-            if let (Some(t_cross), true) = (inside, sigma0 >= 0.0 || clock == Clock::Time) {
-                if recentred < MAX_RETARGETS {
-                    recentred += 1;
-                    clock = Clock::SquareRoot {
-                        reference: t0 + (t_cross - t0) * (1.0 + ROOT_OVERSHOOT),
-                    };
-                    continue;
+            // Centre a clock on the crossing (ROOT_OVERSHOOT past it) when it lies inside the
+            // reach of a series not centred ahead, or when a landing series finds it well short
+            // of its reference.
+            let retarget = crossing.filter(|&t_cross| match clock {
+                Clock::SquareRoot { reference } if ahead => {
+                    landing && reference - t_cross > 10.0 * ROOT_OVERSHOOT * (reference - t0)
                 }
-            }
-            if let (Clock::SquareRoot { reference }, Some(t_cross)) = (clock, crossing) {
-                let off_centre = reference - t_cross > 10.0 * ROOT_OVERSHOOT * (reference - t0);
-                if landing && off_centre && recentred < MAX_RETARGETS {
-                    recentred += 1;
-                    clock = Clock::SquareRoot {
-                        reference: t0 + (t_cross - t0) * (1.0 + ROOT_OVERSHOOT),
-                    };
-                    continue;
-                }
+                _ => t_cross <= clock.time(sigma0 + reach),
+            });
+            if let Some(t_cross) = retarget.filter(|_| recentred < MAX_RETARGETS) {
+                recentred += 1;
+                clock = Clock::SquareRoot {
+                    reference: t0 + (t_cross - t0) * (1.0 + ROOT_OVERSHOOT),
+                };
+                continue;
             }
             if landing && crossing.is_none() {
                 // The crossing was predicted but lies past the reference: leave the approach
@@ -1103,6 +1084,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// The first zero in `(0, upto]` of surface `k` (affine) along the last Taylor series, in
     /// its clock offset.
     fn surface_zero(&self, k: usize, upto: f64) -> Option<f64> {
+        let start = self.buffers.taylor.clock.start;
+        let start_value = self.system.switching(k, start, &self.buffers.z[..self.n]);
+        first_zero(&self.series_surface_polynomial(k, start_value), upto)
+    }
+
+    /// The polynomial in the clock offset `s` of the affine surface `k` along the last Taylor
+    /// series: `h_k(t0) + g . (x(s) - x(0)) + b (t(s) - t0)`, with `h_k(t0) = start_value`.
+    fn series_surface_polynomial(&self, k: usize, start_value: f64) -> [f64; TAYLOR_ORDER + 1] {
         let n = self.n;
         let taylor = &self.buffers.taylor;
         let mut power = [0.0; TAYLOR_ORDER + 1];
@@ -1110,12 +1099,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             &self.buffers.affine_gradients[k * n..(k + 1) * n],
             &mut power,
         );
-        let clock = &taylor.clock;
-        power[0] = self.system.switching(k, clock.start, &self.buffers.z[..n]);
         let drift = self.buffers.affine_drifts[k];
-        power[1] += drift * clock.rate;
-        power[2] += drift * clock.curvature;
-        first_zero(&power, upto)
+        power[0] = start_value;
+        power[1] += drift * taylor.clock.rate;
+        power[2] += drift * taylor.clock.curvature;
+        power
     }
 
     /// One accepted DOP853 step (with as many rejected attempts as needed); returns the end

@@ -101,7 +101,7 @@ impl TaylorSeries {
         self.coefficients[..self.dim].copy_from_slice(values);
     }
 
-    /// `y(s)` into `out` (length `dim`), by Horner's rule.
+    /// `y(s)` into `out` (its leading `out.len() <= dim` components), by Horner's rule.
     pub fn evaluate(&self, s: f64, out: &mut [f64]) {
         // The common small dimensions as constants, so that the row loop unrolls into
         // registers (the state of one or two modes, their tangents with and without dx/dp).
@@ -111,7 +111,8 @@ impl TaylorSeries {
             16 => self.evaluate_fixed::<16>(s, out),
             20 => self.evaluate_fixed::<20>(s, out),
             dim => {
-                out.copy_from_slice(&self.coefficients[self.order * dim..]);
+                let m = out.len();
+                out.copy_from_slice(&self.coefficients[self.order * dim..][..m]);
                 for row in self.coefficients.chunks_exact(dim).rev().skip(1) {
                     for (o, &c) in out.iter_mut().zip(row) {
                         *o = *o * s + c;
@@ -130,7 +131,7 @@ impl TaylorSeries {
                 *v = *v * s + c;
             }
         }
-        out.copy_from_slice(&value);
+        out.copy_from_slice(&value[..out.len()]);
     }
 
     /// `dy/ds` at `s` into `out` (length `dim`).
@@ -309,14 +310,6 @@ impl TaylorStep {
             }
         }
         reach
-    }
-
-    /// Give the tangent series `order` (at most [`TAYLOR_ORDER`]; coefficients reallocated
-    /// only when it changes).
-    pub fn set_tangent_order(&mut self, order: usize) {
-        if self.tangents.order() != order {
-            self.tangents = TaylorSeries::new(self.tangents.dim(), order);
-        }
     }
 }
 
