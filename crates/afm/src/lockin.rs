@@ -148,11 +148,13 @@ impl CycleLockIn {
     }
 
     /// 4-point Gauss-Legendre quadrature of `u cos(w t)`, `u sin(w t)` over `[a, b]` (inside
-    /// the solver's last step), for contact steps (and for free flight only near critical
-    /// damping). The rule is exact for polynomials of degree 7, the degree of DOP853's dense
-    /// output, so its error comes from the drive factor `cos(w t)`: of order `6e-10 (w h)^8`
-    /// relative for a step `h`, about 2e-8 even for a step of a quarter drive period (contact
-    /// steps are far shorter).
+    /// the solver's last step), in the step's clock, for contact steps (and for free flight
+    /// only near critical damping). The rule is exact for polynomials of degree 7, the degree of
+    /// DOP853's dense output, so there its error comes from the drive factor `cos(w t)`: of
+    /// order `6e-10 (w h)^8` relative for a step `h`, about 2e-8 even for a step of a quarter
+    /// drive period (contact steps are far shorter). A Taylor step's series has degree 20; 8
+    /// points instead of 4 moved the readings of `drumroll approach --case biolever-mica --from
+    /// 8.8 --to 8.65 --rate 1` by at most 8e-12 in `A/A0` and 6e-11 deg in phase.
     fn quadrature(&mut self, solver: &Solver<TappingModel>, model: &TappingModel, a: f64, b: f64) {
         for (t, weight, (sin, cos)) in GAUSS_LEGENDRE_4.clock_drive_nodes(
             solver.last_step_clock(),

@@ -118,9 +118,10 @@ pub struct SteadyOrbit {
     pub state: Vec<f64>,
     /// Floquet multipliers: eigenvalues of the monodromy matrix of `P^k`. For a period-1 orbit,
     /// the monodromy of Newton's last map with it (decoupled sensitivities, see
-    /// `shoot_observed`): about 1e-5 relative (measured 2.1e-5 on the largest multiplier at
-    /// A/A0 = 0.5 of the Biolever on mica, against the coupled integration), enough for the
-    /// orbit's stability; continuation (`bifurcation_diagram`) computes its own.
+    /// `shoot_observed`): the monodromy within 1.0e-6 and 2.3e-6 relative at the Fig. 1 points
+    /// A/A0 = 0.95 and 0.5 of the Biolever on mica (`cargo run --release -p afm --example
+    /// monodromy_error`), enough for the orbit's stability; continuation
+    /// (`bifurcation_diagram`) computes its own.
     #[serde(serialize_with = "serialize_multipliers")]
     pub multipliers: Vec<Complex<f64>>,
     /// Whether every multiplier lies inside the unit circle (the orbit attracts).
@@ -483,9 +484,9 @@ fn observables_at(
 /// The loosest tolerance (relative and absolute) of the first Newton map of
 /// [`shoot_observed`]. At 1e-8 (the sweep's default) the Taylor-series steps in contact left a
 /// state error of ~2e-8 nm at A/A0 = 0.9, enough to fail Newton's quadratic prediction after
-/// the next iteration and cost one more period map with the monodromy; at 1e-9 the first map
-/// costs about the same (its contact steps are as long as the tangent series' own tolerance
-/// allows) and the orbit from its neighbour needs no extra map.
+/// the next iteration and cost one more period map with the monodromy; at 1e-9 the orbit from
+/// its neighbour needs no extra map (2.79M -> 2.07M instructions at A/A0 = 0.9
+/// when this was chosen).
 const FIRST_ITERATE_TOLERANCE: f64 = 1e-9;
 
 /// A first Newton map at [`FIRST_ITERATE_TOLERANCE`] whose residual is below this (nm) is
