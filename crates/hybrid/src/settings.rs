@@ -52,8 +52,8 @@ pub struct Settings {
     /// Allowed: `1e-16 ..= 1`, and `None` with [`SensitivityMethod::Decoupled`]. Default
     /// `None`.
     pub sensitivity_tolerance: Option<f64>,
-    /// How the transition matrix and parameter sensitivity are carried over Runge-Kutta steps
-    /// (exact-flow steps and events are the same either way). Default
+    /// How the transition matrix and parameter sensitivity are carried over Runge-Kutta and
+    /// Taylor-series steps (exact-flow steps and events are the same either way). Default
     /// [`SensitivityMethod::Coupled`].
     pub sensitivity_method: SensitivityMethod,
     /// How far above a surface (on the positive side of `h_k`) extrema must still be found, in
@@ -78,14 +78,15 @@ pub struct Settings {
 }
 
 /// How the variational equations (transition matrix and parameter sensitivity) are
-/// integrated over a Runge-Kutta step of the state.
+/// integrated over a Runge-Kutta or Taylor-series step of the state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SensitivityMethod {
     /// In the same DOP853 system as the state, stage by stage: the transition matrix is the
     /// exact derivative of the numerical flow (so Newton on a map built from it converges
     /// quadratically to the numerical fixed point), accurate to about the state's tolerance
     /// (see [`Settings::sensitivity_tolerance`]), at `N + 1` variational products per stage
-    /// of every attempted step.
+    /// of every attempted step. On a Taylor-series step, by the tangents' series to the state's
+    /// order (under `sensitivity_tolerance` too, where set).
     #[default]
     Coupled,
     /// On a Taylor-series step, by the tangents' own series to order 14 under a tolerance of
