@@ -324,8 +324,9 @@ fn cycle_lockin_matches_the_period_observables() {
 
 /// The closed-form free-flight integrals (harmonics 1 to 3) against composite 8-point
 /// Gauss-Legendre quadrature of the model's exact flow (100 panels over 1.7 periods: converged
-/// to rounding), for the Biolever (both modes under-damped) and for a copy with an over-damped second mode
-/// (Q_2 = 0.3), from a state off the steady orbit so that the homogeneous part matters.
+/// to rounding), for the Biolever (both modes under-damped) and for a copy with an over-damped
+/// second mode (Q_2 = 0.3), from a state off the steady orbit so that the homogeneous part
+/// matters.
 #[test]
 fn free_flight_fourier_matches_quadrature_of_the_exact_flow() {
     use afm::free_flight_fourier::FreeFlightFourier;

@@ -181,10 +181,10 @@ pub trait HybridSystem {
     /// `g` and `b` constant (as [`HybridSystem::switching_gradient`] gives them, read once per
     /// solver). The default is `false`.
     ///
-    /// Over a Runge-Kutta step the interpolant of such an `h_k` is a polynomial in the step's
-    /// clock, and the solver bounds it through its Bernstein coefficients: a step on which
-    /// every surface's `h_k` is proven strictly monotone (no extremum; a crossing shows in the
-    /// signs at the ends) or farther than [`crate::Settings::extremum_height`] from its
+    /// Over a Runge-Kutta or Taylor step the interpolant of such an `h_k` is a polynomial in
+    /// the step's clock, and the solver bounds it through its Bernstein coefficients: a step on
+    /// which every surface's `h_k` is proven strictly monotone (no extremum; a crossing shows in
+    /// the signs at the ends) or farther than [`crate::Settings::extremum_height`] from its
     /// surface is not sampled inside. A gap `Z(t) + sum_i q_i` with a constant or linear
     /// `Z(t)` is affine.
     fn switching_is_affine(&self, k: usize) -> bool {
@@ -259,8 +259,8 @@ pub trait HybridSystem {
     /// The Taylor coefficients, to `tangents.order()` (at most `state.order()`; the solver asks
     /// for fewer under [`crate::SensitivityMethod::Decoupled`]), of a tangent matrix `V` (`n`
     /// rows, `tangents.dim() / n` columns) along the solution whose series is `state` (from
-    /// [`HybridSystem::taylor_series`] with the same `mode` and `clock`): `dV/ds = (dt/ds) J(t(s), x(s)) V`, plus `(dt/ds) df/dp` on the
-    /// last column when `parameter_column`. Each coefficient of `tangents` is a row-major
+    /// [`HybridSystem::taylor_series`] with the same `mode` and `clock`): `dV/ds = (dt/ds)
+    /// J(t(s), x(s)) V`, plus `(dt/ds) df/dp` on the last column when `parameter_column`. Each coefficient of `tangents` is a row-major
     /// matrix (component `row * columns + column`: the recurrences then run along rows of
     /// contiguous columns); the constant terms hold `V` at `s = 0`, and every other coefficient
     /// is written. `scratch` is free space the implementation may resize.
