@@ -4,9 +4,9 @@
 //! `dV/dsigma = (dt/dsigma) (J(t, x) V + [df/dp])`, `V = [dx/dx0 | dx/dp]`,
 //!
 //! by Butcher's explicit Runge-Kutta method of order 6 with 7 stages (J. C. Butcher, 1964; the
-//! seven-stage sixth-order example of Hairer, Norsett, Wanner, *Solving ODEs I*, Sec. II.5),
-//! the state at the stage nodes taken from the step's 7th-order dense output. On a square-root clock the
-//! Jacobian of a half-power contact (`J ~ sqrt(-h)`) is smooth in `sigma`, so the method keeps
+//! seven-stage sixth-order example of Hairer, Norsett, Wanner, *Solving ODEs I*, Sec. II.5), the
+//! state at the stage nodes taken from the step's 7th-order dense output. On a square-root clock
+//! the Jacobian of a half-power contact (`J ~ sqrt(-h)`) is smooth in `sigma`, so the method keeps
 //! its order through contact onset and release.
 
 use crate::clock::Clock;

@@ -256,14 +256,14 @@ pub trait HybridSystem {
         false
     }
 
-    /// The Taylor coefficients, to `tangents.order()` (at most `state.order()`; the solver asks
-    /// for fewer under [`crate::SensitivityMethod::Decoupled`]), of a tangent matrix `V` (`n`
-    /// rows, `tangents.dim() / n` columns) along the solution whose series is `state` (from
-    /// [`HybridSystem::taylor_series`] with the same `mode` and `clock`): `dV/ds = (dt/ds)
-    /// J(t(s), x(s)) V`, plus `(dt/ds) df/dp` on the last column when `parameter_column`. Each coefficient of `tangents` is a row-major
-    /// matrix (component `row * columns + column`: the recurrences then run along rows of
-    /// contiguous columns); the constant terms hold `V` at `s = 0`, and every other coefficient
-    /// is written. `scratch` is free space the implementation may resize.
+    /// The Taylor coefficients, to `tangents.order()` (at most `state.order()`; the solver asks for
+    /// fewer under [`crate::SensitivityMethod::Decoupled`]), of a tangent matrix `V` (`n` rows,
+    /// `tangents.dim() / n` columns) along the solution whose series is `state` (from
+    /// [`HybridSystem::taylor_series`] with the same `mode` and `clock`): `dV/ds = (dt/ds) J(t(s),
+    /// x(s)) V`, plus `(dt/ds) df/dp` on the last column when `parameter_column`. Each coefficient
+    /// of `tangents` is a row-major matrix (component `row * columns + column`: the recurrences
+    /// then run along rows of contiguous columns); the constant terms hold `V` at `s = 0`, and
+    /// every other coefficient is written. `scratch` is free space the implementation may resize.
     ///
     /// To be called only where [`HybridSystem::taylor_series`] returned `true` for `state`.
     fn taylor_tangents(

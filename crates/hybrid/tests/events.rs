@@ -224,10 +224,10 @@ fn exact_flow_matches_runge_kutta() {
     }
 }
 
-/// Step boundaries placed on the extrema themselves: `h = 2 - cos t` (never crossed) has
-/// extrema at `k pi`. (a) exact-flow steps of `pi/4` from t = 0 end on every extremum (to
-/// rounding); (b) DOP853 steps driven with `step(t_end)` for `t_end = pi, 2 pi, ...` end
-/// exactly there (then on to `20 pi + 0.5`), with `h` declared affine or not. Either way each of the 20 extrema in
+/// Step boundaries placed on the extrema themselves: `h = 2 - cos t` (never crossed) has extrema at
+/// `k pi`. (a) exact-flow steps of `pi/4` from t = 0 end on every extremum (to rounding); (b)
+/// DOP853 steps driven with `step(t_end)` for `t_end = pi, 2 pi, ...` end exactly there (then on to
+/// `20 pi + 0.5`), with `h` declared affine or not. Either way each of the 20 extrema in
 /// `(0, 20 pi + 0.5]` is reported exactly once, at `k pi` to 1e-9.
 #[test]
 fn extrema_on_step_boundaries_are_reported_once() {
