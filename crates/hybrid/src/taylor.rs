@@ -296,20 +296,29 @@ impl TaylorStep {
     /// truncation error is about the tolerance.
     pub fn reach(series: &TaylorSeries, relative: f64, absolute: f64) -> f64 {
         let p = series.order();
-        let start = series.row(0);
-        let mut reach = f64::INFINITY;
-        for k in [p - 1, p] {
-            let size = series
-                .row(k)
-                .iter()
-                .zip(start)
-                .map(|(c, y0)| c.abs() / (absolute + relative * y0.abs()))
-                .fold(0.0, f64::max);
-            if size > 0.0 {
-                reach = reach.min(size.powf(-1.0 / k as f64));
-            }
-        }
-        reach
+        // The largest ratio of each of the last two terms to its component's tolerance.
+        let (below, last) = series
+            .row(p - 1)
+            .iter()
+            .zip(series.row(p))
+            .zip(series.row(0))
+            .fold(
+                (0.0, 0.0),
+                |(below, last): (f64, f64), ((c_below, c_last), y0)| {
+                    let weight = 1.0 / (absolute + relative * y0.abs());
+                    (
+                        below.max(c_below.abs() * weight),
+                        last.max(c_last.abs() * weight),
+                    )
+                },
+            );
+        // min_k size_k^(-1/k) as one exponential of the smaller exponent.
+        let exponent = [(below, p - 1), (last, p)]
+            .into_iter()
+            .filter(|&(size, _)| size > 0.0)
+            .map(|(size, k)| -size.ln() / k as f64)
+            .fold(f64::INFINITY, f64::min);
+        exponent.exp()
     }
 }
 
