@@ -118,7 +118,7 @@ pub struct SteadyOrbit {
     pub state: Vec<f64>,
     /// Floquet multipliers: eigenvalues of the monodromy matrix of `P^k`. For a period-1 orbit,
     /// the monodromy of Newton's last map with it (decoupled sensitivities, see
-    /// `shoot_observed`): the monodromy within 1.0e-6 and 2.3e-6 relative at the Fig. 1 points
+    /// `shoot_observed`): the monodromy within 1.3e-6 and 2.3e-6 relative at the Fig. 1 points
     /// A/A0 = 0.95 and 0.5 of the Biolever on mica (`cargo run --release -p afm --example
     /// monodromy_error`), enough for the orbit's stability; continuation
     /// (`bifurcation_diagram`) computes its own.
@@ -380,7 +380,7 @@ fn observed_map(
 /// [`LOOSE_RESIDUAL_FLOOR`] is evaluated again at full tolerance before anything is decided.
 ///
 /// The monodromy of every map is carried by [`newton_maps`]: decoupled from the state's
-/// steps (order-14 tangent series in contact, the exact flow in free flight), within 1.0e-6
+/// steps (order-12 tangent series in contact, the exact flow in free flight), within 1.3e-6
 /// to 2.3e-6 relative at the Fig. 1 points (`cargo run --release -p afm --example
 /// monodromy_error`), so each Newton iteration also contracts the error by about
 /// that much (times the conditioning of `M - I`) besides squaring it: far below what the
@@ -497,9 +497,9 @@ const FIRST_ITERATE_TOLERANCE: f64 = 1e-9;
 const LOOSE_RESIDUAL_FLOOR: f64 = 1e3 * FIRST_ITERATE_TOLERANCE;
 
 /// `settings` for the period maps of [`shoot_observed`]: the monodromy integrated apart from
-/// the state's steps ([`SensitivityMethod::Decoupled`]: tangent series of order 14 on the
+/// the state's steps ([`SensitivityMethod::Decoupled`]: tangent series of order 12 on the
 /// Taylor steps in contact, a sixth-order method on any Runge-Kutta step; the period map with
-/// the monodromy at A/A0 = 0.5 costs 0.64M instructions, against 0.71M with the tangents at
+/// the monodromy at A/A0 = 0.5 costs 0.61M instructions, against 0.71M with the tangents at
 /// the state's order and 0.40M without the monodromy), unless `settings` ask for
 /// error-controlled sensitivities (`sensitivity_tolerance`), which only the coupled method has.
 fn newton_maps(settings: &Settings) -> Settings {

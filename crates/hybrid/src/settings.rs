@@ -89,17 +89,17 @@ pub enum SensitivityMethod {
     /// order (under `sensitivity_tolerance` too, where set).
     #[default]
     Coupled,
-    /// On a Taylor-series step, by the tangents' own series to order 14 under a tolerance of
+    /// On a Taylor-series step, by the tangents' own series to order 12 under a tolerance of
     /// 1e-5 on their last two terms (which then also limits the step). After each accepted
     /// Runge-Kutta step of the state, over that step and on its clock, by Butcher's
     /// 7-stage Runge-Kutta method of order 6, the state at its nodes taken from the step's
     /// dense output: 7 variational evaluations per accepted step and none on rejected ones,
     /// no error control (the state's steps are taken as they come), and an error of order
     /// `(step / time scale)^6` per step. Over one period of the Biolever on mica (A/A0 = 0.95
-    /// and 0.5, default tolerances; contacts by series) the monodromy is within 1.0e-6 and
-    /// 2.3e-6 relative of a tight DOP853 reference, against 6.1e-9 and 4.3e-8 coupled (`cargo
-    /// run --release -p afm --example monodromy_error`), for 10% fewer instructions in the
-    /// period map with the monodromy at A/A0 = 0.5 (callgrind: 0.64M against 0.71M; 0.40M
+    /// and 0.5, default tolerances; contacts by series) the monodromy is within 1.3e-6 and
+    /// 2.3e-6 relative of a tight DOP853 reference, against 6.1e-9 and 4.2e-8 coupled (`cargo
+    /// run --release -p afm --example monodromy_error`), for 14% fewer instructions in the
+    /// period map with the monodromy at A/A0 = 0.5 (callgrind: 0.61M against 0.71M; 0.40M
     /// without it). Enough for Newton iterations, which need the Jacobian only well
     /// enough to contract (each iteration then also reduces the error by about that relative
     /// amount instead of only squaring it), and for stability; not where the derivative of the
