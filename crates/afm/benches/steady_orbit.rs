@@ -8,6 +8,9 @@
 //! one process, so the ratios between rows are meaningful on a noisy machine; the neighbour
 //! start is also timed on the thread's CPU clock (Linux `/proc/thread-self/schedstat`, best of
 //! 5 batches), which does not count the time other processes hold the core.
+//!
+//! The same orbits by a plain scipy transient integration, for the speed ratio: the example
+//! `transient_reference` and `benches/scipy_transient.py` (see that script).
 
 use afm::{
     builtin_case, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, Separation,
