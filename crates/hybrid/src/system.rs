@@ -263,7 +263,9 @@ pub trait HybridSystem {
     /// x(s)) V`, plus `(dt/ds) df/dp` on the last column when `parameter_column`. Each coefficient
     /// of `tangents` is a row-major matrix (component `row * columns + column`: the recurrences
     /// then run along rows of contiguous columns); the constant terms hold `V` at `s = 0`, and
-    /// every other coefficient is written. `scratch` is free space the implementation may resize.
+    /// every other coefficient is written. `scratch` is free space the implementation may
+    /// resize; the solver's has capacity for `(tangents.order() + 2) * columns` values, so
+    /// that an implementation needing no more allocates nothing in a step.
     ///
     /// To be called only where [`HybridSystem::taylor_series`] returned `true` for `state`.
     fn taylor_tangents(

@@ -219,6 +219,11 @@ pub(crate) const DECOUPLED_TANGENT_ORDER: usize = 12;
 /// steady orbit from its neighbour, 1e-4 gave 7e-3).
 pub(crate) const DECOUPLED_TANGENT_TOLERANCE: f64 = 1e-5;
 
+/// The rows of `columns` values beyond the tangents' order that the scratch space of
+/// [`HybridSystem::taylor_tangents`] holds without allocating (the AFM model's contact
+/// recurrence keeps one row per power up to the order, and one more).
+pub(crate) const TANGENT_SCRATCH_ROWS: usize = 2;
+
 /// One Taylor-series step of the solver: the state's series (and the tangents' when
 /// sensitivities are carried) about the step start, in the step's clock offset.
 #[derive(Debug, Clone)]
@@ -239,18 +244,21 @@ pub(crate) struct TaylorStep {
 
 impl TaylorStep {
     /// Storage for `n` states and `columns` tangent columns (0: none), the tangents to the
-    /// order [`tangent_control`] gives for `settings`.
+    /// order [`tangent_control`] gives for `settings`, and scratch for
+    /// [`HybridSystem::taylor_tangents`] with room for [`TANGENT_SCRATCH_ROWS`] more rows of
+    /// `columns` than that order.
     pub fn new(n: usize, columns: usize, settings: &Settings) -> Self {
+        let order = tangent_control(settings).0;
         Self {
             state: TaylorSeries::new(n, TAYLOR_ORDER),
-            tangents: TaylorSeries::new(n * columns, tangent_control(settings).0),
+            tangents: TaylorSeries::new(n * columns, order),
             clock: ClockPolynomial {
                 start: 0.0,
                 rate: 1.0,
                 curvature: 0.0,
             },
             length: 0.0,
-            scratch: Vec::new(),
+            scratch: Vec::with_capacity((order + TANGENT_SCRATCH_ROWS) * columns),
             rows: vec![0.0; n * columns],
         }
     }
