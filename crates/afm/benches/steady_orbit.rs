@@ -1,6 +1,8 @@
 //! Benchmark of the steady orbit at the paper's Fig. 1 points (Biolever on mica, A0 = 10 nm,
 //! A/A0 = 0.95, 0.90, 0.50): the time to converge it from the orbit at a neighbouring point of
-//! the approach branch (Z + 0.01 nm), and from a cold start (the free orbit plus transients),
+//! the approach branch (Z + 0.01 nm), as a branch would (`steady_orbit_in`, one workspace for
+//! the repetitions; also without it, `steady_orbit`, whose period maps each build a new
+//! solver), and from a cold start (the free orbit plus transients),
 //! and the work of one period map with the monodromy: right-hand-side evaluations (DOP853
 //! stages), steps (exact-flow, DOP853 and Taylor-series steps) and, of those, series steps.
 //!
@@ -13,8 +15,8 @@
 //! `transient_reference` and `benches/scipy_transient.py` (see that script).
 
 use afm::{
-    builtin_case, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, Separation,
-    SteadyOrbitSettings, TappingModel,
+    builtin_case, find_amplitude_ratio, steady_orbit, steady_orbit_in, AmplitudeRatioSearch,
+    Separation, SteadyOrbitSettings, SteadyOrbitWorkspace, TappingModel,
 };
 use hybrid::{flow_map, Sensitivity};
 use std::time::Instant;
@@ -64,12 +66,13 @@ fn main() {
     let settings = SteadyOrbitSettings::default();
     println!("steady orbit, Biolever on mica, A0 = 10 nm (median of repetitions)");
     println!(
-        "{:>6} {:>12} {:>8} {:>12} {:>12} {:>10} {:>14} {:>14} {:>12} {:>12}",
+        "{:>6} {:>12} {:>8} {:>12} {:>12} {:>14} {:>10} {:>14} {:>14} {:>12} {:>12}",
         "A/A0",
         "Z (nm)",
         "impacts",
         "neighbour us",
         "(CPU us)",
+        "no workspace",
         "cold us",
         "Newton iters",
         "RHS evals/T",
@@ -85,11 +88,16 @@ fn main() {
             steady_orbit(&model, z + 0.01, Some(&target.state), &settings).expect("neighbour");
         let warm = steady_orbit(&model, z, Some(&neighbour.state), &settings).expect("warm");
         assert!(warm.converged, "warm start converges");
-        let neighbour_us = median_us(201, || {
-            let orbit = steady_orbit(&model, z, Some(&neighbour.state), &settings).expect("warm");
+        let mut workspace = SteadyOrbitWorkspace::default();
+        let mut from_neighbour = || {
+            let orbit =
+                steady_orbit_in(&model, z, Some(&neighbour.state), &settings, &mut workspace)
+                    .expect("warm");
             std::hint::black_box(orbit);
-        });
-        let neighbour_cpu_us = cpu_us(400, || {
+        };
+        let neighbour_us = median_us(201, &mut from_neighbour);
+        let neighbour_cpu_us = cpu_us(400, &mut from_neighbour);
+        let fresh_us = median_us(201, || {
             let orbit = steady_orbit(&model, z, Some(&neighbour.state), &settings).expect("warm");
             std::hint::black_box(orbit);
         });
@@ -110,12 +118,13 @@ fn main() {
         )
         .expect("period map");
         println!(
-            "{:>6.2} {:>12.6} {:>8} {:>12.1} {:>12.1} {:>10.1} {:>14} {:>14} {:>12} {:>12}",
+            "{:>6.2} {:>12.6} {:>8} {:>12.1} {:>12.1} {:>14.1} {:>10.1} {:>14} {:>14} {:>12} {:>12}",
             ratio,
             z,
             target.observables().impacts.len(),
             neighbour_us,
             neighbour_cpu_us,
+            fresh_us,
             cold_us,
             warm.iterations,
             period.statistics.rhs_evaluations,

@@ -7,7 +7,9 @@
 use crate::bifurcation_diagram::{approach_diagram, DiagramSettings};
 use crate::error::AfmError;
 use crate::model::TappingModel;
-use crate::steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};
+use crate::steady_orbit::{
+    steady_orbit_in, SteadyOrbit, SteadyOrbitSettings, SteadyOrbitWorkspace,
+};
 use crate::validation::invalid;
 
 /// What [`find_amplitude_ratio`] looks for, and how. Built by [`AmplitudeRatioSearch::new`],
@@ -93,9 +95,11 @@ pub fn find_amplitude_ratio(
             reason,
         });
     };
-    let above = steady_orbit(model, above.z_nm, Some(&above.state), settings)?;
-    let below = steady_orbit(model, below.z_nm, Some(&below.state), settings)?;
-    refine(model, search, settings, above, below)
+    // One workspace for the refinement's sequence of orbits.
+    let workspace = &mut SteadyOrbitWorkspace::default();
+    let above = steady_orbit_in(model, above.z_nm, Some(&above.state), settings, workspace)?;
+    let below = steady_orbit_in(model, below.z_nm, Some(&below.state), settings, workspace)?;
+    refine(model, search, settings, above, below, workspace)
 }
 
 /// Refine the bracket `above` (A/A0 > R) / `below` (A/A0 <= R) by the Illinois method on Z,
@@ -106,6 +110,7 @@ fn refine(
     settings: &SteadyOrbitSettings,
     mut above: SteadyOrbit,
     mut below: SteadyOrbit,
+    workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<SteadyOrbit, AfmError> {
     let a0 = model.free_amplitude_nm();
     let f = |orbit: &SteadyOrbit| orbit.lockin(a0).0 - search.ratio;
@@ -124,7 +129,7 @@ fn refine(
         } else {
             &below.state
         };
-        let trial = steady_orbit(model, z, Some(start), settings)?;
+        let trial = steady_orbit_in(model, z, Some(start), settings, workspace)?;
         let ft = f(&trial);
         if ft > 0.0 {
             above = trial;

@@ -65,12 +65,14 @@ pub use hertz::{effective_modulus_gpa, HertzContact};
 pub use impact_numbers::MultipleImpactNumbers;
 pub use model::TappingModel;
 pub use observables::{
-    observe_period, orbit_observables, GapMinimum, Harmonic, Impact, OrbitObservables,
-    PeriodObserver,
+    observe_period, observe_period_in, orbit_observables, GapMinimum, Harmonic, Impact,
+    OrbitObservables, PeriodObserver,
 };
 pub use sample::Sample;
 pub use separation::Separation;
-pub use steady_orbit::{steady_orbit, SteadyOrbit, SteadyOrbitSettings};
+pub use steady_orbit::{
+    steady_orbit, steady_orbit_in, SteadyOrbit, SteadyOrbitSettings, SteadyOrbitWorkspace,
+};
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
 pub use theory::{
     compare_theory, measure_impacts, ImpactImpulse, ImpactMeasurement, ImpactPrediction,

@@ -9,8 +9,8 @@
 //! solver's events, gap minima from its extrema, so none is missed between samples.
 
 use hybrid::{
-    flow_map_observed, Direction, ExtremumKind, FlowMap, HybridSystem, Mode, Sensitivity, Settings,
-    Solver, StepOutcome,
+    flow_map_in, Direction, ExtremumKind, FlowMap, HybridSystem, Mode, Sensitivity, Settings,
+    Solver, SolverWorkspace, StepOutcome,
 };
 
 use serde::Serialize;
@@ -365,6 +365,28 @@ pub fn observe_period(
     settings: &Settings,
     harmonic_count: usize,
 ) -> Result<(FlowMap, OrbitObservables), AfmError> {
+    observe_period_in(
+        model,
+        t0,
+        x0,
+        sensitivity,
+        settings,
+        harmonic_count,
+        &mut SolverWorkspace::default(),
+    )
+}
+
+/// As [`observe_period`], the solver's buffers taken from `workspace` and handed back to it
+/// ([`hybrid::flow_map_in`]): the same result, without the allocations of a new solver.
+pub fn observe_period_in(
+    model: &TappingModel,
+    t0: f64,
+    x0: &[f64],
+    sensitivity: Sensitivity,
+    settings: &Settings,
+    harmonic_count: usize,
+    workspace: &mut SolverWorkspace,
+) -> Result<(FlowMap, OrbitObservables), AfmError> {
     if x0.len() != model.dim() {
         return Err(invalid(
             "orbit observables",
@@ -374,7 +396,7 @@ pub fn observe_period(
         ));
     }
     let mut observer = PeriodObserver::new(model, t0, x0, harmonic_count);
-    let flow = flow_map_observed(
+    let flow = flow_map_in(
         model,
         t0,
         x0,
@@ -384,6 +406,7 @@ pub fn observe_period(
         &mut |solver: &Solver<TappingModel>, outcome: &StepOutcome| {
             observer.observe(solver, outcome)
         },
+        workspace,
     )?;
     let observables = observer.finish(model);
     Ok((flow, observables))

@@ -9,6 +9,7 @@ use crate::sensitivity::Sensitivity;
 use crate::settings::Settings;
 use crate::solver::{Solver, Statistics, StepOutcome};
 use crate::system::HybridSystem;
+use crate::workspace::SolverWorkspace;
 
 /// The result of integrating over `[t0, t0 + duration]`.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,11 +71,53 @@ where
     S: HybridSystem + ?Sized,
     O: FnMut(&Solver<S>, &StepOutcome),
 {
+    flow_map_in(
+        system,
+        t0,
+        x0,
+        duration,
+        sensitivity,
+        settings,
+        observer,
+        &mut SolverWorkspace::default(),
+    )
+}
+
+/// As [`flow_map_observed`], the solver taking its buffers from `workspace` and handing them
+/// back to it when done ([`Solver::with_workspace`], [`Solver::into_workspace`]): repeated
+/// maps of one shape (Newton iterations, a branch of orbits) allocate only their results. The
+/// run is identical to one on fresh buffers. On an error the buffers are dropped and
+/// `workspace` is left empty.
+///
+/// # Errors
+/// As [`flow_map`].
+#[allow(clippy::too_many_arguments)]
+pub fn flow_map_in<S, O>(
+    system: &S,
+    t0: f64,
+    x0: &[f64],
+    duration: f64,
+    sensitivity: Sensitivity,
+    settings: &Settings,
+    observer: &mut O,
+    workspace: &mut SolverWorkspace,
+) -> Result<FlowMap, HybridError>
+where
+    S: HybridSystem + ?Sized,
+    O: FnMut(&Solver<S>, &StepOutcome),
+{
     let t_end = t0 + duration;
     if !duration.is_finite() || duration < 0.0 || !t_end.is_finite() {
         return Err(HybridError::InvalidEndTime { t: t0, t_end });
     }
-    let mut solver = Solver::new(system, t0, x0, sensitivity, settings.clone())?;
+    let mut solver = Solver::with_workspace(
+        system,
+        t0,
+        x0,
+        sensitivity,
+        settings.clone(),
+        std::mem::take(workspace),
+    )?;
     let mut events = Vec::new();
     let mut extrema = Vec::new();
     loop {
@@ -87,12 +130,14 @@ where
             StepOutcome::EndTime => break,
         }
     }
-    Ok(FlowMap {
+    let map = FlowMap {
         state: solver.state().to_vec(),
         transition: solver.transition().clone(),
         parameter_sensitivity: solver.parameter_sensitivity().to_vec(),
         events,
         extrema,
         statistics: *solver.statistics(),
-    })
+    };
+    *workspace = solver.into_workspace();
+    Ok(map)
 }

@@ -46,7 +46,7 @@ pub mod workspace;
 pub use clock::Clock;
 pub use error::HybridError;
 pub use event::{Event, Extremum, ExtremumKind};
-pub use flow_map::{flow_map, flow_map_observed, FlowMap};
+pub use flow_map::{flow_map, flow_map_in, flow_map_observed, FlowMap};
 pub use sensitivity::{LinearisationBuffers, Sensitivity};
 pub use settings::{SensitivityMethod, Settings};
 pub use solver::{Solver, Statistics, StepOutcome};

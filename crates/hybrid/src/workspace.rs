@@ -149,7 +149,8 @@ impl Buffers {
         }
     }
 
-    /// Whether these buffers serve a solver of this shape and these settings.
+    /// Whether these buffers serve a solver of this shape and these settings (the sensitivity
+    /// method sizes nothing where no sensitivities are carried).
     pub fn fits(
         &self,
         n: usize,
@@ -162,6 +163,7 @@ impl Buffers {
             && self.sensitivity == sensitivity
             && self.samples_per_step == settings.samples_per_step
             && self.sensitivity_tolerance == settings.sensitivity_tolerance
-            && self.sensitivity_method == settings.sensitivity_method
+            && (sensitivity == Sensitivity::None
+                || self.sensitivity_method == settings.sensitivity_method)
     }
 }
