@@ -55,6 +55,9 @@ pub(crate) struct Samples {
     /// Whether column 0 already holds the samples at the step start (carried over from the end
     /// of the previous step in the same mode).
     pub start_valid: bool,
+    /// Whether the step was sampled at its ends only ([`Samples::sample_ends`]): every interior
+    /// point repeats the end, and there are no extrema.
+    pub ends_only: bool,
 }
 
 impl Samples {
@@ -69,6 +72,7 @@ impl Samples {
             extremum_time: vec![f64::NAN; surfaces * (points - 1)],
             extremum_value: vec![f64::NAN; surfaces * (points - 1)],
             start_valid: false,
+            ends_only: false,
         }
     }
 
@@ -107,6 +111,7 @@ impl Samples {
                 t0 + (t1 - t0) * (i as f64 / last as f64)
             };
         }
+        self.ends_only = false;
         let first = usize::from(self.start_valid);
         for i in first..p {
             let t = self.times[i];
@@ -182,6 +187,7 @@ impl Samples {
             }
         }
         self.start_valid = true;
+        self.ends_only = true;
         self.extremum_time.fill(f64::NAN);
         self.extremum_value.fill(f64::NAN);
         Ok(())

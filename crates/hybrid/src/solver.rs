@@ -1577,6 +1577,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         time_tolerance: f64,
     ) -> Option<(usize, Bracket)> {
         let p = self.buffers.samples.points();
+        // A step sampled at its ends only repeats the end at every interior point: its first
+        // interval is the whole step, and the scan stops there.
+        let intervals = if self.buffers.samples.ends_only {
+            1
+        } else {
+            p - 1
+        };
         let mut best: Option<(usize, Bracket)> = None;
         for k in 0..self.surfaces {
             let side = side_sign(mode, k);
@@ -1585,7 +1592,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let h0 = self.buffers.samples.values[k * p];
             let mut prev = (t0, (side * h0).abs(), h0, self.buffers.samples.rates[k * p]);
             let mut candidate = None;
-            for i in 0..p - 1 {
+            for i in 0..intervals {
                 let te = self.buffers.samples.extremum_time[k * (p - 1) + i];
                 if !te.is_nan() && te > prev.0 {
                     let he = self.buffers.samples.extremum_value[k * (p - 1) + i];
