@@ -55,8 +55,8 @@ pub(crate) struct Samples {
     /// Whether column 0 already holds the samples at the step start (carried over from the end
     /// of the previous step in the same mode).
     pub start_valid: bool,
-    /// Whether the step was sampled at its ends only ([`Samples::sample_ends`]): every interior
-    /// point repeats the end, and there are no extrema.
+    /// Whether the step was sampled at its ends only ([`Samples::sample_ends`]): only the first
+    /// and last points are this step's, and it has no extrema.
     pub ends_only: bool,
 }
 
@@ -150,10 +150,10 @@ impl Samples {
     }
 
     /// Sample `h_k` and `dh_k/dt` at the step's two ends only (the start from `x0` unless
-    /// carried over, the end from `x1`), for a step proven clear of every surface: the
-    /// interior points are put at the end (`times[i] = t1`, the end's values), so that the step
-    /// reads as one monotone interval with no extrema. [`Samples::locate_extrema`] is not to be
-    /// called after it; the extrema of the step are cleared here.
+    /// carried over, the end from `x1`), for a step proven clear of every surface, and mark
+    /// the samples [`Samples::ends_only`]: the step reads as one interval from the first point
+    /// to the last, with no extrema, and the interior points and extrema hold nothing of this
+    /// step. [`Samples::locate_extrema`] is not to be called after it.
     ///
     /// # Errors
     /// [`HybridError::NonFiniteSwitching`] if a sample is NaN or infinite.
@@ -169,9 +169,7 @@ impl Samples {
     ) -> Result<(), HybridError> {
         let p = self.points;
         self.times[0] = t0;
-        for time in &mut self.times[1..] {
-            *time = t1;
-        }
+        self.times[p - 1] = t1;
         let ends: &[(usize, f64, &[f64])] = if self.start_valid {
             &[(p - 1, t1, x1)]
         } else {
@@ -180,16 +178,8 @@ impl Samples {
         for &(i, t, x) in ends {
             self.record(system, mode, i, t, x)?;
         }
-        for k in 0..self.surfaces {
-            for i in 1..p - 1 {
-                self.values[k * p + i] = self.values[k * p + p - 1];
-                self.rates[k * p + i] = self.rates[k * p + p - 1];
-            }
-        }
         self.start_valid = true;
         self.ends_only = true;
-        self.extremum_time.fill(f64::NAN);
-        self.extremum_value.fill(f64::NAN);
         Ok(())
     }
 

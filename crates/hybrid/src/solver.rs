@@ -1577,13 +1577,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         time_tolerance: f64,
     ) -> Option<(usize, Bracket)> {
         let p = self.buffers.samples.points();
-        // A step sampled at its ends only repeats the end at every interior point: its first
-        // interval is the whole step, and the scan stops there.
-        let intervals = if self.buffers.samples.ends_only {
-            1
-        } else {
-            p - 1
-        };
+        // A step sampled at its ends only is one interval, from the first point to the last,
+        // with no extremum.
+        let ends_only = self.buffers.samples.ends_only;
+        let intervals = if ends_only { 1 } else { p - 1 };
         let mut best: Option<(usize, Bracket)> = None;
         for k in 0..self.surfaces {
             let side = side_sign(mode, k);
@@ -1593,7 +1590,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let mut prev = (t0, (side * h0).abs(), h0, self.buffers.samples.rates[k * p]);
             let mut candidate = None;
             for i in 0..intervals {
-                let te = self.buffers.samples.extremum_time[k * (p - 1) + i];
+                let te = if ends_only {
+                    f64::NAN
+                } else {
+                    self.buffers.samples.extremum_time[k * (p - 1) + i]
+                };
                 if !te.is_nan() && te > prev.0 {
                     let he = self.buffers.samples.extremum_value[k * (p - 1) + i];
                     let point = (te, side * he, he, 0.0);
@@ -1603,12 +1604,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     }
                     prev = point;
                 }
-                let hb = self.buffers.samples.values[k * p + i + 1];
+                let j = if ends_only { p - 1 } else { i + 1 };
+                let hb = self.buffers.samples.values[k * p + j];
                 let point = (
-                    self.buffers.samples.times[i + 1],
+                    self.buffers.samples.times[j],
                     side * hb,
                     hb,
-                    self.buffers.samples.rates[k * p + i + 1],
+                    self.buffers.samples.rates[k * p + j],
                 );
                 if point.1 < 0.0 {
                     candidate = Some((prev, point));
