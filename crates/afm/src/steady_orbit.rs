@@ -576,8 +576,8 @@ const LOOSE_RESIDUAL_FLOOR: f64 = 1e3 * FIRST_ITERATE_TOLERANCE;
 /// `settings` for the period maps of [`shoot_observed`]: the monodromy integrated apart from
 /// the state's steps ([`SensitivityMethod::Decoupled`]: tangent series of order 12 on the
 /// Taylor steps in contact, a sixth-order method on any Runge-Kutta step; the period map with
-/// the monodromy at A/A0 = 0.5 costs 0.61M instructions, against 0.71M with the tangents at
-/// the state's order and 0.40M without the monodromy), unless `settings` ask for
+/// the monodromy at A/A0 = 0.5 costs 0.60M instructions, against 0.69M with the tangents at
+/// the state's order and 0.38M without the monodromy), unless `settings` ask for
 /// error-controlled sensitivities (`sensitivity_tolerance`), which only the coupled method has.
 fn newton_maps(settings: &Settings) -> Settings {
     Settings {
