@@ -50,7 +50,7 @@ impl GaussLegendre {
 
     /// The rule's nodes on the part `[a, b]` of a solver step whose states are polynomial in
     /// `clock`'s reading `sigma` (hybrid's `Solver::last_step_clock`), with the drive phase
-    /// there: `(t, weight, (sin w t, cos w t))` for every node. The nodes are the rule's on
+    /// there: a [`ClockNode`] for every node. The nodes are the rule's on
     /// `[sigma(a), sigma(b)]` and the weights carry `dt/dsigma`, so that an integrand smooth in
     /// `sigma` but not in `t` (the Hertz force `~ (t - t_c)^{3/2}` from a contact's onset or up
     /// to its release, on the square-root clock) is integrated to the rule's order; on the time
@@ -61,7 +61,7 @@ impl GaussLegendre {
         a: f64,
         b: f64,
         angular_frequency: f64,
-    ) -> impl Iterator<Item = (f64, f64, (f64, f64))> + '_ {
+    ) -> impl Iterator<Item = ClockNode> + '_ {
         let (sigma_a, sigma_b) = (clock.sigma(a), clock.sigma(b));
         let middle = 0.5 * (sigma_a + sigma_b);
         self.pairs(sigma_a, sigma_b)
@@ -70,10 +70,37 @@ impl GaussLegendre {
             })
             .map(move |(sigma, weight)| {
                 let t = clock.time(sigma).clamp(a, b);
-                let drive = phase::sin_cos(angular_frequency * t);
-                (t, weight * clock.rate(sigma), drive)
+                ClockNode {
+                    sigma,
+                    t,
+                    weight: weight * clock.rate(sigma),
+                    drive: phase::sin_cos(angular_frequency * t),
+                }
             })
     }
+
+    /// The number of nodes of the rule.
+    pub const fn len(&self) -> usize {
+        2 * self.nodes.len()
+    }
+
+    /// Whether the rule has no nodes (none of the rules here).
+    pub const fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+}
+
+/// A node of [`GaussLegendre::clock_drive_nodes`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ClockNode {
+    /// The clock reading `sigma` of the node (hybrid's `Solver::interpolate_clock` takes it).
+    pub sigma: f64,
+    /// Its time, us.
+    pub t: f64,
+    /// Its weight, times `dt/dsigma` there (us): `int f dt ~ sum weight f(t)`.
+    pub weight: f64,
+    /// The drive phase there, `(sin w t, cos w t)`.
+    pub drive: (f64, f64),
 }
 
 #[cfg(test)]
@@ -108,10 +135,18 @@ mod tests {
         for rule in [GAUSS_LEGENDRE_8, GAUSS_LEGENDRE_4] {
             let nodes: Vec<_> = rule.clock_drive_nodes(Clock::Time, a, b, w).collect();
             assert_eq!(nodes.len(), 2 * rule.pairs(a, b).count());
-            let total: f64 = nodes.iter().map(|node| node.1).sum();
+            assert_eq!(nodes.len(), rule.len());
+            let total: f64 = nodes.iter().map(|node| node.weight).sum();
             assert!((total - (b - a)).abs() < 1e-15);
-            for (t, _, (sin, cos)) in nodes {
+            for ClockNode {
+                sigma,
+                t,
+                drive: (sin, cos),
+                ..
+            } in nodes
+            {
                 assert!(t > a && t < b);
+                assert_eq!(sigma, t, "the time clock reads time");
                 let (sin_t, cos_t) = (w * t).sin_cos();
                 assert!(
                     (sin - sin_t).abs() < 1e-15 && (cos - cos_t).abs() < 1e-15,
@@ -134,7 +169,7 @@ mod tests {
         for rule in [GAUSS_LEGENDRE_8, GAUSS_LEGENDRE_4] {
             let on_clock: f64 = rule
                 .clock_drive_nodes(onset, a, b, 1.0)
-                .map(|(t, weight, _)| weight * (t - a).powf(1.5))
+                .map(|node| node.weight * (node.t - a).powf(1.5))
                 .sum();
             let exact = 0.4 * (b - a).powf(2.5);
             assert!(
@@ -143,13 +178,13 @@ mod tests {
             );
             let in_time: f64 = rule
                 .clock_drive_nodes(Clock::Time, a, b, 1.0)
-                .map(|(t, weight, _)| weight * (t - a).powf(1.5))
+                .map(|node| node.weight * (node.t - a).powf(1.5))
                 .sum();
             assert!((in_time - exact).abs() > 1e-7 * exact);
             let end = b + 0.01;
             let ahead: f64 = rule
                 .clock_drive_nodes(release, a, b, 1.0)
-                .map(|(t, weight, _)| weight * (end - t).powf(1.5))
+                .map(|node| node.weight * (end - node.t).powf(1.5))
                 .sum();
             let exact = 0.4 * ((end - a).powf(2.5) - (end - b).powf(2.5));
             assert!((ahead - exact).abs() < 1e-14 * exact, "{ahead} vs {exact}");

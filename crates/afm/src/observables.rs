@@ -16,7 +16,7 @@ use hybrid::{
 use serde::Serialize;
 
 use crate::free_flight_fourier::FreeFlightFourier;
-use crate::gauss_legendre::GAUSS_LEGENDRE_8;
+use crate::gauss_legendre::{ClockNode, GAUSS_LEGENDRE_8};
 use crate::model::{CONTACT, GAP_SURFACE};
 use crate::validation::invalid;
 use crate::{AfmError, TappingModel};
@@ -86,6 +86,9 @@ pub struct OrbitObservables {
     pub impulse_nn_us: f64,
 }
 
+/// The nodes of the contact steps' quadrature ([`GAUSS_LEGENDRE_8`]).
+const QUADRATURE_NODES: usize = GAUSS_LEGENDRE_8.len();
+
 /// An observer of the solver's steps that accumulates the observables of the window
 /// `[t0, t0 + T]`: pass [`PeriodObserver::observe`] to `hybrid::flow_map_observed` (or call it
 /// after every `Solver::step` of a sweep), then call [`PeriodObserver::finish`].
@@ -109,6 +112,8 @@ pub struct PeriodObserver {
     events: Vec<(f64, Direction, f64)>,
     minima: Vec<(f64, f64)>,
     state: Vec<f64>,
+    /// The states at a contact step's quadrature nodes (`n` per node).
+    node_states: Vec<f64>,
     /// The closed-form Fourier integrals over free flight (`None` near critical damping, where
     /// free flight is integrated by quadrature like contact).
     free_flight: Option<FreeFlightFourier>,
@@ -138,6 +143,7 @@ impl PeriodObserver {
             events: Vec::new(),
             minima: Vec::new(),
             state: vec![0.0; model.dim()],
+            node_states: vec![0.0; QUADRATURE_NODES * model.dim()],
             free_flight: FreeFlightFourier::new(model),
             mode: model.mode_of(t0, x0),
             free_start: None,
@@ -149,7 +155,7 @@ impl PeriodObserver {
     /// `u cos(k w t)`, `u sin(k w t)` and `F_ts`, the step's gap minima and its contact event.
     /// Over free flight (exact-flow steps, `F_ts = 0`) the Fourier integrals are taken in
     /// closed form ([`FreeFlightFourier`]) once per free-flight interval, when it ends; over
-    /// contact steps by 8-point Gauss-Legendre quadrature on `Solver::interpolate`.
+    /// contact steps by 8-point Gauss-Legendre quadrature in the step's clock on `Solver::interpolate_clock`.
     pub fn observe(&mut self, solver: &Solver<TappingModel>, outcome: &StepOutcome) {
         let model = solver.system();
         let (step_start, step_end) = solver.last_step();
@@ -166,14 +172,26 @@ impl PeriodObserver {
                 }
             } else {
                 self.close_free_flight(a);
-                for (t, weight, drive) in GAUSS_LEGENDRE_8.clock_drive_nodes(
+                // The nodes' states from one call (on a Taylor step, one pass over the series).
+                let mut nodes = [ClockNode::default(); QUADRATURE_NODES];
+                let mut sigma = [0.0; QUADRATURE_NODES];
+                let mut count = 0;
+                for node in GAUSS_LEGENDRE_8.clock_drive_nodes(
                     solver.last_step_clock(),
                     a,
                     b,
                     self.angular_frequency,
                 ) {
-                    self.accumulate(solver, model, t, drive, weight);
+                    (nodes[count], sigma[count]) = (node, node.sigma);
+                    count += 1;
                 }
+                let n = self.state.len();
+                let mut states = std::mem::take(&mut self.node_states);
+                solver.interpolate_clock(&sigma[..count], &mut states[..count * n]);
+                for (node, state) in nodes[..count].iter().zip(states.chunks_exact(n)) {
+                    self.accumulate(model, node, state);
+                }
+                self.node_states = states;
             }
         }
         self.mode = solver.mode();
@@ -214,19 +232,16 @@ impl PeriodObserver {
         }
     }
 
-    /// Add the quadrature node at `t` with `weight`, given the drive phase there as
-    /// `(sin w t, cos w t)`.
-    fn accumulate(
-        &mut self,
-        solver: &Solver<TappingModel>,
-        model: &TappingModel,
-        t: f64,
-        (sin, cos): (f64, f64),
-        weight: f64,
-    ) {
-        solver.interpolate(t, &mut self.state);
-        let u = model.photodiode(&self.state);
-        self.impulse += weight * model.hertz().force(model.gap(t, &self.state));
+    /// Add the quadrature node `node` with the state `state` there.
+    fn accumulate(&mut self, model: &TappingModel, node: &ClockNode, state: &[f64]) {
+        let ClockNode {
+            t,
+            weight,
+            drive: (sin, cos),
+            ..
+        } = *node;
+        let u = model.photodiode(state);
+        self.impulse += weight * model.hertz().force(model.gap(t, state));
         let (mut sin_k, mut cos_k) = (sin, cos);
         for coefficient in self.fourier.iter_mut() {
             coefficient[0] += weight * u * cos_k;

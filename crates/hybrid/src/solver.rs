@@ -425,6 +425,41 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
     }
 
+    /// The states at the readings `sigma` of the last step's clock ([`Solver::last_step_clock`],
+    /// inside the step), into `states` (`n` per reading, in order): what
+    /// [`Solver::interpolate`] gives at the times `clock.time(sigma)`, without the round trip
+    /// through time, and on a Taylor-series step evaluated together
+    /// ([`crate::TaylorSeries::evaluate_many`]): the nodes of a quadrature in the clock.
+    pub fn interpolate_clock(&self, sigma: &[f64], states: &mut [f64]) {
+        let n = self.n;
+        match self.kind {
+            StepKind::Taylor => {
+                const BLOCK: usize = 8;
+                for (readings, block) in sigma.chunks(BLOCK).zip(states.chunks_mut(BLOCK * n)) {
+                    let mut offsets = [0.0; BLOCK];
+                    for (offset, reading) in offsets.iter_mut().zip(readings) {
+                        *offset = reading - self.sigma_start;
+                    }
+                    self.buffers
+                        .taylor
+                        .state
+                        .evaluate_many(&offsets[..readings.len()], block);
+                }
+            }
+            StepKind::RungeKutta => {
+                for (reading, x) in sigma.iter().zip(states.chunks_exact_mut(n)) {
+                    let theta = (reading - self.sigma_start) / self.buffers.rk.h;
+                    self.buffers.rk.interpolate(&self.buffers.z_start, theta, x);
+                }
+            }
+            StepKind::Exact | StepKind::None => {
+                for (&reading, x) in sigma.iter().zip(states.chunks_exact_mut(n)) {
+                    self.interpolate(reading, x);
+                }
+            }
+        }
+    }
+
     /// The state at time `t` inside the last step, written into `x` (length `n`; a shorter
     /// slice receives the leading components): the 7th-order DOP853 dense output, or the exact
     /// flow from the step start. Before the first step, the current state.

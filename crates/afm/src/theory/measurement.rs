@@ -24,7 +24,7 @@ use hybrid::{
 };
 use serde::Serialize;
 
-use crate::gauss_legendre::GAUSS_LEGENDRE_8;
+use crate::gauss_legendre::{ClockNode, GAUSS_LEGENDRE_8};
 use crate::model::GAP_SURFACE;
 use crate::validation::invalid;
 use crate::{AfmError, Separation, SteadyOrbit, TappingModel};
@@ -151,7 +151,12 @@ impl Accumulator {
         let (a, b) = solver.last_step();
         let b = b.min(self.period);
         if b > a {
-            for (t, w, (sin, cos)) in GAUSS_LEGENDRE_8.clock_drive_nodes(
+            for ClockNode {
+                t,
+                weight: w,
+                drive: (sin, cos),
+                ..
+            } in GAUSS_LEGENDRE_8.clock_drive_nodes(
                 solver.last_step_clock(),
                 a,
                 b,
