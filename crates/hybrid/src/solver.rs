@@ -621,20 +621,51 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 );
             };
             // Exact steps: every interior state from one call (a linear flow reuses its
-            // transition over one spacing).
-            let grid = if kind == StepKind::Exact {
-                let count = self.buffers.samples.points() - 1;
-                system.exact_flow_grid(
-                    mode,
-                    t0,
-                    &z_start[..n],
-                    t1 - t0,
-                    count,
-                    &mut self.buffers.grid,
-                );
-                Some(&self.buffers.grid[..])
-            } else {
-                None
+            // transition over one spacing). Taylor steps: from one pass over the series, at
+            // the sample times `Samples::sample` takes (each the value `state_in_step` gives).
+            let grid = match kind {
+                StepKind::Exact => {
+                    let count = self.buffers.samples.points() - 1;
+                    system.exact_flow_grid(
+                        mode,
+                        t0,
+                        &z_start[..n],
+                        t1 - t0,
+                        count,
+                        &mut self.buffers.grid,
+                    );
+                    Some(&self.buffers.grid[..])
+                }
+                StepKind::Taylor => {
+                    let last = self.buffers.samples.points() - 1;
+                    let (clock, sigma0) = clock;
+                    let series = &self.buffers.taylor.state;
+                    for (first, states) in (1..last)
+                        .step_by(SAMPLE_BLOCK)
+                        .zip(self.buffers.grid.chunks_mut(SAMPLE_BLOCK * n))
+                    {
+                        let end = (first + SAMPLE_BLOCK).min(last);
+                        let mut offsets = [0.0; SAMPLE_BLOCK];
+                        for (offset, i) in offsets.iter_mut().zip(first..end) {
+                            let t = t0 + (t1 - t0) * (i as f64 / last as f64);
+                            *offset = clock.sigma(t) - sigma0;
+                        }
+                        let states = &mut states[..(end - first) * n];
+                        series.evaluate_many(&offsets[..end - first], states);
+                        // The step's ends as `state_in_step` gives them, should a sample time
+                        // round onto one.
+                        for (i, state) in (first..end).zip(states.chunks_exact_mut(n)) {
+                            let t = t0 + (t1 - t0) * (i as f64 / last as f64);
+                            if t == t1 {
+                                state.copy_from_slice(&z_new[..n]);
+                            } else if t == t0 {
+                                state.copy_from_slice(&z_start[..n]);
+                            }
+                        }
+                    }
+                    Some(&self.buffers.grid[..])
+                }
+                _ => None,
             };
             self.buffers.samples.sample(
                 system,
@@ -1984,6 +2015,10 @@ const TRIAL_SAMPLES: usize = 16;
 
 /// Re-centred square-root landings allowed per step after a landing passed its crossing.
 const MAX_RETARGETS: usize = 3;
+
+/// The sample points of a Taylor step's interior evaluated together
+/// ([`crate::TaylorSeries::evaluate_many`]'s block).
+const SAMPLE_BLOCK: usize = 8;
 
 /// The field of `mode` on `clock`: `dz/dsigma = (dt/dsigma) f(t(sigma), z)`, augmented with
 /// the variational equations when `variational` (else only the state part is written).

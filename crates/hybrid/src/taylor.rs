@@ -129,12 +129,15 @@ impl TaylorSeries {
         const BLOCK: usize = 8;
         let dim = self.dim;
         for (offsets, values) in s.chunks(BLOCK).zip(out.chunks_mut(BLOCK * dim)) {
-            // The state of one or two modes at the 8 or 4 nodes of a quadrature as constants.
+            // The state of one or two modes as constants, at 4 offsets (a 4-point quadrature)
+            // or up to 8 (the lanes past the offsets given evaluate at 0 and are dropped).
+            let mut padded = [0.0; BLOCK];
+            padded[..offsets.len()].copy_from_slice(offsets);
             match (dim, offsets.len()) {
-                (2, 8) => self.evaluate_block::<2, 8>(offsets, values),
-                (4, 8) => self.evaluate_block::<4, 8>(offsets, values),
-                (2, 4) => self.evaluate_block::<2, 4>(offsets, values),
-                (4, 4) => self.evaluate_block::<4, 4>(offsets, values),
+                (2, 4) => self.evaluate_block::<2, 4>(&padded, values),
+                (4, 4) => self.evaluate_block::<4, 4>(&padded, values),
+                (2, _) => self.evaluate_block::<2, BLOCK>(&padded, values),
+                (4, _) => self.evaluate_block::<4, BLOCK>(&padded, values),
                 _ => {
                     for (&s, value) in offsets.iter().zip(values.chunks_exact_mut(dim)) {
                         self.evaluate(s, value);
@@ -144,8 +147,9 @@ impl TaylorSeries {
         }
     }
 
-    /// [`TaylorSeries::evaluate_many`] for `dim == D` and `P` offsets: the values held
-    /// component by component, so that the loop over offsets vectorises.
+    /// [`TaylorSeries::evaluate_many`] for `dim == D` at the first `P` offsets of `s`, into the
+    /// points `out` holds (`out.len() / D <= P`): the values held component by component, so
+    /// that the loop over offsets vectorises.
     #[inline(always)]
     fn evaluate_block<const D: usize, const P: usize>(&self, s: &[f64], out: &mut [f64]) {
         let s = &s[..P];
@@ -471,8 +475,9 @@ mod tests {
     use super::*;
 
     /// `evaluate_many` gives, bit for bit, what `evaluate` gives at each offset: for the
-    /// dimensions and node counts it specialises (2 and 4 components; 8 and 4 offsets) and
-    /// for others (3 components, 5 and 11 offsets: a block of 8 and a rest).
+    /// dimensions it specialises (2 and 4 components; 4 offsets, and up to 8 in a padded
+    /// block) and for another (3 components), with 4, 5, 7, 8 and 11 offsets (a block of 8 and
+    /// a rest).
     #[test]
     fn evaluation_at_many_offsets_equals_one_at_a_time() {
         for dim in [2, 3, 4] {
@@ -480,7 +485,7 @@ mod tests {
             for (i, c) in series.coefficients_mut().iter_mut().enumerate() {
                 *c = ((i * 37 % 23) as f64 - 11.0) / (1.0 + i as f64);
             }
-            for count in [4, 5, 8, 11] {
+            for count in [4, 5, 7, 8, 11] {
                 let offsets: Vec<f64> = (0..count).map(|j| 0.9 * j as f64 / 7.0 - 0.2).collect();
                 let mut together = vec![0.0; count * dim];
                 series.evaluate_many(&offsets, &mut together);
