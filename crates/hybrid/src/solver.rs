@@ -805,7 +805,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             if self.kind == StepKind::Taylor {
                 // The series' polynomial in the clock offset, in the fraction of the step.
                 let length = self.buffers.taylor.length;
-                let mut power = self.series_surface_polynomial(k, start_value);
+                let mut power = match self.buffers.taylor.surface {
+                    Some((kept, mut power)) if kept == k => {
+                        power[0] = start_value;
+                        power
+                    }
+                    _ => self.series_surface_polynomial(k, start_value),
+                };
                 let mut scale = 1.0;
                 for c in power.iter_mut() {
                     *c *= scale;
@@ -1148,11 +1154,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     }
 
     /// The first zero in `(0, upto]` of surface `k` (affine) along the last Taylor series, in
-    /// its clock offset.
-    fn surface_zero(&self, k: usize, upto: f64) -> Option<f64> {
+    /// its clock offset. The surface's polynomial is kept with the series
+    /// ([`TaylorStep::surface`]) for the step's Bernstein tests.
+    fn surface_zero(&mut self, k: usize, upto: f64) -> Option<f64> {
         let start = self.buffers.taylor.clock.start;
         let start_value = self.system.switching(k, start, &self.buffers.z[..self.n]);
-        first_zero(&self.series_surface_polynomial(k, start_value), upto)
+        let power = self.series_surface_polynomial(k, start_value);
+        self.buffers.taylor.surface = Some((k, power));
+        first_zero(&power, upto)
     }
 
     /// The polynomial in the clock offset `s` of the affine surface `k` along the last Taylor

@@ -282,6 +282,10 @@ pub(crate) struct TaylorStep {
     pub clock: ClockPolynomial,
     /// The step's length in its clock variable.
     pub length: f64,
+    /// The polynomial in the clock offset of an affine surface `k` along the state's series,
+    /// `(k, coefficients)`, where the solver formed it for this series (its constant term is
+    /// the caller's; cleared by [`TaylorStep::expand`]).
+    pub surface: Option<(usize, [f64; TAYLOR_ORDER + 1])>,
     /// Scratch for [`crate::HybridSystem::taylor_tangents`] and the tangents' row-major
     /// start and value.
     scratch: Vec<f64>,
@@ -304,6 +308,7 @@ impl TaylorStep {
                 curvature: 0.0,
             },
             length: 0.0,
+            surface: None,
             scratch: Vec::with_capacity((order + TANGENT_SCRATCH_ROWS) * columns),
             rows: vec![0.0; n * columns],
         }
@@ -318,6 +323,7 @@ impl TaylorStep {
         x0: &[f64],
     ) -> bool {
         self.clock = clock;
+        self.surface = None;
         self.state.start_at(x0);
         system.taylor_series(mode, &clock, &mut self.state)
     }
