@@ -6,44 +6,13 @@
 //! solver's own construction allocates; a restart and a solver on the first one's workspace do
 //! not, and repeat the run exactly.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use afm::{builtin_case, Separation, TappingModel};
 use hybrid::{Sensitivity, SensitivityMethod, Settings, Solver, StepOutcome};
 
-struct Counting;
+#[path = "../../hybrid/tests/allocation_counter/mod.rs"]
+mod allocation_counter;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    /// Only the test's own thread counts (the test harness allocates on other threads).
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
-fn count() {
-    if COUNTING.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-    }
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+use allocation_counter::{allocations, count_this_thread};
 
 /// The separation of the Fig. 1 point A/A0 = 0.5 on the approach branch (nm).
 const Z_HALF_AMPLITUDE: f64 = 2.733_156_827_672_611;
@@ -52,7 +21,7 @@ const Z_HALF_AMPLITUDE: f64 = 2.733_156_827_672_611;
 /// and the number of Taylor-series steps taken.
 fn run_counting(solver: &mut Solver<TappingModel>, t_end: f64) -> (usize, u64) {
     let mut events = 0;
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     loop {
         match solver.step(t_end).expect("integration succeeds") {
             StepOutcome::Event(_) => events += 1,
@@ -60,7 +29,7 @@ fn run_counting(solver: &mut Solver<TappingModel>, t_end: f64) -> (usize, u64) {
             StepOutcome::EndTime => break,
         }
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = allocations();
     assert!(
         events >= 12,
         "two periods of three impacts: {events} events"
@@ -80,7 +49,7 @@ fn contact_and_free_flight_steps_do_not_allocate() {
         .expect("finite");
     let x0 = model.free_state();
     let t_end = 2.0 * model.period_us();
-    COUNTING.with(|c| c.set(true));
+    count_this_thread();
     for (sensitivity, method) in [
         (Sensitivity::None, SensitivityMethod::Coupled),
         (Sensitivity::Transition, SensitivityMethod::Coupled),
@@ -105,17 +74,17 @@ fn contact_and_free_flight_steps_do_not_allocate() {
         assert!(series_steps >= 12, "{label}: {series_steps} series steps");
         assert_eq!(first, 0, "{label}: the first run");
         let final_state = solver.state().to_vec();
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let before = allocations();
         solver.restart(0.0, &x0).expect("valid");
-        let restart = ALLOCATIONS.load(Ordering::SeqCst) - before;
+        let restart = allocations() - before;
         let (second, _) = run_counting(&mut solver, t_end);
         assert_eq!(restart + second, 0, "{label}: after a restart");
         assert_eq!(solver.state(), &final_state[..]);
         let workspace = solver.into_workspace();
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let before = allocations();
         let mut solver = Solver::with_workspace(&model, 0.0, &x0, sensitivity, settings, workspace)
             .expect("valid");
-        let construction = ALLOCATIONS.load(Ordering::SeqCst) - before;
+        let construction = allocations() - before;
         let (third, _) = run_counting(&mut solver, t_end);
         assert_eq!(
             construction + third,

@@ -4,44 +4,12 @@
 
 mod common;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use common::{HertzOscillator, ImpactOscillator, Rotation};
 use hybrid::{HybridSystem, Sensitivity, Settings, Solver, StepOutcome};
 
-struct Counting;
+mod allocation_counter;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    /// Only the test's own thread counts (the test harness allocates on other threads).
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
-fn count() {
-    if COUNTING.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-    }
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+use allocation_counter::{allocations, count_this_thread};
 
 /// Allocations during the steps of a run, minus one per event (its `state` vector). The run
 /// is made three times: after `Solver::restart`, and by a solver built by
@@ -52,18 +20,18 @@ fn allocations_beyond_events<S: HybridSystem>(system: &S, x0: &[f64], s: Sensiti
     let first = run_counting(&mut solver);
     let final_state = solver.state().to_vec();
     let statistics = *solver.statistics();
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     solver.restart(0.0, x0).expect("valid");
-    let restart = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    let restart = allocations() - before;
     let second = run_counting(&mut solver);
     assert_eq!(solver.state(), &final_state[..]);
     assert_eq!(*solver.statistics(), statistics);
     // A new solver on the first one's buffers: no allocation, and the same run again.
     let workspace = solver.into_workspace();
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     let mut solver =
         Solver::with_workspace(system, 0.0, x0, s, Settings::default(), workspace).expect("valid");
-    let reuse = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    let reuse = allocations() - before;
     let third = run_counting(&mut solver);
     assert_eq!(solver.state(), &final_state[..]);
     assert_eq!(*solver.statistics(), statistics);
@@ -73,7 +41,7 @@ fn allocations_beyond_events<S: HybridSystem>(system: &S, x0: &[f64], s: Sensiti
 fn run_counting<S: HybridSystem>(solver: &mut Solver<S>) -> usize {
     let mut events = 0;
     let mut steps = 0;
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     loop {
         match solver.step(30.0).expect("integration succeeds") {
             StepOutcome::Event(_) => events += 1,
@@ -82,7 +50,7 @@ fn run_counting<S: HybridSystem>(solver: &mut Solver<S>) -> usize {
         }
         steps += 1;
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = allocations();
     assert!(
         events > 3 && steps > 50,
         "a run with events: {events}, {steps}"
@@ -92,7 +60,7 @@ fn run_counting<S: HybridSystem>(solver: &mut Solver<S>) -> usize {
 
 #[test]
 fn steps_do_not_allocate() {
-    COUNTING.with(|c| c.set(true));
+    count_this_thread();
     for s in [
         Sensitivity::None,
         Sensitivity::Transition,
