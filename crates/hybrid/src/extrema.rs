@@ -81,6 +81,19 @@ impl Samples {
         self.points
     }
 
+    /// The time of sample point `i` of the step `[t0, t1]` ([`Samples::sample`]): the ends
+    /// exactly, the interior points equally spaced.
+    pub fn time(&self, t0: f64, t1: f64, i: usize) -> f64 {
+        let last = self.points - 1;
+        if i == 0 {
+            t0
+        } else if i == last {
+            t1
+        } else {
+            t0 + (t1 - t0) * (i as f64 / last as f64)
+        }
+    }
+
     /// Sample `h_k` and `dh_k/dt` (in `mode`) at the step's points between `t0` and `t1`;
     /// with `grid`, the interior states are read from it (interior point `i` at
     /// `grid[(i - 1) n .. i n]`, as [`HybridSystem::exact_flow_grid`] writes them) instead of
@@ -103,13 +116,7 @@ impl Samples {
         let n = x.len();
         let last = p - 1;
         for i in 0..p {
-            self.times[i] = if i == 0 {
-                t0
-            } else if i == last {
-                t1
-            } else {
-                t0 + (t1 - t0) * (i as f64 / last as f64)
-            };
+            self.times[i] = self.time(t0, t1, i);
         }
         self.ends_only = false;
         let first = usize::from(self.start_valid);

@@ -425,6 +425,33 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
     }
 
+    /// The states at the interior sample times ([`Samples::time`]) of the Taylor step `[t0,
+    /// t1]` just taken, into `grid` (`n` per point): by [`Solver::interpolate_clock`], each the
+    /// value `state_in_step` gives (the end's state where a sample time rounds onto an end).
+    fn series_grid(&self, t0: f64, t1: f64, grid: &mut [f64]) {
+        const BLOCK: usize = 8;
+        let n = self.n;
+        let samples = &self.buffers.samples;
+        let last = samples.points() - 1;
+        for (first, states) in (1..last).step_by(BLOCK).zip(grid.chunks_mut(BLOCK * n)) {
+            let points = first..(first + BLOCK).min(last);
+            let mut readings = [0.0; BLOCK];
+            for (reading, i) in readings.iter_mut().zip(points.clone()) {
+                *reading = self.clock.sigma(samples.time(t0, t1, i));
+            }
+            let states = &mut states[..points.len() * n];
+            self.interpolate_clock(&readings[..points.len()], states);
+            for (i, state) in points.zip(states.chunks_exact_mut(n)) {
+                let t = samples.time(t0, t1, i);
+                if t == t1 {
+                    state.copy_from_slice(&self.buffers.z_new[..n]);
+                } else if t == t0 {
+                    state.copy_from_slice(&self.buffers.z_start[..n]);
+                }
+            }
+        }
+    }
+
     /// The states at the readings `sigma` of the last step's clock ([`Solver::last_step_clock`],
     /// inside the step), into `states` (`n` per reading, in order): what
     /// [`Solver::interpolate`] gives at the times `clock.time(sigma)`, without the round trip
@@ -434,17 +461,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let n = self.n;
         match self.kind {
             StepKind::Taylor => {
-                const BLOCK: usize = 8;
-                for (readings, block) in sigma.chunks(BLOCK).zip(states.chunks_mut(BLOCK * n)) {
-                    let mut offsets = [0.0; BLOCK];
-                    for (offset, reading) in offsets.iter_mut().zip(readings) {
-                        *offset = reading - self.sigma_start;
-                    }
-                    self.buffers
-                        .taylor
-                        .state
-                        .evaluate_many(&offsets[..readings.len()], block);
-                }
+                self.buffers
+                    .taylor
+                    .state
+                    .evaluate_many(self.sigma_start, sigma, states);
             }
             StepKind::RungeKutta => {
                 for (reading, x) in sigma.iter().zip(states.chunks_exact_mut(n)) {
@@ -637,32 +657,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     Some(&self.buffers.grid[..])
                 }
                 StepKind::Taylor => {
-                    let last = self.buffers.samples.points() - 1;
-                    let (clock, sigma0) = clock;
-                    let series = &self.buffers.taylor.state;
-                    for (first, states) in (1..last)
-                        .step_by(SAMPLE_BLOCK)
-                        .zip(self.buffers.grid.chunks_mut(SAMPLE_BLOCK * n))
-                    {
-                        let end = (first + SAMPLE_BLOCK).min(last);
-                        let mut offsets = [0.0; SAMPLE_BLOCK];
-                        for (offset, i) in offsets.iter_mut().zip(first..end) {
-                            let t = t0 + (t1 - t0) * (i as f64 / last as f64);
-                            *offset = clock.sigma(t) - sigma0;
-                        }
-                        let states = &mut states[..(end - first) * n];
-                        series.evaluate_many(&offsets[..end - first], states);
-                        // The step's ends as `state_in_step` gives them, should a sample time
-                        // round onto one.
-                        for (i, state) in (first..end).zip(states.chunks_exact_mut(n)) {
-                            let t = t0 + (t1 - t0) * (i as f64 / last as f64);
-                            if t == t1 {
-                                state.copy_from_slice(&z_new[..n]);
-                            } else if t == t0 {
-                                state.copy_from_slice(&z_start[..n]);
-                            }
-                        }
-                    }
+                    let mut grid = std::mem::take(&mut self.buffers.grid);
+                    self.series_grid(t0, t1, &mut grid);
+                    self.buffers.grid = grid;
                     Some(&self.buffers.grid[..])
                 }
                 _ => None,
@@ -2024,10 +2021,6 @@ const TRIAL_SAMPLES: usize = 16;
 
 /// Re-centred square-root landings allowed per step after a landing passed its crossing.
 const MAX_RETARGETS: usize = 3;
-
-/// The sample points of a Taylor step's interior evaluated together
-/// ([`crate::TaylorSeries::evaluate_many`]'s block).
-const SAMPLE_BLOCK: usize = 8;
 
 /// The field of `mode` on `clock`: `dz/dsigma = (dt/dsigma) f(t(sigma), z)`, augmented with
 /// the variational equations when `variational` (else only the state part is written).

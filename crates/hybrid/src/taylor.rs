@@ -122,22 +122,26 @@ impl TaylorSeries {
         }
     }
 
-    /// `y(s_j)` for every offset `s_j` of `s`, into `out` (`dim` per offset, in order), by
-    /// Horner's rule across the offsets at once: each value is the one
-    /// [`TaylorSeries::evaluate`] gives, for less work than one call per offset.
-    pub fn evaluate_many(&self, s: &[f64], out: &mut [f64]) {
+    /// `y(r_j - origin)` for every reading `r_j` of `readings` (a clock whose reading is
+    /// `origin` where the series starts), into `out` (`dim` per reading, in order), by Horner's
+    /// rule across the readings at once: each value is the one [`TaylorSeries::evaluate`] gives
+    /// at `r_j - origin`, for less work than one call per reading.
+    pub fn evaluate_many(&self, origin: f64, readings: &[f64], out: &mut [f64]) {
         const BLOCK: usize = 8;
         let dim = self.dim;
-        for (offsets, values) in s.chunks(BLOCK).zip(out.chunks_mut(BLOCK * dim)) {
+        for (readings, values) in readings.chunks(BLOCK).zip(out.chunks_mut(BLOCK * dim)) {
+            // The offsets, padded with zeros (lanes evaluated and dropped).
+            let mut offsets = [0.0; BLOCK];
+            for (offset, reading) in offsets.iter_mut().zip(readings) {
+                *offset = reading - origin;
+            }
             // The state of one or two modes as constants, at 4 offsets (a 4-point quadrature)
-            // or up to 8 (the lanes past the offsets given evaluate at 0 and are dropped).
-            let mut padded = [0.0; BLOCK];
-            padded[..offsets.len()].copy_from_slice(offsets);
-            match (dim, offsets.len()) {
-                (2, 4) => self.evaluate_block::<2, 4>(&padded, values),
-                (4, 4) => self.evaluate_block::<4, 4>(&padded, values),
-                (2, _) => self.evaluate_block::<2, BLOCK>(&padded, values),
-                (4, _) => self.evaluate_block::<4, BLOCK>(&padded, values),
+            // or up to 8.
+            match (dim, readings.len()) {
+                (2, 4) => self.evaluate_block::<2, 4>(&offsets, values),
+                (4, 4) => self.evaluate_block::<4, 4>(&offsets, values),
+                (2, _) => self.evaluate_block::<2, BLOCK>(&offsets, values),
+                (4, _) => self.evaluate_block::<4, BLOCK>(&offsets, values),
                 _ => {
                     for (&s, value) in offsets.iter().zip(values.chunks_exact_mut(dim)) {
                         self.evaluate(s, value);
@@ -480,10 +484,10 @@ fn transpose(from: &[f64], rows: usize, to: &mut [f64]) {
 mod tests {
     use super::*;
 
-    /// `evaluate_many` gives, bit for bit, what `evaluate` gives at each offset: for the
-    /// dimensions it specialises (2 and 4 components; 4 offsets, and up to 8 in a padded
-    /// block) and for another (3 components), with 4, 5, 7, 8 and 11 offsets (a block of 8 and
-    /// a rest).
+    /// `evaluate_many` gives, bit for bit, what `evaluate` gives at each reading's offset from
+    /// the origin: for the dimensions it specialises (2 and 4 components; 4 readings, and up to
+    /// 8 in a padded block) and for another (3 components), with 4, 5, 7, 8 and 11 readings (a
+    /// block of 8 and a rest).
     #[test]
     fn evaluation_at_many_offsets_equals_one_at_a_time() {
         for dim in [2, 3, 4] {
@@ -492,11 +496,13 @@ mod tests {
                 *c = ((i * 37 % 23) as f64 - 11.0) / (1.0 + i as f64);
             }
             for count in [4, 5, 7, 8, 11] {
-                let offsets: Vec<f64> = (0..count).map(|j| 0.9 * j as f64 / 7.0 - 0.2).collect();
+                let origin = 0.3;
+                let readings: Vec<f64> = (0..count).map(|j| 0.9 * j as f64 / 7.0 + 0.1).collect();
                 let mut together = vec![0.0; count * dim];
-                series.evaluate_many(&offsets, &mut together);
-                for (&s, value) in offsets.iter().zip(together.chunks_exact(dim)) {
+                series.evaluate_many(origin, &readings, &mut together);
+                for (&reading, value) in readings.iter().zip(together.chunks_exact(dim)) {
                     let mut alone = vec![0.0; dim];
+                    let s = reading - origin;
                     series.evaluate(s, &mut alone);
                     assert_eq!(value, &alone[..], "dim {dim}, {count} offsets, s = {s}");
                 }
