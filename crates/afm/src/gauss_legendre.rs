@@ -2,7 +2,7 @@
 //! force integrals) are integrated step by step, where the dense output (or the exact flow) is a
 //! smooth function of time, so a few nodes per step reach rounding accuracy.
 
-use hybrid::Clock;
+use hybrid::{Clock, HybridSystem, Solver};
 
 use crate::phase;
 
@@ -79,6 +79,37 @@ impl GaussLegendre {
             })
     }
 
+    /// The rule's nodes on the part `[a, b]` of `solver`'s last step, on its clock
+    /// ([`GaussLegendre::clock_drive_nodes`]), each with the state there: the states are
+    /// written into `states` (`n` per node, room for [`MAX_RULE_NODES`]) by one
+    /// `Solver::interpolate_clock` (on a Taylor step, one pass over the series).
+    pub fn step_nodes<'s, S: HybridSystem + ?Sized>(
+        &self,
+        solver: &Solver<S>,
+        a: f64,
+        b: f64,
+        angular_frequency: f64,
+        states: &'s mut [f64],
+    ) -> impl Iterator<Item = (ClockNode, &'s [f64])> + 's {
+        let mut nodes = [ClockNode::default(); MAX_RULE_NODES];
+        let mut sigma = [0.0; MAX_RULE_NODES];
+        let mut count = 0;
+        let clock = solver.last_step_clock();
+        for (slot, node) in
+            nodes
+                .iter_mut()
+                .zip(self.clock_drive_nodes(clock, a, b, angular_frequency))
+        {
+            (*slot, sigma[count]) = (node, node.sigma);
+            count += 1;
+        }
+        let n = solver.system().dim();
+        let states = &mut states[..count * n];
+        solver.interpolate_clock(&sigma[..count], states);
+        let states: &'s [f64] = states;
+        nodes.into_iter().take(count).zip(states.chunks_exact(n))
+    }
+
     /// The number of nodes of the rule.
     pub const fn len(&self) -> usize {
         2 * self.nodes.len()
@@ -89,6 +120,10 @@ impl GaussLegendre {
         self.nodes.is_empty()
     }
 }
+
+/// The most nodes of the rules here ([`GAUSS_LEGENDRE_8`]): the room
+/// [`GaussLegendre::step_nodes`] needs.
+pub const MAX_RULE_NODES: usize = GAUSS_LEGENDRE_8.len();
 
 /// A node of [`GaussLegendre::clock_drive_nodes`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -136,6 +171,7 @@ mod tests {
             let nodes: Vec<_> = rule.clock_drive_nodes(Clock::Time, a, b, w).collect();
             assert_eq!(nodes.len(), 2 * rule.pairs(a, b).count());
             assert_eq!(nodes.len(), rule.len());
+            assert!(rule.len() <= MAX_RULE_NODES);
             let total: f64 = nodes.iter().map(|node| node.weight).sum();
             assert!((total - (b - a)).abs() < 1e-15);
             for ClockNode {

@@ -19,7 +19,7 @@
 use hybrid::{Direction, ExtremumKind, HybridSystem, Mode, Solver, StepOutcome};
 
 use crate::free_flight_fourier::FreeFlightFourier;
-use crate::gauss_legendre::{ClockNode, GAUSS_LEGENDRE_4};
+use crate::gauss_legendre::GAUSS_LEGENDRE_4;
 use crate::model::GAP_SURFACE;
 use crate::TappingModel;
 
@@ -38,9 +38,6 @@ pub struct CycleReading {
     /// cycle boundary.
     pub peak_force_nn: f64,
 }
-
-/// The nodes of the contact steps' quadrature ([`GAUSS_LEGENDRE_4`]).
-const QUADRATURE_NODES: usize = GAUSS_LEGENDRE_4.len();
 
 /// Accumulates a [`CycleReading`] from the steps of a solver that integrates one drive cycle
 /// of a [`TappingModel`] with local time `t` in `[0, T]`: call [`CycleLockIn::begin`], then
@@ -78,7 +75,7 @@ impl CycleLockIn {
             sine: 0.0,
             impacts: 0,
             peak_force: 0.0,
-            node_states: vec![0.0; QUADRATURE_NODES * model.dim()],
+            node_states: vec![0.0; GAUSS_LEGENDRE_4.len() * model.dim()],
             free_flight: FreeFlightFourier::new(model),
             mode: 0,
             previous_state: vec![0.0; model.dim()],
@@ -160,22 +157,9 @@ impl CycleLockIn {
     /// points instead of 4 moved the readings of `drumroll approach --case biolever-mica --from
     /// 8.8 --to 8.65 --rate 1` by at most 8e-12 in `A/A0` and 6e-11 deg in phase.
     fn quadrature(&mut self, solver: &Solver<TappingModel>, model: &TappingModel, a: f64, b: f64) {
-        // The nodes' states from one call (on a Taylor step, one pass over the series).
-        let mut nodes = [ClockNode::default(); QUADRATURE_NODES];
-        let mut sigma = [0.0; QUADRATURE_NODES];
-        let mut count = 0;
-        for node in GAUSS_LEGENDRE_4.clock_drive_nodes(
-            solver.last_step_clock(),
-            a,
-            b,
-            self.angular_frequency,
-        ) {
-            (nodes[count], sigma[count]) = (node, node.sigma);
-            count += 1;
-        }
-        let n = model.dim();
-        solver.interpolate_clock(&sigma[..count], &mut self.node_states[..count * n]);
-        for (node, state) in nodes[..count].iter().zip(self.node_states.chunks_exact(n)) {
+        for (node, state) in
+            GAUSS_LEGENDRE_4.step_nodes(solver, a, b, self.angular_frequency, &mut self.node_states)
+        {
             let u = model.photodiode(state);
             let (sin, cos) = node.drive;
             self.cosine += node.weight * u * cos;

@@ -86,9 +86,6 @@ pub struct OrbitObservables {
     pub impulse_nn_us: f64,
 }
 
-/// The nodes of the contact steps' quadrature ([`GAUSS_LEGENDRE_8`]).
-const QUADRATURE_NODES: usize = GAUSS_LEGENDRE_8.len();
-
 /// An observer of the solver's steps that accumulates the observables of the window
 /// `[t0, t0 + T]`: pass [`PeriodObserver::observe`] to `hybrid::flow_map_observed` (or call it
 /// after every `Solver::step` of a sweep), then call [`PeriodObserver::finish`].
@@ -143,7 +140,7 @@ impl PeriodObserver {
             events: Vec::new(),
             minima: Vec::new(),
             state: vec![0.0; model.dim()],
-            node_states: vec![0.0; QUADRATURE_NODES * model.dim()],
+            node_states: vec![0.0; GAUSS_LEGENDRE_8.len() * model.dim()],
             free_flight: FreeFlightFourier::new(model),
             mode: model.mode_of(t0, x0),
             free_start: None,
@@ -172,24 +169,11 @@ impl PeriodObserver {
                 }
             } else {
                 self.close_free_flight(a);
-                // The nodes' states from one call (on a Taylor step, one pass over the series).
-                let mut nodes = [ClockNode::default(); QUADRATURE_NODES];
-                let mut sigma = [0.0; QUADRATURE_NODES];
-                let mut count = 0;
-                for node in GAUSS_LEGENDRE_8.clock_drive_nodes(
-                    solver.last_step_clock(),
-                    a,
-                    b,
-                    self.angular_frequency,
-                ) {
-                    (nodes[count], sigma[count]) = (node, node.sigma);
-                    count += 1;
-                }
-                let n = self.state.len();
                 let mut states = std::mem::take(&mut self.node_states);
-                solver.interpolate_clock(&sigma[..count], &mut states[..count * n]);
-                for (node, state) in nodes[..count].iter().zip(states.chunks_exact(n)) {
-                    self.accumulate(model, node, state);
+                for (node, state) in
+                    GAUSS_LEGENDRE_8.step_nodes(solver, a, b, self.angular_frequency, &mut states)
+                {
+                    self.accumulate(model, &node, state);
                 }
                 self.node_states = states;
             }

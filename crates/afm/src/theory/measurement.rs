@@ -142,7 +142,8 @@ struct Accumulator {
     /// `int F dt`, `int F cos(w t) dt`, `int F sin(w t) dt`.
     force: [f64; 3],
     fragments: Vec<Fragment>,
-    state: Vec<f64>,
+    /// The states at a step's quadrature nodes (`n` per node).
+    node_states: Vec<f64>,
 }
 
 impl Accumulator {
@@ -151,22 +152,23 @@ impl Accumulator {
         let (a, b) = solver.last_step();
         let b = b.min(self.period);
         if b > a {
-            for ClockNode {
-                t,
-                weight: w,
-                drive: (sin, cos),
-                ..
-            } in GAUSS_LEGENDRE_8.clock_drive_nodes(
-                solver.last_step_clock(),
+            for (node, state) in GAUSS_LEGENDRE_8.step_nodes(
+                solver,
                 a,
                 b,
                 self.angular_frequency,
+                &mut self.node_states,
             ) {
-                solver.interpolate(t, &mut self.state);
-                let q1 = self.state[0];
+                let ClockNode {
+                    t,
+                    weight: w,
+                    drive: (sin, cos),
+                    ..
+                } = node;
+                let q1 = state[0];
                 self.q1_fourier[0] += w * q1 * cos;
                 self.q1_fourier[1] += w * q1 * sin;
-                let force = model.hertz().force(model.gap(t, &self.state));
+                let force = model.hertz().force(model.gap(t, state));
                 self.force[0] += w * force;
                 self.force[1] += w * force * cos;
                 self.force[2] += w * force * sin;
@@ -246,7 +248,7 @@ pub fn measure_impacts(
         } else {
             Vec::new()
         },
-        state: vec![0.0; model.dim()],
+        node_states: vec![0.0; GAUSS_LEGENDRE_8.len() * model.dim()],
     };
     flow_map_observed(
         &model,
