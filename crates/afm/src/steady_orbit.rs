@@ -11,7 +11,7 @@ use continuation::{
     floquet_multipliers, is_stable, newton_update, shoot, ContinuationError, HybridPeriodicProblem,
     NewtonSettings, Parametrised,
 };
-use hybrid::{flow_map_in, Sensitivity, SensitivityMethod, Settings, SolverWorkspace};
+use hybrid::{flow_map_in, FlowMap, Sensitivity, SensitivityMethod, Settings, SolverWorkspace};
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
@@ -240,7 +240,6 @@ pub fn steady_orbit_in(
     }
     let mut model = model.clone();
     model.set_separation(Separation::Constant(z_nm))?;
-    let period = model.period_us();
 
     let initial = match start {
         Some(x) => x.to_vec(),
@@ -289,19 +288,8 @@ pub fn steady_orbit_in(
     // The best non-converged attempt: (multiplicity, state, iterations, residual, multipliers).
     #[allow(clippy::type_complexity)]
     let mut best: Option<(usize, Vec<f64>, usize, f64, Vec<Complex<f64>>)> = None;
-    let recurrence_settings = crossings_only(&settings.integration);
     for _ in 0..settings.recurrence_periods {
-        x = flow_map_in(
-            &model,
-            0.0,
-            &x,
-            period,
-            Sensitivity::None,
-            &recurrence_settings,
-            &mut |_: &_, _: &_| {},
-            workspace.for_maps(Sensitivity::None),
-        )?
-        .state;
+        x = iterate(&model, &x, 1, &settings.integration, workspace)?;
         states.push(x.clone());
         let last = states.len() - 1;
         for k in 1..=settings.max_multiplicity.min(last) {
@@ -391,24 +379,16 @@ fn observed_map(
     } else {
         Sensitivity::None
     };
-    let buffers = workspace.for_maps(sensitivity);
     let (flow, observables) = if observe {
+        let buffers = workspace.for_maps(sensitivity);
         let (flow, observables) =
             observe_period_in(model, 0.0, x, sensitivity, integration, 1, buffers)?;
         (flow, Some(observables))
     } else {
-        let settings = crossings_only(integration);
-        let flow = flow_map_in(
-            model,
-            0.0,
-            x,
-            model.period_us(),
-            sensitivity,
-            &settings,
-            &mut |_: &_, _: &_| {},
-            buffers,
-        )?;
-        (flow, None)
+        (
+            period_map(model, x, sensitivity, integration, workspace)?,
+            None,
+        )
     };
     if flow.state.iter().any(|v| !v.is_finite()) || flow.transition.iter().any(|v| !v.is_finite()) {
         return Err(ContinuationError::NonFinite {
@@ -612,6 +592,27 @@ fn crossings_only(settings: &Settings) -> Settings {
     }
 }
 
+/// One period map from `x` with `sensitivity`, crossings only ([`crossings_only`]), on the
+/// workspace's buffers for it.
+fn period_map(
+    model: &TappingModel,
+    x: &[f64],
+    sensitivity: Sensitivity,
+    settings: &Settings,
+    workspace: &mut SteadyOrbitWorkspace,
+) -> Result<FlowMap, AfmError> {
+    Ok(flow_map_in(
+        model,
+        0.0,
+        x,
+        model.period_us(),
+        sensitivity,
+        &crossings_only(settings),
+        &mut |_: &_, _: &_| {},
+        workspace.for_maps(sensitivity),
+    )?)
+}
+
 /// Iterate the stroboscopic map `periods` times from `x0` (state only, no extrema).
 fn iterate(
     model: &TappingModel,
@@ -620,20 +621,9 @@ fn iterate(
     settings: &Settings,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<Vec<f64>, AfmError> {
-    let settings = &crossings_only(settings);
     let mut x = x0.to_vec();
     for _ in 0..periods {
-        x = flow_map_in(
-            model,
-            0.0,
-            &x,
-            model.period_us(),
-            Sensitivity::None,
-            settings,
-            &mut |_: &_, _: &_| {},
-            workspace.for_maps(Sensitivity::None),
-        )?
-        .state;
+        x = period_map(model, &x, Sensitivity::None, settings, workspace)?.state;
     }
     Ok(x)
 }
