@@ -396,11 +396,14 @@ impl TaylorStep {
 }
 
 /// The first zero in `(0, upto]` of the polynomial with power-basis coefficients `power`, if
-/// its sign changes there: bracketed on 16 samples, then bisection safeguarding Newton's method
+/// its sign changes there: bracketed on 8 samples, then bisection safeguarding Newton's method
 /// to the last bits. Two zeros between neighbouring samples go unseen: the solver uses this
-/// only to choose a step's clock, and finds crossings inside a step by its own tests.
+/// only to choose a step's clock, and finds crossings inside a step by its own tests. (The
+/// solver looks up to two steps' reach ahead, so the samples are a quarter of a step apart,
+/// where the series' radius is about four steps; 16 samples cost 1.6% more of an orbit at
+/// A/A0 = 0.5 and gave the same outputs.)
 pub(crate) fn first_zero<const D: usize>(power: &[f64; D], upto: f64) -> Option<f64> {
-    const SAMPLES: usize = 16;
+    const SAMPLES: usize = 8;
     let value = |s: f64| power.iter().rev().fold(0.0, |acc, &c| acc * s + c);
     let slope = |s: f64| {
         power
@@ -410,7 +413,7 @@ pub(crate) fn first_zero<const D: usize>(power: &[f64; D], upto: f64) -> Option<
             .rev()
             .fold(0.0, |acc, (k, &c)| acc * s + k as f64 * c)
     };
-    let start = value(0.0);
+    let start = power[0];
     // No zero where the constant term outweighs the rest on the whole interval.
     let mut scale = 1.0;
     let spread: f64 = power[1..]
