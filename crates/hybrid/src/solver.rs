@@ -100,7 +100,10 @@
 //! along it ([`HybridSystem::taylor_tangents`]). The clock is the one in which the solution is
 //! analytic up to its nearest non-smooth point: the square-root clock from the crossing that
 //! entered the mode, until the crossing out of it that the last series predicts (its first
-//! zero of the half-power surface within two reaches) is nearer; then the square-root clock
+//! zero of the half-power surface within two reaches) is nearer (the series of a step is
+//! re-centred on a crossing inside its own reach on that condition too, so that no series is
+//! expanded next to the entering crossing's half power: a grazing contact, shorter than that
+//! reach, is one step on the clock of its onset); then the square-root clock
 //! centred `ROOT_OVERSHOOT` past that predicted crossing, re-centred on the zero of its own
 //! series when they differ, so that the step landing on its reference holds the crossing, which
 //! is then located on the series like any other. The series is the step's dense output, and
@@ -1092,12 +1095,19 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             });
             // Centre a clock on the crossing (ROOT_OVERSHOOT past it) when it lies inside the
             // reach of a series not centred ahead, or when a landing series finds it well short
-            // of its reference.
+            // of its reference. Not while the onset that entered the mode is nearer than the
+            // crossing: a series on a clock centred ahead, expanded there, would start next to
+            // the onset's half power, outside its own radius (on the first step of a grazing
+            // contact, at it); the step then stays on the onset's clock, which its reach keeps
+            // short of the crossing, and the next step chooses again.
             let retarget = crossing.filter(|&t_cross| match clock {
                 Clock::SquareRoot { reference } if ahead => {
                     landing && reference - t_cross > 10.0 * ROOT_OVERSHOOT * (reference - t0)
                 }
-                _ => t_cross <= clock.time(sigma0 + reach),
+                _ => {
+                    t_cross <= clock.time(sigma0 + reach)
+                        && onset.is_none_or(|t_event| t_cross - t0 <= t0 - t_event)
+                }
             });
             if let Some(t_cross) = retarget.filter(|_| recentred < MAX_RETARGETS) {
                 recentred += 1;
