@@ -217,7 +217,7 @@ pub fn steady_orbit(
 
 /// As [`steady_orbit`], the period maps' solver buffers taken from `workspace` and handed back
 /// to it: the same orbit, without a new solver's allocations per map (about 2% of an orbit
-/// from its neighbour at A/A0 = 0.5: 1.559M against 1.594M instructions). For a sequence of
+/// from its neighbour at A/A0 = 0.5: 1.543M against 1.579M instructions). For a sequence of
 /// orbits, as along a branch.
 pub fn steady_orbit_in(
     model: &TappingModel,
@@ -557,8 +557,8 @@ const LOOSE_RESIDUAL_FLOOR: f64 = 1e3 * FIRST_ITERATE_TOLERANCE;
 /// `settings` for the period maps of [`shoot_observed`]: the monodromy integrated apart from
 /// the state's steps ([`SensitivityMethod::Decoupled`]: tangent series of order 12 on the
 /// Taylor steps in contact, a sixth-order method on any Runge-Kutta step; the period map with
-/// the monodromy at A/A0 = 0.5 costs 0.60M instructions, against 0.69M with the tangents at
-/// the state's order and 0.38M without the monodromy), unless `settings` ask for
+/// the monodromy at A/A0 = 0.5 costs 0.58M instructions, against 0.67M with the tangents at
+/// the state's order and 0.36M without the monodromy), unless `settings` ask for
 /// error-controlled sensitivities (`sensitivity_tolerance`), which only the coupled method has.
 fn newton_maps(settings: &Settings) -> Settings {
     Settings {

@@ -99,7 +99,7 @@ pub enum SensitivityMethod {
     /// and 0.5, default tolerances; contacts by series) the monodromy is within 1.3e-6 and
     /// 2.3e-6 relative of a tight DOP853 reference, against 6.1e-9 and 4.2e-8 coupled (`cargo
     /// run --release -p afm --example monodromy_error`), for 14% fewer instructions in the
-    /// period map with the monodromy at A/A0 = 0.5 (callgrind: 0.60M against 0.69M; 0.38M
+    /// period map with the monodromy at A/A0 = 0.5 (callgrind: 0.58M against 0.67M; 0.36M
     /// without it). Enough for Newton iterations, which need the Jacobian only well
     /// enough to contract (each iteration then also reduces the error by about that relative
     /// amount instead of only squaring it), and for stability; not where the derivative of the
