@@ -1032,15 +1032,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             (Some(k), Some((entered, t_event))) if k == entered => Some(t_event),
             _ => None,
         };
-        let ahead = self
-            .predicted_crossing
-            .filter(|&t_cross| t_cross > t0 && self.steps_in_mode > 0);
+        // A clock centred on a crossing ahead serves only while that crossing is nearer than the
+        // onset that entered the mode: a series expanded nearer the onset would start next to
+        // its half power, outside the series' own radius.
+        let nearer_than_onset =
+            |t_cross: f64| onset.is_none_or(|t_event| t_cross - t0 <= t0 - t_event);
+        let ahead = self.predicted_crossing.filter(|&t_cross| {
+            t_cross > t0 && self.steps_in_mode > 0 && nearer_than_onset(t_cross)
+        });
         let mut clock = match (ahead, onset) {
-            (Some(t_cross), Some(t_event)) if t_cross - t0 <= t0 - t_event => {
-                Clock::SquareRoot { reference: t_cross }
-            }
-            (Some(t_cross), None) => Clock::SquareRoot { reference: t_cross },
-            (_, Some(t_event)) => Clock::SquareRoot { reference: t_event },
+            (Some(t_cross), _) => Clock::SquareRoot { reference: t_cross },
+            (None, Some(t_event)) => Clock::SquareRoot { reference: t_event },
             (None, None) => Clock::Time,
         };
         let mut recentred = 0;
@@ -1095,19 +1097,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             });
             // Centre a clock on the crossing (ROOT_OVERSHOOT past it) when it lies inside the
             // reach of a series not centred ahead, or when a landing series finds it well short
-            // of its reference. Not while the onset that entered the mode is nearer than the
-            // crossing: a series on a clock centred ahead, expanded there, would start next to
-            // the onset's half power, outside its own radius (on the first step of a grazing
-            // contact, at it); the step then stays on the onset's clock, which its reach keeps
-            // short of the crossing, and the next step chooses again.
+            // of its reference. Not while the onset is nearer (`nearer_than_onset`; on the first
+            // step of a grazing contact the series would be expanded at the onset itself): the
+            // step then stays on the onset's clock, which its reach keeps short of the crossing,
+            // and the next step chooses again.
             let retarget = crossing.filter(|&t_cross| match clock {
                 Clock::SquareRoot { reference } if ahead => {
                     landing && reference - t_cross > 10.0 * ROOT_OVERSHOOT * (reference - t0)
                 }
-                _ => {
-                    t_cross <= clock.time(sigma0 + reach)
-                        && onset.is_none_or(|t_event| t_cross - t0 <= t0 - t_event)
-                }
+                _ => t_cross <= clock.time(sigma0 + reach) && nearer_than_onset(t_cross),
             });
             if let Some(t_cross) = retarget.filter(|_| recentred < MAX_RETARGETS) {
                 recentred += 1;
