@@ -1,22 +1,31 @@
 //! Benchmark of the steady orbit at the paper's Fig. 1 points (Biolever on mica, A0 = 10 nm,
-//! A/A0 = 0.95, 0.90, 0.50): the time to converge it from the orbit at a neighbouring point of
-//! the approach branch (Z + 0.01 nm), as a branch would (`steady_orbit_in`, one workspace for
-//! the repetitions; also without it, `steady_orbit`, whose period maps each build a new
-//! solver), and from a cold start (the free orbit plus transients),
-//! and the work of one period map with the monodromy: right-hand-side evaluations (DOP853
-//! stages), steps (exact-flow, DOP853 and Taylor-series steps) and, of those, series steps.
+//! A/A0 = 0.95, 0.90, 0.50): the time to converge it along the approach branch,
+//!
+//! - from the state of the orbit at the neighbouring point (Z + 0.01 nm, `OrbitStart::Near`:
+//!   a loose first Newton map, then two at full tolerance),
+//! - from the cubic Hermite prediction of the two previous orbits (Z + 0.01 and Z + 0.02 nm,
+//!   with their slopes dx/dZ; `OrbitStart::Predicted`, one Newton update: two maps),
+//!
+//! both as a branch would (`steady_orbit_in`, one workspace for the repetitions); also from
+//! the neighbour without the workspace (`steady_orbit`, whose period maps each build a new
+//! solver), and from a cold start (the free orbit plus transients); the Newton iterations
+//! (neighbour/predicted) and the work of one period map with the monodromy: right-hand-side
+//! evaluations (DOP853 stages), steps (exact-flow, DOP853 and Taylor-series steps) and, of
+//! those, series steps.
 //!
 //! Run with `cargo bench -p afm --bench steady_orbit`. Timings are medians over repetitions in
 //! one process, so the ratios between rows are meaningful on a noisy machine; the neighbour
-//! start is also timed on the thread's CPU clock (Linux `/proc/thread-self/schedstat`, best of
-//! 5 batches), which does not count the time other processes hold the core.
+//! and predicted starts are also timed on the thread's CPU clock (Linux
+//! `/proc/thread-self/schedstat`, best of 5 batches), which does not count the time other
+//! processes hold the core.
 //!
 //! The same orbits by a plain scipy transient integration, for the speed ratio: the example
 //! `transient_reference` and `benches/scipy_transient.py` (see that script).
 
 use afm::{
-    builtin_case, find_amplitude_ratio, steady_orbit, steady_orbit_in, AmplitudeRatioSearch,
-    Separation, SteadyOrbitSettings, SteadyOrbitWorkspace, TappingModel,
+    builtin_case, find_amplitude_ratio, hermite_state, steady_orbit, steady_orbit_in,
+    AmplitudeRatioSearch, OrbitStart, Separation, SteadyOrbitSettings, SteadyOrbitWorkspace,
+    TappingModel,
 };
 use hybrid::{flow_map, Sensitivity};
 use std::time::Instant;
@@ -66,15 +75,17 @@ fn main() {
     let settings = SteadyOrbitSettings::default();
     println!("steady orbit, Biolever on mica, A0 = 10 nm (median of repetitions)");
     println!(
-        "{:>6} {:>12} {:>8} {:>12} {:>12} {:>14} {:>10} {:>14} {:>14} {:>12} {:>12}",
+        "{:>6} {:>10} {:>8} {:>12} {:>9} {:>12} {:>9} {:>13} {:>9} {:>7} {:>12} {:>8} {:>9}",
         "A/A0",
         "Z (nm)",
         "impacts",
         "neighbour us",
         "(CPU us)",
+        "predicted us",
+        "(CPU us)",
         "no workspace",
         "cold us",
-        "Newton iters",
+        "iters",
         "RHS evals/T",
         "steps/T",
         "series/T"
@@ -83,26 +94,38 @@ fn main() {
         let search = AmplitudeRatioSearch::new(ratio).expect("ratio");
         let target = find_amplitude_ratio(&model, &search, &settings).expect("reached");
         let z = target.z_nm;
-        // The neighbouring point on the approach branch, 0.01 nm above.
-        let neighbour =
-            steady_orbit(&model, z + 0.01, Some(&target.state), &settings).expect("neighbour");
-        let warm = steady_orbit(&model, z, Some(&neighbour.state), &settings).expect("warm");
-        assert!(warm.converged, "warm start converges");
+        // The two previous points on the approach branch, 0.02 and 0.01 nm above, each
+        // converged from the one before it.
+        let second = steady_orbit(&model, z + 0.02, OrbitStart::Near(&target.state), &settings)
+            .expect("second neighbour");
+        let neighbour = steady_orbit(&model, z + 0.01, OrbitStart::Near(&second.state), &settings)
+            .expect("neighbour");
+        let prediction = hermite_state(z, &second, &neighbour).expect("both have tangents");
+        let warm =
+            steady_orbit(&model, z, OrbitStart::Near(&neighbour.state), &settings).expect("warm");
+        let predicted = steady_orbit(&model, z, OrbitStart::Predicted(&prediction), &settings)
+            .expect("predicted");
+        assert!(
+            warm.converged && predicted.converged,
+            "both starts converge"
+        );
         let mut workspace = SteadyOrbitWorkspace::default();
-        let mut from_neighbour = || {
+        let mut from = |start: OrbitStart<'_>| {
             let orbit =
-                steady_orbit_in(&model, z, Some(&neighbour.state), &settings, &mut workspace)
-                    .expect("warm");
+                steady_orbit_in(&model, z, start, &settings, &mut workspace).expect("orbit");
             std::hint::black_box(orbit);
         };
-        let neighbour_us = median_us(201, &mut from_neighbour);
-        let neighbour_cpu_us = cpu_us(400, &mut from_neighbour);
+        let neighbour_us = median_us(201, || from(OrbitStart::Near(&neighbour.state)));
+        let neighbour_cpu_us = cpu_us(400, || from(OrbitStart::Near(&neighbour.state)));
+        let predicted_us = median_us(201, || from(OrbitStart::Predicted(&prediction)));
+        let predicted_cpu_us = cpu_us(400, || from(OrbitStart::Predicted(&prediction)));
         let fresh_us = median_us(201, || {
-            let orbit = steady_orbit(&model, z, Some(&neighbour.state), &settings).expect("warm");
+            let orbit = steady_orbit(&model, z, OrbitStart::Near(&neighbour.state), &settings)
+                .expect("warm");
             std::hint::black_box(orbit);
         });
         let cold_us = median_us(51, || {
-            let orbit = steady_orbit(&model, z, None, &settings).expect("cold");
+            let orbit = steady_orbit(&model, z, OrbitStart::Cold, &settings).expect("cold");
             std::hint::black_box(orbit);
         });
         let mut at_z = model.clone();
@@ -118,15 +141,17 @@ fn main() {
         )
         .expect("period map");
         println!(
-            "{:>6.2} {:>12.6} {:>8} {:>12.1} {:>12.1} {:>14.1} {:>10.1} {:>14} {:>14} {:>12} {:>12}",
+            "{:>6.2} {:>10.6} {:>8} {:>12.1} {:>9.1} {:>12.1} {:>9.1} {:>13.1} {:>9.1} {:>7} {:>12} {:>8} {:>9}",
             ratio,
             z,
             target.observables().impacts.len(),
             neighbour_us,
             neighbour_cpu_us,
+            predicted_us,
+            predicted_cpu_us,
             fresh_us,
             cold_us,
-            warm.iterations,
+            format!("{}/{}", warm.iterations, predicted.iterations),
             period.statistics.rhs_evaluations,
             // `steps` counts the exact-flow steps too.
             period.statistics.steps,

@@ -13,8 +13,8 @@
 //! ratio.
 
 use afm::{
-    builtin_case, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, SteadyOrbitSettings,
-    TappingModel,
+    builtin_case, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, OrbitStart,
+    SteadyOrbitSettings, TappingModel,
 };
 use serde_json::json;
 
@@ -28,8 +28,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let settings = SteadyOrbitSettings::default();
     let target = find_amplitude_ratio(&model, &AmplitudeRatioSearch::new(ratio)?, &settings)?;
     let z = target.z_nm;
-    let neighbour = steady_orbit(&model, z + 0.01, Some(&target.state), &settings)?;
-    let orbit = steady_orbit(&model, z, Some(&neighbour.state), &settings)?;
+    let neighbour = steady_orbit(&model, z + 0.01, OrbitStart::Near(&target.state), &settings)?;
+    let orbit = steady_orbit(&model, z, OrbitStart::Near(&neighbour.state), &settings)?;
     let modes: Vec<_> = model
         .cantilever()
         .modes

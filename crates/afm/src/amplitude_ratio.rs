@@ -7,8 +7,9 @@
 use crate::bifurcation_diagram::{approach_diagram, DiagramSettings};
 use crate::error::AfmError;
 use crate::model::TappingModel;
+use crate::orbit_prediction::hermite_state;
 use crate::steady_orbit::{
-    steady_orbit_in, SteadyOrbit, SteadyOrbitSettings, SteadyOrbitWorkspace,
+    steady_orbit_in, OrbitStart, SteadyOrbit, SteadyOrbitSettings, SteadyOrbitWorkspace,
 };
 use crate::validation::invalid;
 
@@ -97,13 +98,26 @@ pub fn find_amplitude_ratio(
     };
     // One workspace for the refinement's sequence of orbits.
     let workspace = &mut SteadyOrbitWorkspace::default();
-    let above = steady_orbit_in(model, above.z_nm, Some(&above.state), settings, workspace)?;
-    let below = steady_orbit_in(model, below.z_nm, Some(&below.state), settings, workspace)?;
+    let above = steady_orbit_in(
+        model,
+        above.z_nm,
+        OrbitStart::Near(&above.state),
+        settings,
+        workspace,
+    )?;
+    let below = steady_orbit_in(
+        model,
+        below.z_nm,
+        OrbitStart::Near(&below.state),
+        settings,
+        workspace,
+    )?;
     refine(model, search, settings, above, below, workspace)
 }
 
 /// Refine the bracket `above` (A/A0 > R) / `below` (A/A0 <= R) by the Illinois method on Z,
-/// each orbit started from the bracket end nearer in Z.
+/// each orbit started from the cubic Hermite interpolation of the bracket's two orbits
+/// ([`hermite_state`]), or from the end nearer in Z if one of them has no tangent.
 fn refine(
     model: &TappingModel,
     search: &AmplitudeRatioSearch,
@@ -124,12 +138,13 @@ fn refine(
         if !(z < above.z_nm && z > below.z_nm) {
             z = 0.5 * (above.z_nm + below.z_nm);
         }
-        let start = if above.z_nm - z < z - below.z_nm {
-            &above.state
-        } else {
-            &below.state
+        let prediction = hermite_state(z, &below, &above);
+        let start = match &prediction {
+            Some(state) => OrbitStart::Predicted(state),
+            None if above.z_nm - z < z - below.z_nm => OrbitStart::Near(&above.state),
+            None => OrbitStart::Near(&below.state),
         };
-        let trial = steady_orbit_in(model, z, Some(start), settings, workspace)?;
+        let trial = steady_orbit_in(model, z, start, settings, workspace)?;
         let ft = f(&trial);
         if ft > 0.0 {
             above = trial;

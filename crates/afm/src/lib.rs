@@ -35,6 +35,7 @@ pub mod impact_numbers;
 pub mod lockin;
 pub mod model;
 pub mod observables;
+pub mod orbit_prediction;
 pub mod phase;
 pub mod sample;
 pub mod separation;
@@ -68,10 +69,12 @@ pub use observables::{
     observe_period, observe_period_in, orbit_observables, GapMinimum, Harmonic, Impact,
     OrbitObservables, PeriodObserver,
 };
+pub use orbit_prediction::{hermite_state, tangent_state};
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{
-    steady_orbit, steady_orbit_in, SteadyOrbit, SteadyOrbitSettings, SteadyOrbitWorkspace,
+    steady_orbit, steady_orbit_in, OrbitStart, SteadyOrbit, SteadyOrbitSettings,
+    SteadyOrbitWorkspace,
 };
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
 pub use theory::{

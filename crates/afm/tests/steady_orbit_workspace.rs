@@ -3,8 +3,8 @@
 //! impact per period) down to 8.6 nm, past G2 at 8.72 nm (two impacts), each orbit from the last.
 
 use afm::{
-    builtin_case, steady_orbit, steady_orbit_in, SteadyOrbitSettings, SteadyOrbitWorkspace,
-    TappingModel,
+    builtin_case, steady_orbit, steady_orbit_in, OrbitStart, SteadyOrbitSettings,
+    SteadyOrbitWorkspace, TappingModel,
 };
 
 #[test]
@@ -17,11 +17,17 @@ fn a_reused_workspace_gives_the_same_orbits() {
     let mut impacts = Vec::new();
     for step in 0..5 {
         let z = 8.9 - 0.075 * f64::from(step);
-        let fresh = steady_orbit(&model, z, fresh_start.as_deref(), &settings).expect("fresh");
+        let fresh = steady_orbit(
+            &model,
+            z,
+            OrbitStart::near_or_cold(fresh_start.as_deref()),
+            &settings,
+        )
+        .expect("fresh");
         let reused = steady_orbit_in(
             &model,
             z,
-            reused_start.as_deref(),
+            OrbitStart::near_or_cold(reused_start.as_deref()),
             &settings,
             &mut workspace,
         )

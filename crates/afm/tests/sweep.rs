@@ -3,7 +3,7 @@
 //! agreement with a brute-force integration, and validation messages.
 
 use afm::TappingModel;
-use afm::{builtin_case, AfmError, Sweep, SweepDirection, SweepRecord, SweepSettings};
+use afm::{builtin_case, AfmError, OrbitStart, Sweep, SweepDirection, SweepRecord, SweepSettings};
 
 fn biolever_on_mica() -> TappingModel {
     let case = builtin_case("biolever-mica").expect("case");
@@ -278,7 +278,13 @@ fn cycle_lockin_matches_the_period_observables() {
     use afm::{observe_period, steady_orbit, Separation, SteadyOrbitSettings};
     use hybrid::{Sensitivity, Solver, StepOutcome};
     let mut model = biolever_on_mica();
-    let orbit = steady_orbit(&model, 8.0, None, &SteadyOrbitSettings::default()).expect("orbit");
+    let orbit = steady_orbit(
+        &model,
+        8.0,
+        OrbitStart::Cold,
+        &SteadyOrbitSettings::default(),
+    )
+    .expect("orbit");
     model
         .set_separation(Separation::Constant(8.0))
         .expect("finite");

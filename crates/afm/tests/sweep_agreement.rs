@@ -6,7 +6,9 @@
 //! gap minima.
 
 use afm::TappingModel;
-use afm::{builtin_case, steady_orbit, SteadyOrbit, SteadyOrbitSettings, Sweep, SweepSettings};
+use afm::{
+    builtin_case, steady_orbit, OrbitStart, SteadyOrbit, SteadyOrbitSettings, Sweep, SweepSettings,
+};
 
 /// The second-lowest gap minimum of the steady orbit over its period, nm: positive with one
 /// impact per period (the lowest near impact), negative with two; zero at G2.
@@ -25,13 +27,14 @@ fn second_minimum(orbit: &SteadyOrbit) -> f64 {
 /// the orbit at the bracket end on the same side; returns (Z_G2, the orbit there).
 fn locate_g2(model: &TappingModel, settings: &SteadyOrbitSettings) -> (f64, SteadyOrbit) {
     // Scan down from 9.5 nm in 0.1 nm steps for the first orbit with two impacts.
-    let mut above = steady_orbit(model, 9.5, None, settings).expect("orbit at 9.5 nm");
+    let mut above = steady_orbit(model, 9.5, OrbitStart::Cold, settings).expect("orbit at 9.5 nm");
     assert_eq!(above.observables().impacts.len(), 1);
     let mut below = None;
     let mut z = 9.5;
     while z > 6.0 {
         z -= 0.1;
-        let orbit = steady_orbit(model, z, Some(&above.state), settings).expect("orbit");
+        let orbit =
+            steady_orbit(model, z, OrbitStart::Near(&above.state), settings).expect("orbit");
         assert!(
             orbit.converged && orbit.multiplicity == 1,
             "period-1 orbit at {z}"
@@ -46,7 +49,8 @@ fn locate_g2(model: &TappingModel, settings: &SteadyOrbitSettings) -> (f64, Stea
     // Bisection to 1e-7 nm.
     while above.z_nm - below.z_nm > 1e-7 {
         let middle = 0.5 * (above.z_nm + below.z_nm);
-        let orbit = steady_orbit(model, middle, Some(&above.state), settings).expect("orbit");
+        let orbit =
+            steady_orbit(model, middle, OrbitStart::Near(&above.state), settings).expect("orbit");
         if second_minimum(&orbit) > 0.0 {
             above = orbit;
         } else {
@@ -101,7 +105,7 @@ fn sweep_follows_the_steady_orbit_around_g2() {
         let orbit = steady_orbit(
             &model,
             record.z_nm,
-            previous.as_ref().map(|o| o.state.as_slice()),
+            OrbitStart::near_or_cold(previous.as_ref().map(|o| o.state.as_slice())),
             &orbit_settings,
         )
         .expect("orbit");

@@ -23,8 +23,8 @@ use std::f64::consts::PI;
 
 use afm::{
     builtin_case, compare_theory, find_amplitude_ratio, measure_impacts, sample_trajectory,
-    steady_orbit, AmplitudeRatioSearch, ImpactTheory, Separation, SteadyOrbit, SteadyOrbitSettings,
-    TappingModel, TheoryComparison,
+    steady_orbit, AmplitudeRatioSearch, ImpactTheory, OrbitStart, Separation, SteadyOrbit,
+    SteadyOrbitSettings, TappingModel, TheoryComparison,
 };
 
 fn model(case: &str) -> TappingModel {
@@ -44,7 +44,7 @@ fn single_impact_orbits() -> (TappingModel, Vec<SteadyOrbit>) {
     .expect("A/A0 = 0.95")];
     for below_first_contact in [0.2, 0.45] {
         let z = model.grazing_separation_nm() - below_first_contact;
-        orbits.push(steady_orbit(&model, z, None, &settings).expect("orbit"));
+        orbits.push(steady_orbit(&model, z, OrbitStart::Cold, &settings).expect("orbit"));
     }
     for orbit in &orbits {
         assert!(orbit.converged && orbit.stable && orbit.multiplicity == 1);
@@ -285,8 +285,13 @@ fn off_resonance_drive_keeps_the_harmonic_balance_but_not_eq3() {
     // actual w still holds up to the same cos(theta) = -1 expansion.
     let model = model("maclever-mica-experiment");
     let settings = SteadyOrbitSettings::default();
-    let orbit =
-        steady_orbit(&model, model.grazing_separation_nm() - 0.5, None, &settings).expect("orbit");
+    let orbit = steady_orbit(
+        &model,
+        model.grazing_separation_nm() - 0.5,
+        OrbitStart::Cold,
+        &settings,
+    )
+    .expect("orbit");
     let c = compare(&model, &orbit);
     let m = &c.measurement;
     assert_eq!(m.impacts.len(), 1);
@@ -315,8 +320,13 @@ fn refuses_what_the_theory_does_not_describe() {
     // An orbit of period 2T.
     let model = model("biolever-mica");
     let settings = SteadyOrbitSettings::default();
-    let mut orbit =
-        steady_orbit(&model, model.grazing_separation_nm() - 0.3, None, &settings).expect("orbit");
+    let mut orbit = steady_orbit(
+        &model,
+        model.grazing_separation_nm() - 0.3,
+        OrbitStart::Cold,
+        &settings,
+    )
+    .expect("orbit");
     orbit.multiplicity = 2;
     let error = measure_impacts(&model, &orbit, &settings.integration)
         .expect_err("period 2")

@@ -2,8 +2,8 @@
 //! approach curve reaches an amplitude ratio, with its impacts, gap minima and forces.
 
 use afm::{
-    find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, SteadyOrbit, SteadyOrbitSettings,
-    TappingModel,
+    find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, OrbitStart, SteadyOrbit,
+    SteadyOrbitSettings, TappingModel,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -55,7 +55,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             if !z.is_finite() {
                 bail!("--z {z}: the separation must be a finite number of nm");
             }
-            steady_orbit(&model, z, None, &settings)
+            steady_orbit(&model, z, OrbitStart::Cold, &settings)
                 .with_context(|| format!("no steady orbit at Z = {z} nm"))?
         }
         (None, Some(ratio)) => {

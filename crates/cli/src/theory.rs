@@ -3,8 +3,8 @@
 //! measured on the simulated steady orbit at one `Z` or `A/A0`, with relative errors.
 
 use afm::{
-    compare_theory, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, SteadyOrbit,
-    SteadyOrbitSettings, TappingModel, TheoryComparison,
+    compare_theory, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, OrbitStart,
+    SteadyOrbit, SteadyOrbitSettings, TappingModel, TheoryComparison,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -74,7 +74,7 @@ fn orbit(
             if !z.is_finite() {
                 bail!("--z {z}: the separation must be a finite number of nm");
             }
-            steady_orbit(model, z, None, settings)
+            steady_orbit(model, z, OrbitStart::Cold, settings)
                 .with_context(|| format!("no steady orbit at Z = {z} nm"))
         }
         (None, ratio) => {
