@@ -96,22 +96,14 @@ pub fn find_amplitude_ratio(
             reason,
         });
     };
-    // One workspace for the refinement's sequence of orbits.
+    // One workspace for the refinement's sequence of orbits; the bracket's ends as steady
+    // orbits (with their slopes dx/dZ, for the refinement's predictions).
     let workspace = &mut SteadyOrbitWorkspace::default();
-    let above = steady_orbit_in(
-        model,
-        above.z_nm,
-        OrbitStart::Near(&above.state),
-        settings,
-        workspace,
-    )?;
-    let below = steady_orbit_in(
-        model,
-        below.z_nm,
-        OrbitStart::Near(&below.state),
-        settings,
-        workspace,
-    )?;
+    let mut orbit_at = |z_nm: f64, state: &[f64]| {
+        steady_orbit_in(model, z_nm, OrbitStart::Near(state), settings, workspace)
+    };
+    let above = orbit_at(above.z_nm, &above.state)?;
+    let below = orbit_at(below.z_nm, &below.state)?;
     refine(model, search, settings, above, below, workspace)
 }
 
