@@ -133,7 +133,7 @@ pub struct SteadyOrbit {
     /// parameter derivative `dP/dZ` of the same period map (of `P^k`; the implicit-function
     /// theorem on `P(x; Z) = x`), the map being Newton's last one with sensitivities (as for
     /// the multipliers). The branch's slope, for predicting a neighbouring orbit
-    /// ([`OrbitStart::predicted`]). `None` where `M - I` is singular (a fold of the branch,
+    /// ([`OrbitStart::Predicted`]). `None` where `M - I` is singular (a fold of the branch,
     /// where `Z` cannot parametrise it) or the solve gives a non-finite vector.
     pub tangent: Option<Vec<f64>>,
     /// The observables of each of the `k` drive periods of the orbit, in order.
@@ -221,8 +221,10 @@ pub enum OrbitStart<'a> {
     /// extrapolation from two orbits along the branch ([`crate::orbit_prediction`]): the
     /// first map is integrated at full tolerance, and when its residual is small enough for
     /// one Newton update to converge, the next map is the last (two period maps in all
-    /// instead of three). A worse prediction costs a map, never accuracy: convergence is
-    /// decided by measured residuals only.
+    /// instead of three: at the Fig. 1 points 0.52M, 0.84M and 1.16M instructions per orbit
+    /// at A/A0 = 0.95, 0.90 and 0.50, against 0.71M, 1.13M and 1.60M from the nearer
+    /// orbit's state; callgrind). A worse prediction costs a map, never accuracy:
+    /// convergence is decided by measured residuals only.
     Predicted(&'a [f64]),
 }
 
