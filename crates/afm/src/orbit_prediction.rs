@@ -25,6 +25,9 @@ use crate::steady_orbit::SteadyOrbit;
 /// with the cubic Hermite basis `h00 = 2s^3 - 3s^2 + 1`, `h10 = s^3 - 2s^2 + s`,
 /// `h01 = -2s^3 + 3s^2`, `h11 = s^3 - s^2`. State units (nm, nm/us).
 ///
+/// For orbits of period `k T` (`k > 1`) the two states must be the same phase of the cycle
+/// (the same drive period of it at `t = 0`), which the multiplicity alone does not check.
+///
 /// `None` when either orbit has no tangent, the two are at the same separation or of
 /// different multiplicity or dimension, or the result is not finite.
 pub fn hermite_state(z_nm: f64, a: &SteadyOrbit, b: &SteadyOrbit) -> Option<Vec<f64>> {
