@@ -14,6 +14,8 @@
 //! the slope against central differences and the cubic's fourth order): the cubic is close
 //! enough for one Newton update to converge ([`crate::OrbitStart::Predicted`]).
 
+use continuation::hermite_basis;
+
 use crate::steady_orbit::SteadyOrbit;
 
 /// The cubic Hermite interpolant in `Z` of the states of `a` and `b` and their slopes
@@ -22,8 +24,8 @@ use crate::steady_orbit::SteadyOrbit;
 /// `x(Z) = h00(s) x_a + h10(s) h x'_a + h01(s) x_b + h11(s) h x'_b`, `s = (Z - Z_a) / h`,
 /// `h = Z_b - Z_a`,
 ///
-/// with the cubic Hermite basis `h00 = 2s^3 - 3s^2 + 1`, `h10 = s^3 - 2s^2 + s`,
-/// `h01 = -2s^3 + 3s^2`, `h11 = s^3 - s^2`. State units (nm, nm/us).
+/// with the cubic Hermite basis [`continuation::hermite_basis`] (the branch's cubic
+/// predictor's). State units (nm, nm/us).
 ///
 /// For orbits of period `k T` (`k > 1`) the two states must be the same phase of the cycle
 /// (the same drive period of it at `t = 0`), which the multiplicity alone does not check.
@@ -41,12 +43,7 @@ pub fn hermite_state(z_nm: f64, a: &SteadyOrbit, b: &SteadyOrbit) -> Option<Vec<
     if !(comparable && h != 0.0 && h.is_finite()) {
         return None;
     }
-    let s = (z_nm - a.z_nm) / h;
-    let (s2, s3) = (s * s, s * s * s);
-    let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-    let h10 = s3 - 2.0 * s2 + s;
-    let h01 = -2.0 * s3 + 3.0 * s2;
-    let h11 = s3 - s2;
+    let [h00, h10, h01, h11] = hermite_basis((z_nm - a.z_nm) / h);
     let state: Vec<f64> = (0..n)
         .map(|i| h00 * a.state[i] + h10 * h * slope_a[i] + h01 * b.state[i] + h11 * h * slope_b[i])
         .collect();

@@ -28,6 +28,7 @@ use nalgebra::{Complex, DVector};
 use crate::corrector::{correct, tangent};
 use crate::error::ContinuationError;
 use crate::floquet::{floquet_multipliers, is_stable};
+use crate::hermite::hermite_basis;
 use crate::location::{Location, Sample, Segment};
 use crate::problem::{OrbitStructure, PeriodicProblem};
 use crate::settings::ContinuationSettings;
@@ -441,12 +442,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         if h.is_nan() || h <= 0.0 || ds > 2.0 * h {
             return None;
         }
-        let tau = 1.0 + ds / h;
-        let (t2, t3) = (tau * tau, tau * tau * tau);
-        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
-        let h10 = t3 - 2.0 * t2 + tau;
-        let h01 = -2.0 * t3 + 3.0 * t2;
-        let h11 = t3 - t2;
+        let [h00, h10, h01, h11] = hermite_basis(1.0 + ds / h);
         let guess = h00 * u0 + (h10 * h) * t0 + h01 * u1 + (h11 * h) * t1;
         let linear = u1 + ds * t1;
         let finite = guess.iter().all(|v| v.is_finite());
