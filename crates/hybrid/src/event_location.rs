@@ -179,6 +179,44 @@ pub(crate) fn extremum_guess(
     cubic.newton_zero(1, s0, sign)
 }
 
+/// The start of a bracket on which `g = side h_k` is monotone, for the first crossing out of
+/// a mode between `start = (a, g(a) >= 0)` and `b` (`g(b) < 0`), along an interpolant that
+/// gives `g` and its rate `g'` at any time (`point(t) = (g, g')`). Where `g` does not rise at
+/// `a`, `start` itself. Where it rises (`g'(a) > 0`: the state moves into the mode, as on the
+/// surface right after the event that entered it), the crossing lies past the maximum of `g`,
+/// the zero of `g'` between `a` and `b`, located to `time_tolerance`; that maximum is the
+/// start, or `None` where the interpolant does not show one excursion into the mode (`g'(b) >=
+/// 0`: `g` rises again, or never fell; or `g <= 0` at the zero of `g'`).
+///
+/// [`locate_sign_change`] from `a` itself would search a bracket holding the maximum, and from
+/// a start on the surface (`g(a)` zero or a rounding error) its first secant lands next to `a`,
+/// where the rounding of `g` decides the sign: a crossing out was found one rounding step after
+/// the onset, and the step that was to land on it could not advance time.
+pub(crate) fn turnaround(
+    start: (f64, f64),
+    b: f64,
+    point: &mut dyn FnMut(f64) -> (f64, f64),
+    time_tolerance: f64,
+) -> Option<(f64, f64)> {
+    let (a, _) = start;
+    let rate_a = point(a).1;
+    let rising = rate_a > 0.0;
+    if !rising {
+        return Some(start);
+    }
+    let rate_b = point(b).1;
+    let falls = rate_b < 0.0;
+    if !falls {
+        return None;
+    }
+    let mut rate = |t: f64| point(t).1;
+    let top = locate_sign_change(a, rate_a, b, rate_b, &mut rate, time_tolerance, 0.0, None);
+    // The higher end of the bracket (`far` where it is an exact zero of `g'`).
+    let (near, far) = ((top.near, point(top.near).0), (top.far, point(top.far).0));
+    let highest = if far.1 > near.1 { far } else { near };
+    (highest.1 > 0.0).then_some(highest)
+}
+
 /// Locate the first sign change of `g` on `[a, b]` where `g(a) = g_a > 0` (supplied, not
 /// evaluated: at the start of a step the side is fixed by the mode) and `g(b) = g_b <= 0`.
 ///
@@ -308,6 +346,31 @@ mod tests {
         assert!(b.near <= root + 1e-15 && b.far >= root - 1e-15, "{b:?}");
         assert!(b.far - b.near <= 1e-14);
         assert!(b.near_value > 0.0 && b.far_value <= 0.0);
+    }
+
+    /// From a start on the surface moving into the mode, `g = t (1 - t)` on `[0, 2]`: the
+    /// bracket starts at the maximum `t = 1/2` (`g = 1/4`), and the crossing out located from
+    /// there is `t = 1`, not the start's own zero. Where `g` falls at the start it is the start;
+    /// where `g` rises again at the end (`t (1 - t) (2 - t)` on `[0, 1.9]`: a maximum and a
+    /// minimum, more than one monotone bracket holds) there is none.
+    #[test]
+    fn turnaround_starts_the_bracket_at_the_maximum() {
+        let mut point = |t: f64| (t * (1.0 - t), 1.0 - 2.0 * t);
+        let (top, value) = turnaround((0.0, 0.0), 2.0, &mut point, 1e-14).expect("a maximum");
+        assert!(
+            (top - 0.5).abs() < 1e-14 && (value - 0.25).abs() < 1e-15,
+            "{top} {value}"
+        );
+        let mut g = |t: f64| t * (1.0 - t);
+        let crossing = locate_sign_change(top, value, 2.0, -2.0, &mut g, 1e-14, 0.0, None);
+        assert!((crossing.far - 1.0).abs() <= 1e-14, "{crossing:?}");
+        let mut falling = |t: f64| (1.0 - t, -1.0);
+        assert_eq!(
+            turnaround((0.0, 1.0), 2.0, &mut falling, 1e-14),
+            Some((0.0, 1.0))
+        );
+        let mut cubic = |t: f64| (t * (1.0 - t) * (2.0 - t), 2.0 - 6.0 * t + 3.0 * t * t);
+        assert_eq!(turnaround((0.0, 0.0), 1.9, &mut cubic, 1e-14), None);
     }
 
     /// With the guesses from the ends' values and rates (a crossing of `cos t` on

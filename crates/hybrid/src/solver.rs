@@ -18,6 +18,15 @@
 //!   continuation tracks). A minimum that dips strictly below zero, however little, fires two
 //!   events (down, then up), both flagged `grazing` when `|dh/dt| < grazing_rate`; each event
 //!   advances time past its bracket, so neither repeats.
+//! * **Rounding at the surface.** A sample computed past surface `k` by no more than
+//!   `event_value_tolerance`, where `dh_k/dt` points into the mode at it and at the previous
+//!   sample point with no extremum between (so that sampling takes `h_k` to be monotone there,
+//!   away from the surface), is no crossing: it is the rounding of `h_k` next to zero, as in
+//!   the first nanoseconds of a contact only a rounding error deep. A crossing located in a
+//!   rejected trial that started on the surface moving into the mode is searched from the
+//!   maximum of the excursion (`crate::event_location::turnaround`), and a crossing nearer
+//!   than `1024 eps |t|` is not landed on: the controller shortens the step, and the event is
+//!   located in the step it accepts.
 //! * A reset chooses its bracket end from the sign of `dh_k/dt` just after the reset
 //!   (evaluated with the pre-event mode's field) at the far end: the near end if the state
 //!   bounces back, the far end if it goes through. The new mode bit of surface `k` is then the
@@ -127,7 +136,9 @@ use crate::clock::Clock;
 use crate::dop853::Dop853;
 use crate::error::HybridError;
 use crate::event::{Event, Extremum};
-use crate::event_location::{crossing_guess, locate_sign_change, Bracket, CubicHermite};
+use crate::event_location::{
+    crossing_guess, locate_sign_change, turnaround, Bracket, CubicHermite,
+};
 use crate::extrema::Clearance;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
@@ -1267,8 +1278,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         if let Some((s, k)) = predicted.filter(|&(s, _)| !first || s >= h) {
             // Too close to resolve in time (a Zeno accumulation): leave the step to the
             // controller and the event location.
-            let resolvable = s > 1024.0 * f64::EPSILON * t0.abs();
-            if resolvable && s < t_end - t0 {
+            if resolvable(s, t0) && s < t_end - t0 {
                 if half_power == Some(k) && h >= s / ROOT_APPROACH {
                     // Within a few steps of a crossing of the half-power surface: steps on a
                     // square-root clock centred on it, located on the last step's dense output
@@ -1282,7 +1292,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                         None
                     };
                     match located {
-                        Some(t_cross) if t_cross > t0 && t_cross - t0 <= max_step => {
+                        Some(t_cross)
+                            if resolvable(t_cross - t0, t0) && t_cross - t0 <= max_step =>
+                        {
                             let target = (t_cross - t0) * (1.0 + ROOT_OVERSHOOT);
                             let reference = t0 + target;
                             clock = Clock::SquareRoot { reference };
@@ -1389,7 +1401,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                         let moved = crossing_target.is_none_or(|reference| {
                             (t0 + target - reference).abs() > 10.0 * ROOT_OVERSHOOT * target
                         });
-                        if moved && target > 0.0 && target <= max_step {
+                        if moved && resolvable(target, t0) && target <= max_step {
                             retargets += 1;
                             let reference = t0 + target;
                             clock = Clock::SquareRoot { reference };
@@ -1615,6 +1627,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             before = (t, value);
         }
         let tolerance = self.settings.event_time_tolerance * t0.abs().max(t1.abs());
+        let mut point = |t: f64| {
+            rk.interpolate(z0, (clock.sigma(t) - sigma0) / dsigma, x);
+            (
+                side * system.switching(k, t, x),
+                side * system.switching_rate(k, mode, t, x),
+            )
+        };
+        let before = turnaround(before, after.0, &mut point, tolerance)?;
+        let mut g = |t: f64| point(t).0;
         let bracket = locate_sign_change(
             before.0, before.1, after.0, after.1, &mut g, tolerance, 0.0, None,
         );
@@ -1662,6 +1683,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let ends_only = self.buffers.samples.ends_only;
         let intervals = if ends_only { 1 } else { p - 1 };
         let mut best: Option<(usize, Bracket)> = None;
+        let value_tolerance = self.settings.event_value_tolerance;
         for k in 0..self.surfaces {
             let side = side_sign(mode, k);
             // At the step start the side is the mode's, whatever the computed value.
@@ -1686,15 +1708,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 }
                 let j = if ends_only { p - 1 } else { i + 1 };
                 let hb = self.buffers.samples.values[k * p + j];
-                let point = (
-                    self.buffers.samples.times[j],
-                    side * hb,
-                    hb,
-                    self.buffers.samples.rates[k * p + j],
-                );
+                let rb = self.buffers.samples.rates[k * p + j];
+                let mut point = (self.buffers.samples.times[j], side * hb, hb, rb);
                 if point.1 < 0.0 {
-                    candidate = Some((prev, point));
-                    break;
+                    if !is_rounding(side, prev.3, point.1, rb, value_tolerance) {
+                        candidate = Some((prev, point));
+                        break;
+                    }
+                    point.1 = 0.0;
                 }
                 if point.0 > prev.0 {
                     prev = point;
@@ -2054,6 +2075,29 @@ pub(crate) fn clocked_field<'b, S: HybridSystem + ?Sized>(
             }
         }
     }
+}
+
+/// Whether a crossing `distance` ahead of `t0` is far enough to land a step on:
+/// `1024 eps |t0|`, a few hundred rounding steps of time. Nearer, a step cannot hold it
+/// (a Zeno accumulation, or a state on the surface whose rounding puts the crossing next to
+/// it): the step is left to the controller, and a crossing inside the accepted step to the
+/// event location.
+fn resolvable(distance: f64, t0: f64) -> bool {
+    distance > 1024.0 * f64::EPSILON * t0.abs()
+}
+
+/// Whether a sample that computes `g_b = side h_k < 0` (past surface `k`, by at most
+/// `value_tolerance`) is rounding rather than a crossing: `dh_k/dt` points into the mode (`side
+/// dh_k/dt > 0`) at the previous sample point (rate `previous_rate`) and at this one (`rate`),
+/// with no extremum located between them (an extremum point carries rate 0 and so never
+/// qualifies). Sampling takes `h_k` to be monotone between such points, here away from the
+/// surface from a value on the mode's side, so it cannot have crossed; the computed sign is the
+/// rounding of `h_k` next to zero. (At a contact onset at `1e-7` nm/us, the gap `Z + sum_i q_i`
+/// with `|Z|` near 9 nm is rounded to `1.8e-15` nm steps while the true indentation stays below
+/// that for `1e-8` us: without this rule, a sample there one rounding step outside fired a
+/// release whose rate pointed into the contact, then a second onset.)
+fn is_rounding(side: f64, previous_rate: f64, g_b: f64, rate: f64, value_tolerance: f64) -> bool {
+    g_b >= -value_tolerance && side * previous_rate > 0.0 && side * rate > 0.0
 }
 
 /// If the trial step on `clock` from `(t0, sigma0, z0)` over `dsigma` to `(t1, z1)` ends
