@@ -116,6 +116,28 @@ pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serd
     })
 }
 
+/// Distance from +1 within which a real Floquet multiplier of an orbit Newton did not converge
+/// to marks a fold: next to a saddle-node, the transients of a cold start linger at the ghost
+/// of the orbit that vanished there for longer than the periods a cold start integrates, and
+/// Newton has no fixed point to find (measured: the MAClever on mica from 1e-11 to 4e-8 nm
+/// below its fold at 19.9958410294 nm, best attempts with multipliers within 5e-6 of +1;
+/// from 5e-8 nm below, the cold start's transients pass the ghost and converge).
+const FOLD_MULTIPLIER_DISTANCE: f64 = 1e-2;
+
+/// The real Floquet multiplier within [`FOLD_MULTIPLIER_DISTANCE`] of +1 of an orbit that did
+/// not converge, if any.
+fn fold_multiplier(orbit: &SteadyOrbit) -> Option<f64> {
+    if orbit.converged {
+        return None;
+    }
+    orbit
+        .multipliers
+        .iter()
+        .filter(|m| m.im == 0.0 && (m.re - 1.0).abs() < FOLD_MULTIPLIER_DISTANCE)
+        .map(|m| m.re)
+        .min_by(|a, b| (a - 1.0).abs().total_cmp(&(b - 1.0).abs()))
+}
+
 /// The readable summary of one steady orbit.
 pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String {
     use std::fmt::Write;
@@ -138,6 +160,12 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
         format!("NOT CONVERGED after {} Newton iterations, residual {:.1e}: the values below are the best attempt", orbit.iterations, orbit.residual)
     };
     let _ = writeln!(s, "steady orbit at Z = {:.9} nm: {status}", orbit.z_nm);
+    if let Some(multiplier) = fold_multiplier(orbit) {
+        let _ = writeln!(
+            s,
+            "  a Floquet multiplier is {multiplier:.6}, at +1: Z is next to a fold, where the transients linger at the ghost of the orbit that vanished there and Newton has no orbit near to find; `drumroll continue` locates the fold, and `drumroll simulate` finds the orbit beyond it farther from the fold"
+        );
+    }
     if orbit.multiplicity > 1 {
         let _ = writeln!(
             s,

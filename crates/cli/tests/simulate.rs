@@ -155,3 +155,35 @@ fn plot_is_written_whole_or_not_at_all() {
         .failure();
     assert!(!bad.exists());
 }
+
+#[test]
+fn next_to_a_fold_an_orbit_not_found_is_reported_with_its_fold() {
+    // The MAClever on mica has a fold 3e-3 nm below first contact; 1e-8 nm beyond it the
+    // orbit of the approach has vanished, and a cold start's transients linger at its ghost
+    // for more than the 4000 periods searched (measured: Newton stops with a residual of
+    // 1.2e-7, a multiplier at 0.999894, in 0.1 s). The summary must either give a converged
+    // orbit or say that Z is next to a fold.
+    let diagram = json_of(&["continue", "--case", "maclever-mica"]);
+    let fold = diagram["special_points"]
+        .as_array()
+        .expect("list")
+        .iter()
+        .find(|s| s["label"] == "fold")
+        .expect("a fold on the approach");
+    let z = common::number(fold, "z_nm") - 1e-8;
+    let output = drumroll()
+        .args([
+            "simulate",
+            "--case",
+            "maclever-mica",
+            "--z",
+            &format!("{z:.12}"),
+        ])
+        .output()
+        .expect("runs");
+    assert!(output.status.success());
+    let summary = String::from_utf8_lossy(&output.stdout);
+    let converged = summary.contains(": converged in ");
+    let explained = summary.contains("NOT CONVERGED") && summary.contains("Z is next to a fold");
+    assert!(converged || explained, "{summary}");
+}
