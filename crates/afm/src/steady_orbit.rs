@@ -337,9 +337,10 @@ pub fn steady_orbit_in(
     }
 
     // Period-1 Newton failed or found a repelling orbit: look for the attractor by iteration.
-    // Each period, the smallest multiplicity whose state recurs is shot, unless an earlier
-    // shot at that multiplicity failed from a recurrence at least as close (a transient
-    // nearing an attractor comes closer by factors; the ghost of a vanished orbit does not).
+    // Each period, the smallest multiplicity whose state recurs is shot, leaving out those at
+    // which an earlier shot failed from a recurrence less than [`RETRY_FACTOR`] times farther
+    // (a transient nearing an attractor comes closer by factors; the ghost of a vanished orbit
+    // does not).
     let mut states = Vec::with_capacity(settings.recurrence_periods + 1);
     let mut x = iterate(
         &model,
@@ -359,13 +360,12 @@ pub fn steady_orbit_in(
         let last = states.len() - 1;
         let recurrence = (1..=settings.max_multiplicity.min(last))
             .map(|k| (k, distance(&states[last], &states[last - k])))
-            .find(|&(_, distance)| distance <= RECURRENCE_DISTANCE * scale);
+            .find(|&(k, distance)| {
+                distance <= RECURRENCE_DISTANCE * scale && distance <= RETRY_FACTOR * failed_at[k]
+            });
         let Some((k, distance)) = recurrence else {
             continue;
         };
-        if distance > RETRY_FACTOR * failed_at[k] {
-            continue;
-        }
         let problem = HybridPeriodicProblem::new(model.clone(), k, settings.integration.clone())?;
         let shot = shoot(&problem, &states[last], z_nm, &settings.newton)?;
         let multipliers = floquet_multipliers(&shot.period_map.monodromy);
