@@ -35,7 +35,9 @@ const US_PER_S: f64 = 1e6;
 pub const MAX_RATE_NM_PER_S: f64 = 1e6;
 /// The largest separation accepted for either end of a sweep, nm.
 pub const MAX_SEPARATION_NM: f64 = 1e5;
-/// The largest number of cycles in a lock-in block, a decimation step or the settling.
+/// The largest number of cycles in a lock-in block, a decimation step, the settling or one
+/// direction of a sweep (at about 46 us per cycle, the Biolever on mica's approach from first
+/// contact at 1 nm/s, 1e8 cycles take over an hour).
 pub const MAX_CYCLE_COUNT: usize = 100_000_000;
 /// The default start of a sweep above first contact `Z_G1`, nm: the free orbit is exact there,
 /// so the first records show the free amplitude and phase before the first impact.
@@ -256,14 +258,15 @@ impl Sweep {
         // Full cycles that fit between `from` and `to` (a relative slack of 1e-9 keeps an
         // exact multiple from losing its last cycle to rounding).
         let cycles_per_leg = (span / z_step_nm * (1.0 + 1e-9)).floor();
-        if !(1.0..=1e15).contains(&cycles_per_leg) {
+        if !(1.0..=MAX_CYCLE_COUNT as f64).contains(&cycles_per_leg) {
             return Err(invalid(
                 "sweep settings",
                 "from_nm - to_nm",
                 span,
                 format!(
                     "at least one drive cycle at the rate given ({z_step_nm:e} nm per cycle) \
-                     and at most 1e15 cycles"
+                     and at most {MAX_CYCLE_COUNT:e} cycles per direction (tens of \
+                     microseconds each: {MAX_CYCLE_COUNT:e} take over an hour)"
                 ),
             ));
         }

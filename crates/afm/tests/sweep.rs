@@ -262,6 +262,14 @@ fn invalid_settings_name_the_field_and_range() {
             },
             "from_nm - to_nm",
         ),
+        // Longer than 1e8 cycles in one direction (1 nm at 1e-6 nm/s is 9.3e9 cycles).
+        (
+            SweepSettings {
+                rate_nm_per_s: 1e-6,
+                ..base.clone()
+            },
+            "from_nm - to_nm",
+        ),
     ];
     for (settings, expected) in cases {
         let message = field_of(Sweep::new(&model, settings).expect_err("invalid"));

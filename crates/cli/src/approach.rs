@@ -113,6 +113,16 @@ impl ApproachArgs {
                 self.rate
             );
         }
+        let cycles = (from - self.to) / cycle_travel;
+        if cycles > MAX_CYCLE_COUNT as f64 {
+            bail!(
+                "--from {from} --to {} at --rate {} nm/s: {cycles:.3e} drive cycles in each \
+                 direction, allowed at most {MAX_CYCLE_COUNT:e} (tens of microseconds each: \
+                 {MAX_CYCLE_COUNT:e} take over an hour); raise --rate or narrow --from/--to",
+                self.to,
+                self.rate
+            );
+        }
         settings.from_nm = from;
         settings.to_nm = self.to;
         settings.rate_nm_per_s = self.rate;
