@@ -107,6 +107,42 @@ fn homogeneous_transition_matches_taylor_series_of_the_matrix_exponential() {
     }
 }
 
+/// Strongly over-damped modes (`Q` = 1e-2 and 1e-3) over long steps, where `2 delta t` reaches
+/// 3e4: against Sylvester's formula `exp(A t) = (e^{l1 t} (A - l2 I) - e^{l2 t} (A - l1 I)) /
+/// (l1 - l2)` with the eigenvalues `l2 = mu - delta` (fast) and `l1 = w^2 / l2` (slow, without
+/// cancellation), both exponentials in (0, 1] forward in time. The transition had factored
+/// `S` on the fast exponential, `e^{l2 t} (e^{2 delta t} - 1)`, which is `0 * inf` once `2 delta
+/// t > 709`: the state of a contact-free period went NaN.
+#[test]
+fn strongly_over_damped_transition_is_finite_over_long_steps() {
+    for quality in [1e-2, 1e-3] {
+        let mu = -OMEGA / (2.0 * quality);
+        let delta = (mu * mu - OMEGA * OMEGA).sqrt();
+        let fast = mu - delta;
+        let slow = OMEGA * OMEGA / fast;
+        let a = [[0.0, 1.0], [-OMEGA * OMEGA, -OMEGA / quality]];
+        for t in [1.0, 40.0, 500.0] {
+            let oscillator = DrivenOscillator::new(OMEGA, quality, STATIC_NM, OMEGA);
+            let phi = oscillator.homogeneous_transition(t);
+            let (e_slow, e_fast) = ((slow * t).exp(), (fast * t).exp());
+            for r in 0..2 {
+                for c in 0..2 {
+                    let identity = if r == c { 1.0 } else { 0.0 };
+                    let reference = (e_slow * (a[r][c] - fast * identity)
+                        - e_fast * (a[r][c] - slow * identity))
+                        / (slow - fast);
+                    assert!(
+                        phi[r][c].is_finite()
+                            && (phi[r][c] - reference).abs() <= 1e-12 * reference.abs().max(1.0),
+                        "Q = {quality}, t = {t}: [{r}][{c}] {} vs {reference}",
+                        phi[r][c]
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn transition_matrix_matches_finite_differences_and_flow_is_a_group() {
     for quality in [4.3, 0.5, 0.3] {
