@@ -2,13 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::eigenmode::{MAX_FREQUENCY, MIN_FREQUENCY};
 use crate::validation::{check, check_name, Interval};
 use crate::{AfmError, Cantilever, Sample};
 
 /// Largest accepted free amplitude, nm.
 const MAX_FREE_AMPLITUDE_NM: f64 = 1e5;
-/// Largest accepted drive frequency, kHz.
-const MAX_DRIVE_FREQUENCY_KHZ: f64 = 1e6;
 
 /// A case file as written on disk (`fixtures/cases/*.json`): the cantilever and the sample are
 /// referenced by name (a built-in fixture) or by a path ending in `.json` (relative to the case
@@ -28,8 +27,8 @@ pub struct CaseFile {
     /// The free amplitude `A0`: first-harmonic amplitude of `u` with `F_ts = 0`, nm;
     /// range (0, 1e5] (MODEL.md section 3).
     pub free_amplitude_nm: f64,
-    /// The drive frequency `f = w / 2 pi`, kHz; range (0, 1e6]; absent: `f_1` (the paper's
-    /// `w = w_1`, MODEL.md section 3).
+    /// The drive frequency `f = w / 2 pi`, kHz; range [1e-2, 1e6] (as a natural frequency's);
+    /// absent: `f_1` (the paper's `w = w_1`, MODEL.md section 3).
     #[serde(default)]
     pub drive_frequency_khz: Option<f64>,
 }
@@ -60,7 +59,7 @@ pub(crate) fn check_case_numbers(
             file,
             "drive_frequency_khz",
             frequency,
-            Interval::positive(MAX_DRIVE_FREQUENCY_KHZ, "kHz"),
+            Interval::closed(MIN_FREQUENCY, MAX_FREQUENCY, "kHz"),
         )?;
     }
     Ok(())

@@ -5,10 +5,22 @@ use serde::{Deserialize, Serialize};
 use crate::validation::{check, invalid, Interval};
 use crate::AfmError;
 
+/// Smallest accepted modal stiffness, N/m: a thousandth of the softest cantilevers made
+/// (the Biolever's 0.036 N/m is among them). Far below it the contact is so stiff against the
+/// lever that steps underflow (measured on the Biolever on mica: `k_1` = 1e-12 N/m still
+/// converges, 1e-20 N/m does not).
+const MIN_STIFFNESS: f64 = 1e-6;
 /// Largest accepted modal stiffness, N/m.
 const MAX_STIFFNESS: f64 = 1e6;
+/// Smallest accepted natural frequency, kHz (10 Hz, far below any cantilever's: the paper's are
+/// 3.5 to 72 kHz). A drive period of a slower one takes millions of steps at the contact's time
+/// scale (measured: `f_1` = 1 Hz converges in 0.8 s, 0.1 Hz exhausts the step limit).
+pub(crate) const MIN_FREQUENCY: f64 = 1e-2;
 /// Largest accepted natural frequency, kHz (1 GHz).
-const MAX_FREQUENCY: f64 = 1e6;
+pub(crate) const MAX_FREQUENCY: f64 = 1e6;
+/// Smallest accepted quality factor: a mode damped a thousand times past critical (measured:
+/// `Q_2` = 1e-6 still converges, in 2 s; 1e-9 exhausts the step limit).
+const MIN_QUALITY: f64 = 1e-3;
 /// Largest accepted quality factor.
 const MAX_QUALITY: f64 = 1e6;
 /// Largest accepted magnitude of an optical sensitivity or forcing ratio.
@@ -24,11 +36,11 @@ pub fn angular_frequency_rad_per_us(frequency_khz: f64) -> f64 {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Eigenmode {
-    /// Equivalent modal stiffness `k_i` at the tip, N/m (= nN/nm); range (0, 1e6].
+    /// Equivalent modal stiffness `k_i` at the tip, N/m (= nN/nm); range [1e-6, 1e6].
     pub stiffness_n_per_m: f64,
-    /// Natural frequency `f_i = w_i / 2 pi` (in liquid), kHz; range (0, 1e6].
+    /// Natural frequency `f_i = w_i / 2 pi` (in liquid), kHz; range [1e-2, 1e6].
     pub frequency_khz: f64,
-    /// Quality factor `Q_i`; any value in (0, 1e6] (over-damped `Q_i <= 0.5` included).
+    /// Quality factor `Q_i`; any value in [1e-3, 1e6] (over-damped `Q_i <= 0.5` included).
     pub quality_factor: f64,
     /// Optical-lever sensitivity `chi_i` of the mode in the photodiode signal
     /// `u = sum_i chi_i q_i`; exactly 1 for mode 1, [-1000, 1000] otherwise.
@@ -52,19 +64,19 @@ impl Eigenmode {
             file,
             &field("stiffness_n_per_m"),
             self.stiffness_n_per_m,
-            Interval::positive(MAX_STIFFNESS, "N/m"),
+            Interval::closed(MIN_STIFFNESS, MAX_STIFFNESS, "N/m"),
         )?;
         check(
             file,
             &field("frequency_khz"),
             self.frequency_khz,
-            Interval::positive(MAX_FREQUENCY, "kHz"),
+            Interval::closed(MIN_FREQUENCY, MAX_FREQUENCY, "kHz"),
         )?;
         check(
             file,
             &field("quality_factor"),
             self.quality_factor,
-            Interval::positive(MAX_QUALITY, ""),
+            Interval::closed(MIN_QUALITY, MAX_QUALITY, ""),
         )?;
         if index == 0 {
             for (name, value, meaning) in [
