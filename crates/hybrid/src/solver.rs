@@ -115,7 +115,12 @@
 //! reach, is one step on the clock of its onset); then the square-root clock
 //! centred `ROOT_OVERSHOOT` past that predicted crossing, re-centred on the zero of its own
 //! series when they differ, so that the step landing on its reference holds the crossing, which
-//! is then located on the series like any other. The series is the step's dense output, and
+//! is then located on the series like any other. A ridge of that surface (approached and left
+//! without a crossing: the indentation's shallow minimum between two merged contacts), seen
+//! ahead on the series or passed earlier in the mode, puts branch points of `|h|^{1/2}` next to
+//! the real axis that the state's last terms do not show: the step then stays within half
+//! their distance (`crate::taylor::surface_ahead`, `TaylorStep::radius_reach`). The series is
+//! the step's dense output, and
 //! its polynomial in the switching function carries the Bernstein tests above. A system that
 //! gives no series, a series that cannot be formed (a grazing touch), a crossing predicted past
 //! the reference, or a reach collapsing below `1e-3` of the last series step hands the step to
@@ -143,7 +148,9 @@ use crate::extrema::Clearance;
 use crate::sensitivity::{Sensitivity, VariationalField};
 use crate::settings::Settings;
 use crate::system::{side_sign, Direction, HybridSystem, Mode, MAX_SURFACES};
-use crate::taylor::{first_zero, tangent_control, ClockPolynomial, TaylorStep, TAYLOR_ORDER};
+use crate::taylor::{
+    surface_ahead, tangent_control, ClockPolynomial, Ridge, SurfaceAhead, TaylorStep, TAYLOR_ORDER,
+};
 use crate::workspace::{Buffers, SolverWorkspace};
 
 /// Why [`Solver::step`] returned.
@@ -233,6 +240,10 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// The crossing of the mode's half-power surface that the last Taylor step's series
     /// predicts (its first zero up to [`RELEASE_LOOKAHEAD`] reaches past the step).
     predicted_crossing: Option<f64>,
+    /// The last ridge of the mode's half-power surface a Taylor step's series showed (time and
+    /// half width in time units), which bounds the radius of every later series in the mode,
+    /// after it as before it.
+    ridge: Option<Ridge>,
     /// The time length of the last Taylor step.
     last_series_step: f64,
     statistics: Statistics,
@@ -335,6 +346,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             proven_clear: false,
             affine_switching,
             predicted_crossing: None,
+            ridge: None,
             last_series_step: 0.0,
             statistics: Statistics::default(),
             settings,
@@ -379,6 +391,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.first_same_as_last = false;
         self.entered = None;
         self.predicted_crossing = None;
+        self.ridge = None;
         self.last_series_step = 0.0;
         self.clock = Clock::Time;
         self.kind = StepKind::None;
@@ -1092,20 +1105,46 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             // On a square-root clock centred ahead, the step ends at its reference at the
             // latest. (On the time clock `sigma0 = t0` may be negative: it is never ahead.)
             let ahead = matches!(clock, Clock::SquareRoot { .. }) && sigma0 < 0.0;
-            let landing = ahead && reach >= -sigma0;
+            let mut landing = ahead && reach >= -sigma0;
             if ahead {
                 reach = reach.min(-sigma0);
             }
             // The half-power surface's first zero along the series: within the step, the
-            // crossing the step must hold; beyond it, the prediction for the next step.
-            let crossing = half_power.and_then(|k| {
-                let upto = if ahead {
-                    -sigma0
-                } else {
-                    RELEASE_LOOKAHEAD * reach
-                };
-                self.surface_zero(k, upto).map(|s| polynomial.time(s))
-            });
+            // crossing the step must hold; beyond it, the prediction for the next step. A ridge
+            // before it (the surface approached and left without a crossing) bounds the
+            // series' radius, which the step keeps well inside.
+            let crossing = match half_power {
+                Some(k) => {
+                    let upto = if ahead {
+                        -sigma0
+                    } else {
+                        RELEASE_LOOKAHEAD * reach
+                    };
+                    let surface = self.surface_ahead(k, upto);
+                    if let Some(ridge) = surface.ridge {
+                        // Kept in time units for the steps after it.
+                        self.ridge = Some(Ridge {
+                            at: polynomial.time(ridge.at),
+                            half_width: ridge.half_width * polynomial.time_rate(ridge.at),
+                        });
+                    }
+                    // The ridge's distance in this series' clock offset, at its rate here.
+                    let radius = self.ridge.map(|ridge| {
+                        let rate = polynomial.time_rate(0.0);
+                        Ridge {
+                            at: (ridge.at - t0) / rate,
+                            half_width: ridge.half_width / rate,
+                        }
+                        .radius_from(0.0)
+                    });
+                    if let Some(radius) = radius.filter(|r| r.is_finite()) {
+                        reach = reach.min(TaylorStep::radius_reach(radius));
+                        landing = landing && reach >= -sigma0;
+                    }
+                    surface.zero.map(|s| polynomial.time(s))
+                }
+                None => None,
+            };
             // Centre a clock on the crossing (ROOT_OVERSHOOT past it) when it lies inside the
             // reach of a series not centred ahead, or when a landing series finds it well short
             // of its reference. Not while the onset is nearer (`nearer_than_onset`; on the first
@@ -1170,14 +1209,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     }
 
     /// The first zero in `(0, upto]` of surface `k` (affine) along the last Taylor series, in
-    /// its clock offset. The surface's polynomial is kept with the series
+    /// its clock offset, and the radius a ridge of it limits the series to
+    /// ([`surface_ahead`]). The surface's polynomial is kept with the series
     /// ([`TaylorStep::surface`]) for the step's Bernstein tests.
-    fn surface_zero(&mut self, k: usize, upto: f64) -> Option<f64> {
+    fn surface_ahead(&mut self, k: usize, upto: f64) -> SurfaceAhead {
         let start = self.buffers.taylor.clock.start;
         let start_value = self.system.switching(k, start, &self.buffers.z[..self.n]);
         let power = self.series_surface_polynomial(k, start_value);
         self.buffers.taylor.surface = Some((k, power));
-        first_zero(&power, upto)
+        surface_ahead(&power, upto, side_sign(self.mode, k))
     }
 
     /// The polynomial in the clock offset `s` of the affine surface `k` along the last Taylor
@@ -1972,6 +2012,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.buffers.samples.start_valid = false;
         self.landing_limit = None;
         self.steps_in_mode = 0;
+        self.ridge = None;
         self.entered = Some((k, t_event));
         self.sync_transition();
         Ok(Event {
