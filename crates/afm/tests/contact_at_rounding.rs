@@ -12,7 +12,10 @@
 //! at 7% (Biolever) and 4% (MAClever) of the separations within 1.5e-12 nm of G2 on the soft
 //! sample, and made the continuation label the Biolever's G2 (A0 = 10.0007 nm) `G3`.
 
-use afm::{approach_diagram, builtin_case, DiagramSettings, Separation, TappingModel};
+use afm::{
+    approach_diagram, builtin_case, builtin_sample, Cantilever, DiagramSettings, Separation,
+    TappingModel,
+};
 use hybrid::{flow_map, Direction, Sensitivity};
 
 /// Separations scanned on each side of a grazing point, in steps of [`Z_STEP_NM`].
@@ -119,4 +122,68 @@ fn the_biolever_on_soft_at_a0_10_0007_nm_has_its_g2_labelled() {
         "grazing points of the approach"
     );
     assert!(diagram.error.is_none(), "{:?}", diagram.error);
+}
+
+/// A three-mode lever (the Biolever's first mode, with the second and third of an
+/// Euler-Bernoulli beam without tip mass, as `drumroll cantilever --tip-mass-ratio 0 --k1 0.036
+/// --f1 9.3 --q1 1.2 --q2 2 --q3 3 --modes 3 --radius 30` writes it).
+const THREE_MODES: &str = r#"{
+  "name": "three",
+  "description": "three modes",
+  "tip_radius_nm": 30.0,
+  "tip_mass_ratio": 0.0,
+  "tip_youngs_modulus_gpa": 130.0,
+  "tip_poisson_ratio": 0.3,
+  "modes": [
+    {"stiffness_n_per_m": 0.036, "frequency_khz": 9.3, "quality_factor": 1.2,
+     "optical_sensitivity": 1.0, "force_ratio": 1.0},
+    {"stiffness_n_per_m": 1.4138621350723086, "frequency_khz": 58.2821051396672,
+     "quality_factor": 2.0, "optical_sensitivity": 3.4731270332344217,
+     "force_ratio": -0.5542023805021495},
+    {"stiffness_n_per_m": 11.084908403614275, "frequency_khz": 163.19158201231855,
+     "quality_factor": 3.0, "optical_sensitivity": 5.701877786819476,
+     "force_ratio": 0.32493994336925014}
+  ]
+}"#;
+
+#[test]
+fn a_three_mode_lever_on_mica_has_every_grazing_point_located() {
+    // Its G2 (A0 = 5 nm, 4.3878 nm) was left unconverged: at the grazing point the new
+    // contact meets the surface at 3e-10 nm/us and leaves it 4e-7 us later; the first trial in
+    // it estimated the crossing out at its very start, and the landing step past it, the
+    // fraction 1e-6 of the trial squared on its square-root clock (7e-14 us), could not
+    // advance time (StepSizeUnderflow).
+    let cantilever: Cantilever = serde_json::from_str(THREE_MODES).expect("cantilever");
+    let model = TappingModel::new(
+        cantilever,
+        builtin_sample("mica").expect("sample"),
+        5.0,
+        None,
+        Separation::Constant(5.0),
+    )
+    .expect("model");
+    let diagram = approach(&model, None);
+    let grazing: Vec<(&str, usize, usize, bool)> = diagram
+        .special_points
+        .iter()
+        .filter(|s| s.label.starts_with('G'))
+        .map(|s| {
+            (
+                s.label.as_str(),
+                s.impacts_before,
+                s.impacts_after,
+                s.converged,
+            )
+        })
+        .collect();
+    assert_eq!(
+        grazing,
+        [
+            ("G1", 0, 1, true),
+            ("G2", 1, 2, true),
+            ("G3", 2, 3, true),
+            ("G4", 3, 4, true)
+        ],
+        "grazing points of the approach"
+    );
 }

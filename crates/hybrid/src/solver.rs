@@ -1491,8 +1491,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 if let Some((theta, _)) = crossed {
                     landing_tried = true;
                     let fraction = (theta + LANDING_OVERSHOOT).min(1.0);
-                    if fraction < 1.0 {
-                        h = clock.time_step(t0, fraction * dsigma);
+                    // (On a square-root clock a crossing next to its start lands a step of the
+                    // fraction squared: one too short to advance time is left to the
+                    // controller.)
+                    let landing_step = clock.time_step(t0, fraction * dsigma);
+                    if fraction < 1.0 && resolvable(landing_step, t0) {
+                        h = landing_step;
                         previous = None;
                         continue;
                     }
