@@ -530,33 +530,22 @@ pub(crate) fn surface_ahead<const D: usize>(
         let right = points[j];
         // side h' goes from negative to positive across the minimum.
         let rate = |s: f64| side * slope(s);
-        if !(rate(left) < 0.0 && rate(right) > 0.0) {
-            return None;
-        }
-        let (mut a, mut b) = (left, right);
-        for _ in 0..60 {
-            let mid = 0.5 * (a + b);
-            if rate(mid) < 0.0 {
-                a = mid;
-            } else {
-                b = mid;
-            }
-            if b - a <= 4.0 * f64::EPSILON * b {
-                break;
-            }
-        }
-        let s_m = 0.5 * (a + b);
-        let g_m = side * value(s_m);
-        let curvature = side
-            * power
+        let curvature = |s: f64| {
+            side * power
                 .iter()
                 .enumerate()
                 .skip(2)
                 .rev()
-                .fold(0.0, |acc, (k, &c)| acc * s_m + (k * (k - 1)) as f64 * c);
-        (g_m > 0.0 && curvature > 0.0).then(|| Ridge {
+                .fold(0.0, |acc, (k, &c)| acc * s + (k * (k - 1)) as f64 * c)
+        };
+        if !(rate(left) < 0.0 && rate(right) > 0.0) {
+            return None;
+        }
+        let s_m = bisect_newton(rate, curvature, left, right, false);
+        let (g_m, g2) = (side * value(s_m), curvature(s_m));
+        (g_m > 0.0 && g2 > 0.0).then(|| Ridge {
             at: s_m,
-            half_width: (2.0 * g_m / curvature).sqrt(),
+            half_width: (2.0 * g_m / g2).sqrt(),
         })
     });
     SurfaceAhead { zero, ridge }
