@@ -106,12 +106,9 @@ pub fn time_domain_impacts(model: &TappingModel, z_nm: f64, x0: &[f64], periods:
     time_domain_run(model, z_nm, x0, periods).impacts_last_period
 }
 
-/// Euclidean distance between two states (state units: nm and nm/us mixed).
+/// Euclidean distance between two states (state units: nm and nm/us mixed): `afm`'s, with the
+/// states' lengths checked.
 pub fn state_distance(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len(), "states of one model");
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt()
+    afm::state_distance(a, b)
 }

@@ -73,7 +73,7 @@ pub use orbit_prediction::{hermite_state, tangent_state};
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{
-    steady_orbit, steady_orbit_in, OrbitStart, SteadyOrbit, SteadyOrbitSettings,
+    state_distance, steady_orbit, steady_orbit_in, OrbitStart, SteadyOrbit, SteadyOrbitSettings,
     SteadyOrbitWorkspace,
 };
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};

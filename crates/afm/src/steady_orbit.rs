@@ -359,7 +359,7 @@ pub fn steady_orbit_in(
         states.push(x.clone());
         let last = states.len() - 1;
         let recurrence = (1..=settings.max_multiplicity.min(last))
-            .map(|k| (k, distance(&states[last], &states[last - k])))
+            .map(|k| (k, state_distance(&states[last], &states[last - k])))
             .find(|&(k, distance)| {
                 distance <= RECURRENCE_DISTANCE * scale && distance <= RETRY_FACTOR * failed_at[k]
             });
@@ -578,7 +578,7 @@ fn shoot_observed(
         )?
     };
     let mut full_tolerance = predicted;
-    if !predicted && distance(&image, &x) <= LOOSE_RESIDUAL_FLOOR {
+    if !predicted && state_distance(&image, &x) <= LOOSE_RESIDUAL_FLOOR {
         (image, first_sensitivities, observables) =
             observed_map(model, &x, full, false, integration, workspace)?;
         full_tolerance = true;
@@ -639,7 +639,7 @@ fn shoot_observed(
             integration,
             workspace,
         )?;
-        let next_residual = distance(&next_image, &candidate);
+        let next_residual = state_distance(&next_image, &candidate);
         if next_residual > newton.divergence_factor * residual {
             let observables = observables_at(model, &x, observables, integration, workspace)?;
             return Ok(ObservedShot {
@@ -780,7 +780,10 @@ fn iterate(
     Ok(x)
 }
 
-fn distance(a: &[f64], b: &[f64]) -> f64 {
+/// The Euclidean distance between two states of the model, `[q_1, q_1', ..., q_N, q_N']` (nm
+/// and nm/us mixed, as Newton's residual and the 1e-10 nm convergence test measure it).
+pub fn state_distance(a: &[f64], b: &[f64]) -> f64 {
+    debug_assert_eq!(a.len(), b.len(), "states of one model");
     a.iter()
         .zip(b)
         .map(|(x, y)| (x - y) * (x - y))

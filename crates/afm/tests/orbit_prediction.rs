@@ -5,8 +5,8 @@
 //! A/A0 = 0.95, 0.90, 0.50).
 
 use afm::{
-    builtin_case, hermite_state, steady_orbit, tangent_state, AfmError, OrbitStart, SteadyOrbit,
-    SteadyOrbitSettings, TappingModel,
+    builtin_case, hermite_state, state_distance, steady_orbit, tangent_state, AfmError, OrbitStart,
+    SteadyOrbit, SteadyOrbitSettings, TappingModel,
 };
 
 /// The Fig. 1 separations (nm), to the digits `drumroll simulate --amplitude-ratio` gives.
@@ -36,16 +36,8 @@ fn orbit(
     orbit
 }
 
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt()
-}
-
 fn norm(a: &[f64]) -> f64 {
-    distance(a, &vec![0.0; a.len()])
+    state_distance(a, &vec![0.0; a.len()])
 }
 
 /// Orbits 0.04, 0.03, 0.02 and 0.01 nm above `z`, each from the one above it, as an approach
@@ -84,7 +76,7 @@ fn the_tangent_is_the_slope_of_the_branch() {
                 .map(|(a, b)| (a - b) / (2.0 * h))
                 .collect();
             let tangent = centre.tangent.as_ref().expect("tangent");
-            let error = distance(tangent, &central);
+            let error = state_distance(tangent, &central);
             assert!(
                 error <= bound * (1.0 + norm(tangent)),
                 "Z = {z}, {sensitivity_tolerance:?}: |dx/dZ - central difference| = {error:e}, \
@@ -110,15 +102,15 @@ fn a_hermite_prediction_converges_in_one_newton_update() {
             "Z = {z}: {} Newton updates from the prediction",
             from_prediction.iterations
         );
-        let apart = distance(&from_prediction.state, &from_neighbour.state);
+        let apart = state_distance(&from_prediction.state, &from_neighbour.state);
         assert!(apart <= 1e-10, "Z = {z}: the two orbits {apart:e} nm apart");
 
         // Far better than the tangent line (by 270 to 1400 times), itself better than the
         // neighbour's state (by 10 to 150 times).
         let exact = &from_neighbour.state;
-        let error = distance(&prediction, exact);
-        let line_error = distance(&tangent_state(z, neighbour).expect("line"), exact);
-        let neighbour_error = distance(&neighbour.state, exact);
+        let error = state_distance(&prediction, exact);
+        let line_error = state_distance(&tangent_state(z, neighbour).expect("line"), exact);
+        let neighbour_error = state_distance(&neighbour.state, exact);
         assert!(
             error < 0.02 * line_error && line_error < 0.5 * neighbour_error,
             "Z = {z}: cubic {error:e}, tangent line {line_error:e}, neighbour {neighbour_error:e}"
@@ -137,11 +129,11 @@ fn the_hermite_prediction_is_of_fourth_order_on_the_branch() {
     for z in FIGURE_1_Z_NM {
         let above = approach_to(&model, z, &settings);
         let exact = orbit(&model, z, OrbitStart::Near(&above[3].state), &settings).state;
-        let fine = distance(
+        let fine = state_distance(
             &hermite_state(z, &above[2], &above[3]).expect("fine"),
             &exact,
         );
-        let coarse = distance(
+        let coarse = state_distance(
             &hermite_state(z, &above[0], &above[2]).expect("coarse"),
             &exact,
         );

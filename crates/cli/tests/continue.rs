@@ -5,7 +5,7 @@
 //! bad options refused with a message naming the option and its range, and the MAClever on
 //! mica's hysteresis between its two folds.
 
-use afm::{builtin_case, Separation, TappingModel};
+use afm::{builtin_case, state_distance, Separation, TappingModel};
 use assert_cmd::Command;
 use hybrid::{flow_map, Direction, Sensitivity, Settings};
 use serde_json::Value;
@@ -69,16 +69,8 @@ fn time_domain(
         .iter()
         .filter(|e| e.surface == 0 && e.direction == Direction::Down)
         .count();
-    let drift = distance(&last.state, &settled);
+    let drift = state_distance(&last.state, &settled);
     (impacts, last.state, drift)
-}
-
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt()
 }
 
 fn state_of(point: &Value) -> Vec<f64> {
@@ -347,11 +339,11 @@ fn maclever_on_mica_retract_reports_the_bistable_range_between_the_folds() {
     eprintln!(
         "folds [{fold_low}, {fold_high}] nm, bistable range [{low}, {high}] nm; at Z = {z} nm \
          the two runs end {} apart (drifts {drift_a:.1e}, {drift_b:.1e})",
-        distance(&end_a, &end_b)
+        state_distance(&end_a, &end_b)
     );
     assert!(
-        distance(&end_a, &end_b) > 1e-2,
+        state_distance(&end_a, &end_b) > 1e-2,
         "two distinct orbits at Z = {z} nm: {}",
-        distance(&end_a, &end_b)
+        state_distance(&end_a, &end_b)
     );
 }
