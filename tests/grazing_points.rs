@@ -164,7 +164,7 @@ fn g1_and_g2_are_located_on_every_case_and_g3_on_the_biolevers() {
             .approach
             .points
             .iter()
-            .map(|p| p.impacts_per_period)
+            .map(|p| p.impacts_per_orbit)
             .max()
             .expect("points");
         let expected: Vec<usize> = (1..=most).collect();
@@ -230,8 +230,8 @@ fn stable_orbits_at(diagram: &BifurcationDiagram, z: f64) -> Vec<(usize, usize, 
         if !(a.stable && b.stable && low <= z && z <= high) {
             continue;
         }
-        let impacts = if a.impacts_per_period == b.impacts_per_period {
-            a.impacts_per_period
+        let impacts = if a.impacts_per_orbit == b.impacts_per_orbit {
+            a.impacts_per_orbit
         } else {
             let special = diagram
                 .special_points
@@ -239,9 +239,9 @@ fn stable_orbits_at(diagram: &BifurcationDiagram, z: f64) -> Vec<(usize, usize, 
                 .find(|s| low <= s.z_nm && s.z_nm <= high)
                 .expect("a special point where the count changes");
             if (z - special.z_nm) * (a.z_nm - special.z_nm) > 0.0 {
-                a.impacts_per_period
+                a.impacts_per_orbit
             } else {
-                b.impacts_per_period
+                b.impacts_per_orbit
             }
         };
         let s = if high > low {
@@ -270,8 +270,8 @@ fn segment_of(diagram: &BifurcationDiagram, g: &DiagramSpecialPoint) -> usize {
             let (low, high) = (w[0].z_nm.min(w[1].z_nm), w[0].z_nm.max(w[1].z_nm));
             low <= g.z_nm
                 && g.z_nm <= high
-                && w[0].impacts_per_period == g.impacts_before
-                && w[1].impacts_per_period == g.impacts_after
+                && w[0].impacts_per_orbit == g.impacts_before
+                && w[1].impacts_per_orbit == g.impacts_after
         })
         .expect("the special point lies between two branch points with its counts")
 }

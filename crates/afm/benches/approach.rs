@@ -84,7 +84,7 @@ fn main() {
         let now = Instant::now();
         let seconds = (now - last).as_secs_f64();
         last = now;
-        let impacts = record.impacts as usize;
+        let impacts = record.impacts_per_period as usize;
         match per_regime.iter_mut().find(|r| r.0 == impacts) {
             Some(regime) => {
                 regime.1 += 1;
@@ -96,7 +96,7 @@ fn main() {
             last_z_print = record.z_nm;
             println!(
                 "  Z = {:7.3} nm  A/A0 = {:.4}  phase = {:8.3} deg  impacts = {}",
-                record.z_nm, record.amplitude_ratio, record.phase_deg, record.impacts
+                record.z_nm, record.amplitude_ratio, record.phase_deg, record.impacts_per_period
             );
         }
     }

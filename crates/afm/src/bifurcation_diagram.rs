@@ -100,7 +100,9 @@ impl DiagramSettings {
     }
 }
 
-/// One point of the diagram: a periodic orbit at a separation, with its observables.
+/// One point of the diagram: a periodic orbit at a separation, with its observables. The
+/// branch is one of period-1 orbits (the period map over one drive period), so its orbits have
+/// multiplicity 1 and an integer number of impacts per period.
 #[derive(Debug, Clone, Serialize)]
 pub struct DiagramPoint {
     /// Separation `Z`, nm.
@@ -109,14 +111,28 @@ pub struct DiagramPoint {
     pub amplitude_ratio: f64,
     /// Phase lag `Phi` of that harmonic, degrees.
     pub phase_deg: f64,
-    /// Impacts per period.
-    pub impacts_per_period: usize,
+    /// The orbit's period in drive periods (always 1 on the branch).
+    pub multiplicity: usize,
+    /// Impacts per drive period (impacts over the orbit over its multiplicity).
+    pub impacts_per_period: f64,
+    /// Impacts over the whole orbit.
+    pub impacts_per_orbit: usize,
     /// Every local minimum of the gap over the period.
     pub gap_minima: Vec<GapMinimum>,
+    /// The lowest of `gap_minima`, nm (`None` if there is none).
+    pub min_gap_nm: Option<f64>,
     /// Largest tip-sample force, nN.
     pub peak_force_nn: f64,
+    /// Mean tip-sample force over the period, nN.
+    pub mean_force_nn: f64,
+    /// Impulse `int F_ts dt` per drive period, nN us.
+    pub impulse_nn_us: f64,
+    /// Time in contact per drive period, in periods.
+    pub contact_time_periods: f64,
     /// Floquet multipliers `[re, im]`, by decreasing modulus.
     pub floquet_multipliers: Vec<[f64; 2]>,
+    /// The largest modulus of the Floquet multipliers.
+    pub spectral_radius: f64,
     /// Whether every multiplier lies inside the unit circle.
     pub stable: bool,
     /// The orbit's state at `t = 0`, `[q_1, q_1', ..., q_N, q_N']` (nm, nm/us).
@@ -298,14 +314,22 @@ fn multipliers_of(multipliers: &[Complex<f64>]) -> Vec<[f64; 2]> {
 }
 
 fn diagram_point(point: &BranchPoint, observables: &OrbitObservables) -> DiagramPoint {
+    let min_gap = observables.min_gap_nm();
     DiagramPoint {
         z_nm: point.parameter,
         amplitude_ratio: observables.amplitude_ratio,
         phase_deg: observables.phase_deg,
-        impacts_per_period: observables.impacts.len(),
+        multiplicity: observables.window_periods,
+        impacts_per_period: observables.impacts_per_period,
+        impacts_per_orbit: observables.impacts_per_window(),
         gap_minima: observables.gap_minima.clone(),
+        min_gap_nm: min_gap.is_finite().then_some(min_gap),
         peak_force_nn: observables.peak_force_nn,
+        mean_force_nn: observables.mean_force_nn,
+        impulse_nn_us: observables.impulse_nn_us,
+        contact_time_periods: observables.contact_time_periods,
         floquet_multipliers: multipliers_of(&point.multipliers),
+        spectral_radius: continuation::spectral_radius(&point.multipliers),
         stable: point.stable,
         state: point.state.as_slice().to_vec(),
         iterations: point.iterations,

@@ -66,15 +66,15 @@ pub use hertz::{effective_modulus_gpa, HertzContact};
 pub use impact_numbers::MultipleImpactNumbers;
 pub use model::TappingModel;
 pub use observables::{
-    observe_period, observe_period_in, orbit_observables, GapMinimum, Harmonic, Impact,
-    OrbitObservables, PeriodObserver,
+    observe_orbit_in, observe_period, observe_period_in, orbit_observables, GapMinimum,
+    GapMinimumKind, Harmonic, Impact, OrbitObservables, PeriodObserver, NEAR_IMPACT_FRACTION,
 };
 pub use orbit_prediction::{hermite_state, tangent_state};
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{
-    state_distance, steady_orbit, steady_orbit_in, OrbitStart, SteadyOrbit, SteadyOrbitSettings,
-    SteadyOrbitWorkspace,
+    state_distance, steady_orbit, steady_orbit_in, OrbitStart, PeriodBreakdown, SteadyOrbit,
+    SteadyOrbitSettings, SteadyOrbitWorkspace,
 };
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
 pub use theory::{

@@ -1,6 +1,7 @@
-//! Observables of a trajectory over one drive period (MODEL.md sections 4 and 5): the first
-//! (and higher) harmonics of `u`, the impacts with their onset velocities and peak forces, every
-//! local minimum of the gap, and the force integrals.
+//! Observables of a trajectory over a window of whole drive periods (MODEL.md sections 4 and
+//! 5): one period, or the `k` periods of a period-`k` orbit. The first (and higher) harmonics
+//! of `u`, the impacts with their onset velocities and peak forces, every local minimum of the
+//! gap, and the force integrals, all over the whole window.
 //!
 //! The Fourier coefficients are integrated in closed form over free flight
 //! ([`crate::free_flight_fourier`], exact to rounding; by quadrature near critical damping),
@@ -28,11 +29,12 @@ const DUPLICATE_FRACTION: f64 = 1e-9;
 /// One impact: a maximal interval with `d < 0` (MODEL.md section 5).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Impact {
-    /// Onset time, in periods from the window start (in `[0, 1)`).
+    /// Onset time, in drive periods from the window start (in `[0, k)` for a window of `k`
+    /// periods).
     pub start_periods: f64,
-    /// Release time, in periods from the window start; greater than 1 for an impact that wraps
-    /// around the period boundary (in progress at the start and at the end of the window of a
-    /// periodic orbit: one impact).
+    /// Release time, in drive periods from the window start; greater than `k` for an impact
+    /// that wraps around the window's end (in progress at the start and at the end of the
+    /// window of a periodic orbit: one impact).
     pub end_periods: f64,
     /// The gap's rate `d'` at onset (negative: approach speed), nm/us; NaN when the onset is not
     /// in the window (the tip is in contact at the start and free at the end, or in contact
@@ -42,48 +44,115 @@ pub struct Impact {
     pub peak_force_nn: f64,
 }
 
+/// A gap minimum above the sample is a near impact when it lies within this fraction of the
+/// free amplitude `A0` of the surface (MODEL.md section 5): close enough that a small change of
+/// `Z` (a tenth of the approach from first contact to `Z = 0`) turns it into an impact.
+pub const NEAR_IMPACT_FRACTION: f64 = 0.1;
+
+/// What a local minimum of the gap is, by its depth (MODEL.md section 5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GapMinimumKind {
+    /// `d < 0`: the deepest point of an impact.
+    Impact,
+    /// `0 <= d <= NEAR_IMPACT_FRACTION * A0`: a near impact, which becomes one at grazing.
+    NearImpact,
+    /// `d > NEAR_IMPACT_FRACTION * A0`: clear of the sample.
+    Clear,
+}
+
+impl GapMinimumKind {
+    /// The kind of a gap minimum `gap_nm` deep for a free amplitude `free_amplitude_nm`.
+    pub fn of(gap_nm: f64, free_amplitude_nm: f64) -> Self {
+        if gap_nm < 0.0 {
+            Self::Impact
+        } else if gap_nm <= NEAR_IMPACT_FRACTION * free_amplitude_nm {
+            Self::NearImpact
+        } else {
+            Self::Clear
+        }
+    }
+
+    /// The kind's name as in the JSON output: `impact`, `near-impact` or `clear`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Impact => "impact",
+            Self::NearImpact => "near-impact",
+            Self::Clear => "clear",
+        }
+    }
+}
+
 /// A local minimum of the gap `d(t)` (MODEL.md section 5): an impact's deepest point when
-/// negative, a near impact when positive; zero at grazing.
+/// negative, a near impact when a little positive; zero at grazing.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GapMinimum {
-    /// Time, in periods from the window start (in `[0, 1)`).
+    /// Time, in drive periods from the window start (in `[0, k)` for a window of `k` periods).
     pub t_periods: f64,
     /// The gap there, nm.
     pub gap_nm: f64,
+    /// Impact, near impact or clear, by [`GapMinimumKind::of`] with the model's `A0`.
+    pub kind: GapMinimumKind,
 }
 
 /// One harmonic `k` of the photodiode signal: `u ~ sum_k A_k cos(k w t - Phi_k)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Harmonic {
-    /// `A_k = hypot(a_k, b_k)`, nm, with `a_k = (2/T) int u cos(k w t) dt` and `b_k` with sin.
+    /// `A_k = hypot(a_k, b_k)`, nm, with `a_k = (2/W) int u cos(k w t) dt` and `b_k` with sin,
+    /// over the window `W` of whole drive periods (the lock-in reading of the whole window).
     pub amplitude_nm: f64,
     /// `Phi_k = atan2(b_k, a_k)`, degrees (a lag).
     pub phase_deg: f64,
 }
 
-/// The observables of a trajectory over one drive period `[t0, t0 + T]` (MODEL.md section 4).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The observables of a trajectory over a window of `k` whole drive periods
+/// `[t0, t0 + k T]` (MODEL.md sections 4 and 5): for a period-`k` orbit, the whole orbit.
+/// Lists (impacts, gap minima) cover the whole window; integrals are given per drive period.
+/// The default is an empty record (no window, no contact), for placeholders in tests.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct OrbitObservables {
-    /// First-harmonic amplitude `A` of `u`, nm.
+    /// The window's length `k` in drive periods (the orbit's multiplicity when the window is
+    /// a whole period-`k` orbit).
+    pub window_periods: usize,
+    /// First-harmonic amplitude `A` of `u` over the window, nm.
     pub amplitude_nm: f64,
     /// `A / A0`.
     pub amplitude_ratio: f64,
-    /// Phase lag `Phi` of the first harmonic of `u`, degrees.
+    /// Phase lag `Phi` of the first harmonic of `u` over the window, degrees.
     pub phase_deg: f64,
     /// Harmonics `k = 1..=K` of `u` (`harmonics[0]` repeats `A`, `Phi`).
     pub harmonics: Vec<Harmonic>,
-    /// The impacts in order of onset (a wrapped impact last); `impacts.len()` is `n`.
+    /// The impacts of the window in order of onset (a wrapped impact last).
     pub impacts: Vec<Impact>,
+    /// Impacts per drive period: `impacts.len() / k` (an integer for a period-1 window).
+    pub impacts_per_period: f64,
     /// Every local minimum of the gap in the window, in time order.
     pub gap_minima: Vec<GapMinimum>,
-    /// The largest tip-sample force, nN (0 without contact).
+    /// The largest tip-sample force in the window, nN (0 without contact).
     pub peak_force_nn: f64,
-    /// The mean tip-sample force `(1/T) int F_ts dt`, nN.
+    /// The mean tip-sample force `(1/(k T)) int F_ts dt` over the window, nN.
     pub mean_force_nn: f64,
-    /// The time in contact (`d < 0`), in periods.
+    /// The time in contact (`d < 0`) per drive period, in periods (the window's contact
+    /// time over `k`: the fraction of time in contact).
     pub contact_time_periods: f64,
-    /// The impulse per period `int F_ts dt`, nN us.
+    /// The impulse per drive period `(1/k) int F_ts dt` over the window, nN us.
     pub impulse_nn_us: f64,
+}
+
+impl OrbitObservables {
+    /// The impacts over the whole window (`n k` for a period-`k` orbit with `n` impacts per
+    /// period on average).
+    pub fn impacts_per_window(&self) -> usize {
+        self.impacts.len()
+    }
+
+    /// The lowest gap minimum of the window, nm (`+inf` when the window has none).
+    pub fn min_gap_nm(&self) -> f64 {
+        self.gap_minima
+            .iter()
+            .map(|m| m.gap_nm)
+            .fold(f64::INFINITY, f64::min)
+    }
 }
 
 /// An observer of the solver's steps that accumulates the observables of the window
@@ -97,6 +166,8 @@ pub struct PeriodObserver {
     start: f64,
     end: f64,
     period: f64,
+    /// The window's length in drive periods.
+    window_periods: usize,
     angular_frequency: f64,
     free_amplitude: f64,
     starts_in_contact: bool,
@@ -125,11 +196,27 @@ impl PeriodObserver {
     /// An observer of the period `[t0, t0 + T]` of `model` started from state `x0` at `t0`,
     /// recording harmonics `1..=harmonic_count` of `u` (at least 1).
     pub fn new(model: &TappingModel, t0: f64, x0: &[f64], harmonic_count: usize) -> Self {
+        Self::over_periods(model, t0, x0, 1, harmonic_count)
+    }
+
+    /// An observer of the window `[t0, t0 + k T]` of `k = window_periods` drive periods (at
+    /// least 1) of `model` started from state `x0` at `t0`, recording harmonics
+    /// `1..=harmonic_count` of `u` (at least 1). For a period-`k` orbit the window is the whole
+    /// orbit, and an impact in progress at both of its ends is one impact.
+    pub fn over_periods(
+        model: &TappingModel,
+        t0: f64,
+        x0: &[f64],
+        window_periods: usize,
+        harmonic_count: usize,
+    ) -> Self {
         let period = model.period_us();
+        let window_periods = window_periods.max(1);
         Self {
             start: t0,
-            end: t0 + period,
+            end: t0 + window_periods as f64 * period,
             period,
+            window_periods,
             angular_frequency: model.drive_angular_frequency(),
             free_amplitude: model.free_amplitude_nm(),
             starts_in_contact: model.mode_of(t0, x0) & CONTACT != 0,
@@ -236,7 +323,8 @@ impl PeriodObserver {
 
     /// The observables of the window (call after the solver has reached `t0 + T`).
     pub fn finish(&self, model: &TappingModel) -> OrbitObservables {
-        let scale = 2.0 / self.period;
+        let k = self.window_periods as f64;
+        let scale = 2.0 / (k * self.period);
         let harmonics: Vec<Harmonic> = self
             .fourier
             .iter()
@@ -251,21 +339,22 @@ impl PeriodObserver {
             .iter()
             .map(|impact| impact.peak_force_nn)
             .fold(0.0, f64::max);
-        let contact_time_periods = impacts
-            .iter()
-            .map(|impact| impact.end_periods - impact.start_periods)
-            .sum();
+        let contact_time_periods = impacts.iter().fold(0.0, |sum, impact| {
+            sum + (impact.end_periods - impact.start_periods)
+        }) / k;
         OrbitObservables {
+            window_periods: self.window_periods,
             amplitude_nm: harmonics[0].amplitude_nm,
             amplitude_ratio: harmonics[0].amplitude_nm / self.free_amplitude,
             phase_deg: harmonics[0].phase_deg,
             harmonics,
+            impacts_per_period: impacts.len() as f64 / k,
             impacts,
             gap_minima,
             peak_force_nn,
-            mean_force_nn: self.impulse / self.period,
+            mean_force_nn: self.impulse / (k * self.period),
             contact_time_periods,
-            impulse_nn_us: self.impulse,
+            impulse_nn_us: self.impulse / k,
         }
     }
 
@@ -282,6 +371,7 @@ impl PeriodObserver {
             .map(|&(t, gap)| GapMinimum {
                 t_periods: self.periods(t),
                 gap_nm: gap,
+                kind: GapMinimumKind::of(gap, self.free_amplitude),
             })
             .collect()
     }
@@ -332,11 +422,12 @@ impl PeriodObserver {
                 peak_force_nn: peak,
             });
         }
+        let window = self.window_periods as f64;
         if let Some((start, velocity)) = tail {
-            let mut peak = peak_in(start, 1.0).max(boundary_end);
-            let mut end = 1.0;
+            let mut peak = peak_in(start, window).max(boundary_end);
+            let mut end = window;
             if let Some((head_end, head_peak)) = head {
-                end = 1.0 + head_end;
+                end = window + head_end;
                 peak = peak.max(head_peak);
             } else if self.starts_in_contact && intervals.is_empty() {
                 // In contact throughout the window.
@@ -355,7 +446,7 @@ impl PeriodObserver {
 
 /// Integrate `model` over one period from `(t0, x0)` and return the flow map (state, monodromy
 /// and `dx/dZ` as `sensitivity` asks, events, extrema) with the period's observables, harmonics
-/// `1..=harmonic_count` of `u` included.
+/// `1..=harmonic_count` of `u` included ([`observe_window_in`] over one period).
 pub fn observe_period(
     model: &TappingModel,
     t0: f64,
@@ -386,6 +477,31 @@ pub fn observe_period_in(
     harmonic_count: usize,
     workspace: &mut SolverWorkspace,
 ) -> Result<(FlowMap, OrbitObservables), AfmError> {
+    check_state(model, x0)?;
+    let observer = PeriodObserver::new(model, t0, x0, harmonic_count);
+    observe_in(model, observer, x0, sensitivity, settings, workspace)
+}
+
+/// The observables of the whole period-`k` orbit of `model` through `x0` at `t = 0`
+/// (`k = multiplicity`, at least 1): one window of `k` drive periods, so that an impact in
+/// progress across a period boundary is one impact and every list and integral covers the
+/// orbit. Also returns the state after the `k` periods (`x0` again, to the integration's
+/// accuracy, on a converged orbit). The solver's buffers come from `workspace`.
+pub fn observe_orbit_in(
+    model: &TappingModel,
+    x0: &[f64],
+    multiplicity: usize,
+    settings: &Settings,
+    workspace: &mut SolverWorkspace,
+) -> Result<(Vec<f64>, OrbitObservables), AfmError> {
+    check_state(model, x0)?;
+    let observer = PeriodObserver::over_periods(model, 0.0, x0, multiplicity, 1);
+    observe_in(model, observer, x0, Sensitivity::None, settings, workspace)
+        .map(|(flow, observables)| (flow.state, observables))
+}
+
+/// An error unless `x0` has the model's dimension.
+fn check_state(model: &TappingModel, x0: &[f64]) -> Result<(), AfmError> {
     if x0.len() != model.dim() {
         return Err(invalid(
             "orbit observables",
@@ -394,12 +510,24 @@ pub fn observe_period_in(
             format!("the model's dimension 2N = {}", model.dim()),
         ));
     }
-    let mut observer = PeriodObserver::new(model, t0, x0, harmonic_count);
+    Ok(())
+}
+
+/// Integrate `model` from `x0` over the window of `observer` (from its start) and return the
+/// flow map with the window's observables.
+fn observe_in(
+    model: &TappingModel,
+    mut observer: PeriodObserver,
+    x0: &[f64],
+    sensitivity: Sensitivity,
+    settings: &Settings,
+    workspace: &mut SolverWorkspace,
+) -> Result<(FlowMap, OrbitObservables), AfmError> {
     let flow = flow_map_in(
         model,
-        t0,
+        observer.start,
         x0,
-        model.period_us(),
+        observer.window_periods as f64 * observer.period,
         sensitivity,
         settings,
         &mut |solver: &Solver<TappingModel>, outcome: &StepOutcome| {

@@ -67,6 +67,7 @@ pub fn tangent_state(z_nm: f64, orbit: &SteadyOrbit) -> Option<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::observables::OrbitObservables;
 
     /// An orbit whose state and slope are those of the cubic `x_i(Z) = c_i(Z)` at `z`.
     fn on_cubic(z: f64, cubics: &[[f64; 4]]) -> SteadyOrbit {
@@ -82,6 +83,7 @@ mod tests {
             multipliers: Vec::new(),
             stable: true,
             tangent: Some(cubics.iter().map(slope).collect()),
+            whole_orbit: OrbitObservables::default(),
             periods: Vec::new(),
         }
     }

@@ -19,7 +19,7 @@ use serde::Serialize;
 
 use crate::error::AfmError;
 use crate::model::TappingModel;
-use crate::observables::{observe_period_in, OrbitObservables};
+use crate::observables::{observe_orbit_in, observe_period_in, OrbitObservables};
 use crate::separation::Separation;
 use crate::validation::invalid;
 
@@ -138,37 +138,95 @@ pub struct SteadyOrbit {
     /// ([`OrbitStart::Predicted`]). `None` where `M - I` is singular (a fold of the branch,
     /// where `Z` cannot parametrise it) or the solve gives a non-finite vector.
     pub tangent: Option<Vec<f64>>,
-    /// The observables of each of the `k` drive periods of the orbit, in order.
+    /// The observables of the whole orbit: one window of its `k` drive periods, so that every
+    /// impact, gap minimum and force of every period is in it (times in drive periods from
+    /// `t = 0`, in `[0, k)`), integrals per drive period, and the first harmonic the lock-in
+    /// reading over `k T`.
+    pub whole_orbit: OrbitObservables,
+    /// The observables of each of the `k` drive periods of the orbit in order, each over its
+    /// own window `[j T, (j + 1) T]` (times from that period's start): its first harmonic,
+    /// force integrals, gap minima and peak force. Its impact list treats the one period as
+    /// periodic (an impact running across the window's end joins one running across its
+    /// start), so per-period impact counts come from [`SteadyOrbit::period_breakdown`].
     pub periods: Vec<OrbitObservables>,
 }
 
+/// One drive period of a period-`k` orbit: the per-period breakdown of its observables.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PeriodBreakdown {
+    /// The period's index `j` in the orbit, from 0 (the window `[j T, (j + 1) T]`).
+    pub period: usize,
+    /// `A / A0` of the first harmonic of `u` over this period alone.
+    pub amplitude_ratio: f64,
+    /// Phase lag `Phi` of that harmonic over this period alone, degrees.
+    pub phase_deg: f64,
+    /// The orbit's impacts whose onset lies in this period (an impact belongs to the period
+    /// it starts in; one in contact throughout the orbit belongs to period 0).
+    pub impacts: usize,
+    /// The largest tip-sample force in this period, nN.
+    pub peak_force_nn: f64,
+    /// The mean tip-sample force over this period, nN.
+    pub mean_force_nn: f64,
+    /// The impulse `int F_ts dt` over this period, nN us.
+    pub impulse_nn_us: f64,
+    /// The time in contact within this period, in periods.
+    pub contact_time_periods: f64,
+    /// The lowest local minimum of the gap in this period, nm (`null` in JSON if none).
+    pub min_gap_nm: Option<f64>,
+}
+
 impl SteadyOrbit {
-    /// The observables of the orbit's first drive period.
+    /// The observables of the whole orbit (all `k` periods; see [`SteadyOrbit::whole_orbit`]).
     pub fn observables(&self) -> &OrbitObservables {
-        &self.periods[0]
+        &self.whole_orbit
     }
 
-    /// The lock-in reading over the whole orbit (`k` periods): the first-harmonic Fourier
-    /// coefficients `a`, `b` of `u` averaged over the periods, returned as
-    /// `(A / A0, Phi in degrees)` (MODEL.md section 4).
+    /// The lock-in reading over the whole orbit (`k` periods): `(A / A0, Phi in degrees)` of
+    /// the first harmonic of `u` over `k T` (MODEL.md section 4), with `A0 =
+    /// free_amplitude_nm`.
     pub fn lockin(&self, free_amplitude_nm: f64) -> (f64, f64) {
-        let (mut a, mut b) = (0.0, 0.0);
-        for period in &self.periods {
-            let phase = period.phase_deg.to_radians();
-            a += period.amplitude_nm * phase.cos();
-            b += period.amplitude_nm * phase.sin();
-        }
-        let k = self.periods.len() as f64;
         (
-            (a / k).hypot(b / k) / free_amplitude_nm,
-            (b / k).atan2(a / k).to_degrees(),
+            self.whole_orbit.amplitude_nm / free_amplitude_nm,
+            self.whole_orbit.phase_deg,
         )
     }
 
-    /// Impacts per drive period: the total over the orbit's `k` periods divided by `k`.
+    /// Impacts per drive period: the impacts over the orbit's `k` periods divided by `k`.
     pub fn impacts_per_period(&self) -> f64 {
-        let total: usize = self.periods.iter().map(|p| p.impacts.len()).sum();
-        total as f64 / self.periods.len() as f64
+        self.whole_orbit.impacts_per_period
+    }
+
+    /// The impacts over the whole orbit (`k` periods), an integer.
+    pub fn impacts_per_orbit(&self) -> usize {
+        self.whole_orbit.impacts.len()
+    }
+
+    /// The per-period breakdown of the orbit's observables, one entry per drive period.
+    pub fn period_breakdown(&self, free_amplitude_nm: f64) -> Vec<PeriodBreakdown> {
+        self.periods
+            .iter()
+            .enumerate()
+            .map(|(j, period)| {
+                let onsets = j as f64..(j + 1) as f64;
+                let min_gap = period.min_gap_nm();
+                PeriodBreakdown {
+                    period: j,
+                    amplitude_ratio: period.amplitude_nm / free_amplitude_nm,
+                    phase_deg: period.phase_deg,
+                    impacts: self
+                        .whole_orbit
+                        .impacts
+                        .iter()
+                        .filter(|impact| onsets.contains(&impact.start_periods))
+                        .count(),
+                    peak_force_nn: period.peak_force_nn,
+                    mean_force_nn: period.mean_force_nn,
+                    impulse_nn_us: period.impulse_nn_us,
+                    contact_time_periods: period.contact_time_periods,
+                    min_gap_nm: min_gap.is_finite().then_some(min_gap),
+                }
+            })
+            .collect()
     }
 }
 
@@ -332,6 +390,7 @@ pub fn steady_orbit_in(
             stable: true,
             multipliers: first_multipliers,
             tangent: first_tangent,
+            whole_orbit: first.observables.clone(),
             periods: vec![first.observables],
         });
     }
@@ -791,7 +850,8 @@ pub fn state_distance(a: &[f64], b: &[f64]) -> f64 {
         .sqrt()
 }
 
-/// Assemble the orbit: the observables of each of its `k` periods from the converged state.
+/// Assemble the orbit: the observables of the whole orbit and of each of its `k` periods from
+/// the converged state.
 fn finish(
     model: &TappingModel,
     attempt: Attempt,
@@ -813,6 +873,18 @@ fn finish(
         periods.push(observables);
         x = flow.state;
     }
+    let whole_orbit = if attempt.multiplicity == 1 {
+        periods[0].clone()
+    } else {
+        observe_orbit_in(
+            model,
+            &attempt.state,
+            attempt.multiplicity,
+            &settings.integration,
+            workspace.for_maps(Sensitivity::None),
+        )?
+        .1
+    };
     Ok(SteadyOrbit {
         z_nm: model.parameter(),
         multiplicity: attempt.multiplicity,
@@ -823,6 +895,7 @@ fn finish(
         stable: is_stable(&attempt.multipliers),
         multipliers: attempt.multipliers,
         tangent: attempt.tangent,
+        whole_orbit,
         periods,
     })
 }

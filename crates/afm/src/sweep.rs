@@ -90,8 +90,9 @@ pub struct SweepRecord {
     pub amplitude_ratio: f64,
     /// The phase lag `Phi = atan2(b, a)` of the first harmonic of `u`, degrees.
     pub phase_deg: f64,
-    /// Contact onsets per drive cycle, averaged over the block (an integer for one cycle).
-    pub impacts: f64,
+    /// Impacts (contact onsets) per drive cycle, averaged over the block (an integer for a
+    /// block of one cycle).
+    pub impacts_per_period: f64,
     /// The largest tip-sample force in the block, nN.
     pub peak_force_nn: f64,
     /// Approach or retract.
@@ -105,7 +106,7 @@ impl SweepRecord {
             z_nm: block.z_nm,
             amplitude_ratio: block.amplitude_ratio,
             phase_deg: block.phase_deg,
-            impacts: block.impacts_per_cycle,
+            impacts_per_period: block.impacts_per_cycle,
             peak_force_nn: block.peak_force_nn,
             direction,
         }

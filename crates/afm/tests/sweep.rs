@@ -50,7 +50,7 @@ fn above_first_contact_the_lockin_reads_the_free_orbit() {
             (record.phase_deg - model.free_phase_deg()).abs() < 1e-9,
             "{record:?}"
         );
-        assert_eq!(record.impacts, 0.0);
+        assert_eq!(record.impacts_per_period, 0.0);
         assert_eq!(record.peak_force_nn, 0.0);
     }
 }
@@ -80,12 +80,12 @@ fn blocks_average_single_cycle_readings_and_every_decimates() {
         assert!((block.phase_deg - b.atan2(a).to_degrees()).abs() < 1e-10);
         let z_mean = cycles.iter().map(|c| c.z_nm).sum::<f64>() / 4.0;
         assert!((block.z_nm - z_mean).abs() < 1e-12);
-        let impacts = cycles.iter().map(|c| c.impacts).sum::<f64>() / 4.0;
-        assert_eq!(block.impacts, impacts);
+        let impacts = cycles.iter().map(|c| c.impacts_per_period).sum::<f64>() / 4.0;
+        assert_eq!(block.impacts_per_period, impacts);
         let peak = cycles.iter().map(|c| c.peak_force_nn).fold(0.0, f64::max);
         assert_eq!(block.peak_force_nn, peak);
         assert!(
-            block.impacts >= 1.0 && block.peak_force_nn > 0.0,
+            block.impacts_per_period >= 1.0 && block.peak_force_nn > 0.0,
             "in contact at 9 nm"
         );
     }
@@ -119,7 +119,7 @@ fn retract_mirrors_the_approach() {
             let expected = floor + ((k - leg) as f64 + 0.5) * z_step;
             assert!((record.z_nm - expected).abs() < 1e-12);
             // Two impacts per cycle both ways in this window (G2 is near 8.72 nm, G3 lower).
-            assert_eq!(record.impacts, 2.0);
+            assert_eq!(record.impacts_per_period, 2.0);
         }
     }
 }
@@ -143,8 +143,12 @@ fn default_settings_agree_with_a_brute_force_run() {
         let fine = run(&model, fine_settings);
         assert_eq!(coarse.len(), fine.len());
         for (c, f) in coarse.iter().zip(&fine) {
-            assert_eq!(c.impacts, f.impacts, "impacts at Z = {}", c.z_nm);
-            assert!(c.impacts >= 2.0);
+            assert_eq!(
+                c.impacts_per_period, f.impacts_per_period,
+                "impacts at Z = {}",
+                c.z_nm
+            );
+            assert!(c.impacts_per_period >= 2.0);
             // DOP853 at 1e-8 per step over ~50 contact steps per cycle: the readings differ by
             // ~1e-8 in A/A0 and ~1e-6 deg (measured ~7e-8 and 1e-5 deg even at 1e-7); 1e-6 and
             // 1e-4 deg keep a margin of 100 and still sit 1000 times inside the lock-in targets.
@@ -178,7 +182,10 @@ fn skipping_clear_free_flight_changes_no_record() {
         assert_eq!(skipping.len(), full.len());
         let (mut ratio, mut phase, mut force) = (0.0f64, 0.0f64, 0.0f64);
         for (s, f) in skipping.iter().zip(&full) {
-            assert_eq!((s.cycle, s.z_nm, s.impacts), (f.cycle, f.z_nm, f.impacts));
+            assert_eq!(
+                (s.cycle, s.z_nm, s.impacts_per_period),
+                (f.cycle, f.z_nm, f.impacts_per_period)
+            );
             ratio = ratio.max((s.amplitude_ratio - f.amplitude_ratio).abs());
             phase = phase.max((s.phase_deg - f.phase_deg).abs());
             force =

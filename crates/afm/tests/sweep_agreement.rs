@@ -128,7 +128,7 @@ fn sweep_follows_the_steady_orbit_around_g2() {
             record.phase_deg
         );
         assert_eq!(
-            record.impacts,
+            record.impacts_per_period,
             orbit.observables().impacts.len() as f64,
             "impacts at Z = {}",
             record.z_nm
@@ -141,19 +141,27 @@ fn sweep_follows_the_steady_orbit_around_g2() {
     // The impact count changes from 1 to 2 within 0.01 nm of G2.
     for record in &records {
         if record.z_nm > z_g2 + G2_TOLERANCE_NM {
-            assert_eq!(record.impacts, 1.0, "one impact at Z = {}", record.z_nm);
+            assert_eq!(
+                record.impacts_per_period, 1.0,
+                "one impact at Z = {}",
+                record.z_nm
+            );
         } else if record.z_nm < z_g2 - G2_TOLERANCE_NM {
-            assert_eq!(record.impacts, 2.0, "two impacts at Z = {}", record.z_nm);
+            assert_eq!(
+                record.impacts_per_period, 2.0,
+                "two impacts at Z = {}",
+                record.z_nm
+            );
         }
     }
     let lowest_single = records
         .iter()
-        .filter(|r| r.impacts == 1.0)
+        .filter(|r| r.impacts_per_period == 1.0)
         .map(|r| r.z_nm)
         .fold(f64::INFINITY, f64::min);
     let highest_double = records
         .iter()
-        .filter(|r| r.impacts == 2.0)
+        .filter(|r| r.impacts_per_period == 2.0)
         .map(|r| r.z_nm)
         .fold(f64::NEG_INFINITY, f64::max);
     assert!(

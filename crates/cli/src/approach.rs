@@ -7,16 +7,19 @@ use afm::{Sweep, SweepDirection, SweepRecord, SweepSettings, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::inputs::inputs_json;
 use crate::model_args::{output_path, ModelArgs};
 use crate::output::write_atomically;
-use crate::plot::{render_svg, Panel, Series, Stroke};
+use crate::plot::{render_svg, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 
-/// The CSV header: the required prefix, then the sweep direction.
-pub const CSV_HEADER: &str = "cycle,z_nm,amplitude_ratio,phase_deg,impacts,peak_force_nn,direction";
+/// The CSV header: the JSON Lines records' keys, in their order (docs/output-schema.md).
+pub const CSV_HEADER: &str =
+    "cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,direction";
 
 /// The most points drawn per series in `--plot` (records are thinned evenly beyond this).
 const MAX_PLOT_POINTS: usize = 20_000;
@@ -206,7 +209,7 @@ pub fn format_record(record: &SweepRecord, jsonl: bool, line: &mut String) -> Re
             record.z_nm,
             record.amplitude_ratio,
             record.phase_deg,
-            record.impacts,
+            record.impacts_per_period,
             record.peak_force_nn,
             record.direction.name()
         )?;
@@ -223,6 +226,21 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
     let settings = args.settings(&model)?;
+    let first_line = if args.jsonl {
+        let options = json!({
+            "from_nm": settings.from_nm,
+            "to_nm": settings.to_nm,
+            "rate_nm_per_s": settings.rate_nm_per_s,
+            "retract": settings.retract,
+            "settle_cycles": settings.settle_cycles,
+            "lockin_cycles": settings.lockin_cycles,
+            "every": settings.every,
+        });
+        let inputs = inputs_json("approach", options, &case, &model, &settings.integration);
+        format!("{}\n", json!({ "inputs": inputs }))
+    } else {
+        format!("{CSV_HEADER}\n")
+    };
     let mut sweep = Sweep::new(&model, settings).context("cannot set up the sweep")?;
     let mut sink = match &args.out {
         None => RecordSink::Stdout(std::io::stdout()),
@@ -232,7 +250,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
             path.clone(),
         ),
     };
-    if !args.jsonl && !sink.write_line(&format!("{CSV_HEADER}\n"))? {
+    if !sink.write_line(&first_line)? {
         return Ok(());
     }
     let progress = progress_bar(sweep.total_cycles());
@@ -326,6 +344,7 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             y_label: String::from("phase (deg)"),
             series: both(|r| (r.amplitude_ratio, r.phase_deg)),
             markers: Vec::new(),
+            y_period: Some(PHASE_PERIOD_DEG),
         },
         Panel {
             title: format!("{case}: amplitude ratio vs separation"),
@@ -333,6 +352,7 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             y_label: String::from("A/A0"),
             series: both(|r| (r.z_nm, r.amplitude_ratio)),
             markers: Vec::new(),
+            y_period: None,
         },
     ]
 }

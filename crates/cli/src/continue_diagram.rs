@@ -13,7 +13,7 @@ use std::path::PathBuf;
 
 use crate::model_args::{output_path, ModelArgs};
 use crate::output::write_atomically;
-use crate::plot::{render_svg, Marker, Panel, Series, Stroke};
+use crate::plot::{render_svg, Marker, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 
 /// Options of `drumroll continue`.
 #[derive(Debug, Clone, Args)]
@@ -152,10 +152,10 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         }
     }
     if let Some(path) = csv_path {
-        let mut text = csv_text(&approach, "approach");
+        let mut text = csv_text(&approach, "approach")?;
         if let Some(retract) = &retract {
             text.push_str(
-                csv_text(retract, "retract")
+                csv_text(retract, "retract")?
                     .split_once('\n')
                     .map_or("", |(_, rows)| rows),
             );
@@ -234,34 +234,44 @@ fn merge_ranges(mut ranges: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
     merged
 }
 
-/// The CSV of a diagram's points (header line first).
-fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> String {
-    let mut text = String::from("direction,z_nm,amplitude_ratio,phase_deg,impacts_per_period,stable,peak_force_nn,min_gap_nm,spectral_radius\n");
-    for p in &diagram.points {
-        let min_gap = p
-            .gap_minima
-            .iter()
-            .map(|m| m.gap_nm)
-            .fold(f64::INFINITY, f64::min);
-        let radius = p
-            .floquet_multipliers
-            .iter()
-            .map(|m| m[0].hypot(m[1]))
-            .fold(0.0, f64::max);
-        let _ = writeln!(
-            text,
-            "{direction},{},{},{},{},{},{},{},{}",
-            p.z_nm,
-            p.amplitude_ratio,
-            p.phase_deg,
-            p.impacts_per_period,
-            p.stable,
-            p.peak_force_nn,
-            min_gap,
-            radius
-        );
+/// The CSV columns after `direction`: the scalar keys of a JSON branch point, in this order
+/// (docs/output-schema.md).
+pub const CSV_COLUMNS: [&str; 15] = [
+    "z_nm",
+    "amplitude_ratio",
+    "phase_deg",
+    "multiplicity",
+    "impacts_per_period",
+    "impacts_per_orbit",
+    "min_gap_nm",
+    "peak_force_nn",
+    "mean_force_nn",
+    "impulse_nn_us",
+    "contact_time_periods",
+    "spectral_radius",
+    "stable",
+    "iterations",
+    "residual",
+];
+
+/// The CSV of a diagram's points (header line first): `direction` (`approach` or `retract`),
+/// then [`CSV_COLUMNS`], each the value of the JSON point's key of that name (empty for
+/// `null`).
+fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
+    let mut text = format!("direction,{}\n", CSV_COLUMNS.join(","));
+    for point in &diagram.points {
+        let value = serde_json::to_value(point)?;
+        text.push_str(direction);
+        for column in CSV_COLUMNS {
+            text.push(',');
+            match &value[column] {
+                serde_json::Value::Null => {}
+                other => text.push_str(&other.to_string()),
+            }
+        }
+        text.push('\n');
     }
-    text
+    Ok(text)
 }
 
 /// Split a diagram's points into runs of equal stability, as polylines of `(x, y)`.
@@ -347,6 +357,7 @@ fn panels(
                 .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.amplitude_ratio, p.phase_deg)))
                 .collect(),
             markers: phase_markers,
+            y_period: Some(PHASE_PERIOD_DEG),
         },
         Panel {
             title: String::from("A/A0 vs Z"),
@@ -357,6 +368,7 @@ fn panels(
                 .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.amplitude_ratio)))
                 .collect(),
             markers: z_markers,
+            y_period: None,
         },
         Panel {
             title: String::from("impacts per period vs Z"),
@@ -364,11 +376,10 @@ fn panels(
             y_label: String::from("impacts per period"),
             series: diagrams
                 .iter()
-                .flat_map(|(d, l, c)| {
-                    branch_series(d, l, *c, |p| (p.z_nm, p.impacts_per_period as f64))
-                })
+                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.impacts_per_period)))
                 .collect(),
             markers: Vec::new(),
+            y_period: None,
         },
     ]
 }

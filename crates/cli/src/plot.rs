@@ -50,6 +50,35 @@ pub struct Panel {
     pub series: Vec<Series>,
     /// Labelled points.
     pub markers: Vec<Marker>,
+    /// `Some(p)` when the vertical axis is an angle modulo `p` (360 for a phase in degrees,
+    /// wrapped to `(-180, 180]`): a line is broken, not drawn, between consecutive points more
+    /// than `p / 2` apart, so that a wrap does not draw a vertical line across the chart.
+    pub y_period: Option<f64>,
+}
+
+/// The period of a phase axis in degrees (see [`Panel::y_period`]).
+pub const PHASE_PERIOD_DEG: f64 = 360.0;
+
+/// `points` cut into polylines wherever consecutive `y` values are more than `period / 2`
+/// apart (a wrap of an angle modulo `period`); one polyline without a period.
+fn unwrapped_pieces(points: Vec<(f64, f64)>, period: Option<f64>) -> Vec<Vec<(f64, f64)>> {
+    let Some(period) = period else {
+        return vec![points];
+    };
+    let mut pieces: Vec<Vec<(f64, f64)>> = Vec::new();
+    for point in points {
+        match pieces.last_mut() {
+            Some(piece)
+                if piece
+                    .last()
+                    .is_some_and(|last| (point.1 - last.1).abs() <= 0.5 * period) =>
+            {
+                piece.push(point)
+            }
+            _ => pieces.push(vec![point]),
+        }
+    }
+    pieces
 }
 
 const PALETTE: [RGBColor; 6] = [
@@ -155,17 +184,27 @@ where
             .copied()
             .filter(|(x, y)| x.is_finite() && y.is_finite())
             .collect();
+        let pieces = unwrapped_pieces(finite, panel.y_period);
         let drawn = match series.stroke {
             Stroke::Solid => chart
-                .draw_series(LineSeries::new(finite, style))
+                .draw_series(
+                    pieces
+                        .into_iter()
+                        .map(|piece| PathElement::new(piece, style)),
+                )
                 .map_err(plot_error)?,
             Stroke::Dashed => chart
-                .draw_series(DashedLineSeries::new(finite, 6, 4, style))
+                .draw_series(
+                    pieces
+                        .into_iter()
+                        .flat_map(|piece| DashedLineSeries::new(piece, 6, 4, style)),
+                )
                 .map_err(plot_error)?,
             Stroke::Dots => chart
                 .draw_series(
-                    finite
+                    pieces
                         .into_iter()
+                        .flatten()
                         .map(|p| Circle::new(p, 1, colour.filled())),
                 )
                 .map_err(plot_error)?,
@@ -198,4 +237,21 @@ where
             .map_err(plot_error)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_phase_wrap_breaks_the_line_and_nothing_else_does() {
+        // A branch's phase running past -180 deg comes back at +180: two pieces, no segment
+        // spanning the wrap. Steps up to half the period stay joined.
+        let points = vec![(0.3, -170.0), (0.2, -179.0), (0.1, 179.5), (0.0, 170.0)];
+        let pieces = unwrapped_pieces(points.clone(), Some(PHASE_PERIOD_DEG));
+        assert_eq!(pieces, vec![points[..2].to_vec(), points[2..].to_vec()]);
+        let steep = vec![(0.0, -90.0), (1.0, 90.0)];
+        assert_eq!(unwrapped_pieces(steep.clone(), Some(360.0)), vec![steep]);
+        assert_eq!(unwrapped_pieces(points.clone(), None), vec![points]);
+    }
 }

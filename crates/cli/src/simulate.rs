@@ -84,10 +84,13 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     Ok(())
 }
 
-/// The JSON object of one steady orbit (units in the key names).
+/// The JSON object of one steady orbit (units in the key names; docs/output-schema.md). Every
+/// observable covers the whole orbit (all its `multiplicity` drive periods), with the
+/// per-period breakdown in `periods`.
 pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serde_json::Value {
     let observables = orbit.observables();
     let (amplitude_ratio, phase_deg) = orbit.lockin(model.free_amplitude_nm());
+    let min_gap = observables.min_gap_nm();
     json!({
         "case": case,
         "z_nm": orbit.z_nm,
@@ -98,21 +101,24 @@ pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serd
         "amplitude_ratio": amplitude_ratio,
         "phase_deg": phase_deg,
         "free_phase_deg": model.free_phase_deg(),
-        "impacts_per_period": orbit.impacts_per_period(),
         "multiplicity": orbit.multiplicity,
+        "impacts_per_period": orbit.impacts_per_period(),
+        "impacts_per_orbit": orbit.impacts_per_orbit(),
         "converged": orbit.converged,
         "newton_iterations": orbit.iterations,
         "residual": orbit.residual,
         "stable": orbit.stable,
         "floquet_multipliers": orbit.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "spectral_radius": continuation::spectral_radius(&orbit.multipliers),
         "gap_minima": observables.gap_minima,
+        "min_gap_nm": min_gap.is_finite().then_some(min_gap),
         "impacts": observables.impacts,
         "peak_force_nn": observables.peak_force_nn,
         "mean_force_nn": observables.mean_force_nn,
         "contact_time_periods": observables.contact_time_periods,
         "impulse_nn_us": observables.impulse_nn_us,
         "state": orbit.state,
-        "periods": orbit.periods,
+        "periods": orbit.period_breakdown(model.free_amplitude_nm()),
     })
 }
 
@@ -184,26 +190,61 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
         "A/A0 = {ratio:.6}   phase = {phase:.4} deg (free: {:.4} deg)",
         model.free_phase_deg()
     );
-    let _ = writeln!(s, "impacts per period: {}", orbit.impacts_per_period());
+    let k = orbit.multiplicity;
+    if k > 1 {
+        let _ = writeln!(
+            s,
+            "impacts per period: {} ({} over the orbit's {k} drive periods)",
+            orbit.impacts_per_period(),
+            orbit.impacts_per_orbit()
+        );
+    } else {
+        let _ = writeln!(s, "impacts per period: {}", orbit.impacts_per_orbit());
+    }
+    let time_origin = if k > 1 { "the orbit's start" } else { "t = 0" };
     for (i, impact) in observables.impacts.iter().enumerate() {
         let _ = writeln!(s, "  impact {}: t = {:.6} .. {:.6} periods, onset velocity {:.6} nm/us, peak force {:.6} nN",
             i + 1, impact.start_periods, impact.end_periods, impact.velocity_nm_per_us, impact.peak_force_nn);
     }
-    let _ = writeln!(s, "gap minima (t in periods, gap in nm):");
+    let _ = writeln!(
+        s,
+        "gap minima (t in drive periods from {time_origin}, gap d in nm; a near impact has 0 <= d <= {} A0 = {} nm):",
+        afm::NEAR_IMPACT_FRACTION,
+        afm::NEAR_IMPACT_FRACTION * model.free_amplitude_nm()
+    );
     for minimum in &observables.gap_minima {
-        let kind = if minimum.gap_nm < 0.0 {
-            "impact"
-        } else {
-            "near impact"
-        };
         let _ = writeln!(
             s,
-            "  t = {:.6}  d = {:+.6e}  ({kind})",
-            minimum.t_periods, minimum.gap_nm
+            "  t = {:.6}  d = {:+.6e}  ({})",
+            minimum.t_periods,
+            minimum.gap_nm,
+            minimum.kind.name()
         );
     }
     // (+ 0.0 prints a negative zero as 0.)
-    let _ = writeln!(s, "peak force {:.6} nN, mean force {:.6e} nN, contact time {:.6} periods, impulse {:.6} nN us",
+    let _ = writeln!(s, "peak force {:.6} nN, mean force {:.6e} nN, contact time {:.6} periods per period, impulse {:.6} nN us per period",
         observables.peak_force_nn, observables.mean_force_nn + 0.0, observables.contact_time_periods + 0.0, observables.impulse_nn_us + 0.0);
+    if k > 1 {
+        let _ = writeln!(
+            s,
+            "per period:  {:>9} {:>10} {:>8} {:>12} {:>12} {:>12}",
+            "A/A0", "phase", "impacts", "peak F (nN)", "impulse", "min gap (nm)"
+        );
+        for period in orbit.period_breakdown(model.free_amplitude_nm()) {
+            let _ = writeln!(
+                s,
+                "  period {:<3} {:>9.6} {:>10.4} {:>8} {:>12.6} {:>12.6} {:>12}",
+                period.period + 1,
+                period.amplitude_ratio,
+                period.phase_deg,
+                period.impacts,
+                period.peak_force_nn,
+                period.impulse_nn_us + 0.0,
+                period
+                    .min_gap_nm
+                    .map_or_else(|| String::from("none"), |gap| format!("{gap:+.4e}"))
+            );
+        }
+    }
     s
 }

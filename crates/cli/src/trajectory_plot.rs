@@ -48,6 +48,7 @@ pub fn trajectory_panels(
             y_label: String::from("u (nm)"),
             series: vec![series("", |s| s.u_nm)],
             markers: Vec::new(),
+            y_period: None,
         },
         Panel {
             title: String::from("tip-sample force (Hertz)"),
@@ -55,6 +56,7 @@ pub fn trajectory_panels(
             y_label: String::from("F_ts (nN)"),
             series: vec![series("", |s| s.force_nn)],
             markers: Vec::new(),
+            y_period: None,
         },
     ])
 }

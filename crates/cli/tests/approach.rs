@@ -68,7 +68,7 @@ fn csv_rows_follow_the_steady_orbit() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
-        Some("cycle,z_nm,amplitude_ratio,phase_deg,impacts,peak_force_nn,direction")
+        Some("cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,direction")
     );
     let rows: Vec<_> = lines.map(parse_row).collect();
     let free = simulate(12.0);
@@ -130,10 +130,19 @@ fn jsonl_file_with_retract_and_plot() {
     assert!(output.stdout.is_empty(), "records go to the file");
     let text = std::fs::read_to_string(&out).expect("records file");
     assert!(text.ends_with('\n'));
-    let records: Vec<Value> = text
+    let mut lines: Vec<Value> = text
         .lines()
         .map(|line| serde_json::from_str(line).expect("one complete object per line"))
         .collect();
+    // The first line holds the inputs: enough to run the sweep again.
+    let header = lines.remove(0);
+    let inputs = &header["inputs"];
+    assert_eq!(inputs["command"], "approach");
+    assert_eq!(inputs["case"], "biolever-mica");
+    assert_eq!(inputs["options"]["from_nm"].as_f64(), Some(from));
+    assert_eq!(inputs["options"]["retract"], true);
+    assert_eq!(inputs["cantilever"]["name"], "biolever");
+    let records = lines;
     let approach: Vec<&Value> = records
         .iter()
         .filter(|r| r["direction"] == "approach")
@@ -151,10 +160,13 @@ fn jsonl_file_with_retract_and_plot() {
             // Free flight: exact flow from the exact free state.
             assert!((record["amplitude_ratio"].as_f64().unwrap() - 1.0).abs() < 1e-9);
             assert!((record["phase_deg"].as_f64().unwrap() - free_phase).abs() < 1e-6);
-            assert_eq!(record["impacts"], 0.0);
+            assert_eq!(record["impacts_per_period"], 0.0);
         }
         if z < z_g1 - 1e-2 {
-            assert_eq!(record["impacts"], 1.0, "in contact below Z_G1: {record}");
+            assert_eq!(
+                record["impacts_per_period"], 1.0,
+                "in contact below Z_G1: {record}"
+            );
         }
     }
     let z: Vec<f64> = retract
@@ -242,7 +254,7 @@ fn a_killed_run_leaves_only_complete_records() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
-        Some("cycle,z_nm,amplitude_ratio,phase_deg,impacts,peak_force_nn,direction")
+        Some("cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,direction")
     );
     let rows: Vec<_> = lines.map(parse_row).collect();
     assert!(rows.len() > 100);

@@ -148,7 +148,7 @@ fn json_has_the_documented_fields_and_the_fixtures_grazing_points() {
         let point = points
             .iter()
             .find(|p| {
-                p["impacts_per_period"] == n
+                p["impacts_per_orbit"] == n
                     && p["stable"] == true
                     && p["gap_minima"]
                         .as_array()
@@ -203,13 +203,12 @@ fn csv_and_svg_are_written_whole() {
         assert!(same(z, number(&point["z_nm"])), "{z} vs {}", point["z_nm"]);
         let ratio: f64 = row[column("amplitude_ratio")].parse().expect("a number");
         assert!(same(ratio, number(&point["amplitude_ratio"])), "{ratio}");
-        let impacts: u64 = row[column("impacts_per_period")]
+        let impacts: f64 = row[column("impacts_per_period")].parse().expect("a number");
+        assert_eq!(impacts, number(&point["impacts_per_period"]));
+        let impacts: u64 = row[column("impacts_per_orbit")]
             .parse()
             .expect("an integer");
-        assert_eq!(
-            impacts,
-            point["impacts_per_period"].as_u64().expect("count")
-        );
+        assert_eq!(impacts, point["impacts_per_orbit"].as_u64().expect("count"));
         let stable: bool = row[column("stable")].parse().expect("true or false");
         assert_eq!(stable, point["stable"] == true);
     }

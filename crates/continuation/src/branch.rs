@@ -35,7 +35,8 @@ use crate::settings::ContinuationSettings;
 use crate::shooting::{shoot, NewtonSettings};
 use crate::special_point::{SpecialPoint, SpecialPointKind};
 use crate::test_function::{
-    neimark_sacker_test, period_doubling_test, structure_changes, ExtremumKind, StructureTest,
+    has_complex_pair_on_unit_circle, neimark_sacker_test, period_doubling_test, structure_changes,
+    ExtremumKind, StructureTest,
 };
 
 /// One accepted point of a branch of periodic orbits.
@@ -709,7 +710,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                 let (gl, gh) = (test(&segment.get(l)), test(&segment.get(h)));
                 gl.is_finite() && gh.is_finite() && sign(gl) != sign(gh)
             });
-            let (mut kind, location) = match continuous {
+            let (kind, location) = match continuous {
                 Some((l, h)) => {
                     let location =
                         segment.locate(l, h, &test, f64::NAN, tolerance, max_iterations)?;
@@ -733,15 +734,15 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
                     (kind, location)
                 }
             };
-            if kind == SpecialPointKind::NeimarkSacker {
-                let on_circle = location.point.as_ref().is_some_and(|s| {
-                    s.multipliers
-                        .iter()
-                        .any(|m| m.im.abs() > 1e-8 * m.norm() && (m.norm() - 1.0).abs() < 1e-3)
-                });
-                if !on_circle {
-                    kind = SpecialPointKind::NeutralSaddle;
-                }
+            // The Neimark-Sacker test also vanishes where two real multipliers have product 1
+            // (a neutral saddle): no bifurcation of the branch, so not a special point.
+            if kind == SpecialPointKind::NeimarkSacker
+                && !location
+                    .point
+                    .as_ref()
+                    .is_some_and(|s| has_complex_pair_on_unit_circle(&s.multipliers))
+            {
+                continue;
             }
             let converged = location.converged && continuous.is_some();
             found.push(self.special_point(segment, kind, &location, converged, index));
@@ -764,6 +765,16 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         let (pl, ph) = location.parameters;
         let point = location.point.clone().unwrap_or_else(|| low.clone());
         let n = point.u.len() - 1;
+        // A merge into, or a split out of, contact throughout the period has its own name.
+        let kind = match kind {
+            SpecialPointKind::Merge if high.map.structure.permanent_contact => {
+                SpecialPointKind::PermanentContact
+            }
+            SpecialPointKind::Split if low.map.structure.permanent_contact => {
+                SpecialPointKind::LiftOff
+            }
+            kind => kind,
+        };
         let (mut impacts_before, mut impacts_after) =
             (low.map.structure.impacts, high.map.structure.impacts);
         // A location converged onto the structure change itself can leave both bracket ends on
@@ -772,7 +783,11 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
         if impacts_before == impacts_after
             && matches!(
                 kind,
-                SpecialPointKind::Grazing | SpecialPointKind::Merge | SpecialPointKind::Split
+                SpecialPointKind::Grazing
+                    | SpecialPointKind::Merge
+                    | SpecialPointKind::Split
+                    | SpecialPointKind::PermanentContact
+                    | SpecialPointKind::LiftOff
             )
         {
             impacts_before = segment.get(0).map.structure.impacts;

@@ -222,6 +222,7 @@ impl<S: Parametrised> PeriodicProblem for HybridPeriodicProblem<S> {
             minima: Vec::new(),
             maxima: Vec::new(),
             impacts: 0,
+            permanent_contact: false,
             duration,
         };
         for extremum in flow.extrema.iter().filter(|e| e.surface == k) {
@@ -241,6 +242,14 @@ impl<S: Parametrised> PeriodicProblem for HybridPeriodicProblem<S> {
                 let value = self.virtual_minimum(&system, k, event.t, event.rate, &event.state);
                 structure.minima.push((event.t - self.start_time, value));
             }
+        }
+        // No crossing of the surface at all from a start inside it: in contact throughout, one
+        // impact (a maximal interval with h < 0 that is the whole period).
+        if !flow.events.iter().any(|e| e.surface == k)
+            && system.switching(k, self.start_time, x) < 0.0
+        {
+            structure.permanent_contact = true;
+            structure.impacts = 1;
         }
         structure.minima.sort_by(|a, b| a.0.total_cmp(&b.0));
         Ok(PeriodMap {

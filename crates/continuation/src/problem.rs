@@ -27,8 +27,13 @@ pub struct OrbitStructure {
     /// `(time since the period start, value of h)` of every local maximum of `h`; a maximum
     /// with `h < 0` between two contacts means they have merged.
     pub maxima: Vec<(f64, f64)>,
-    /// Number of impacts per period: `Down` crossings of (or impacts on) the contact surface.
+    /// Number of impacts per period: `Down` crossings of (or impacts on) the contact surface,
+    /// or 1 for a trajectory in contact throughout (see `permanent_contact`), so that the
+    /// count is the number of maximal intervals with `h < 0` (MODEL.md Sec. 5).
     pub impacts: usize,
+    /// Whether the trajectory stays inside the contact surface (`h < 0`) for the whole period,
+    /// crossing it nowhere: one impact without onset or release.
+    pub permanent_contact: bool,
     /// Duration of the period map (system time units): the times above lie in
     /// `[0, duration)` and are compared modulo it.
     pub duration: f64,

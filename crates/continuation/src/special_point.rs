@@ -12,9 +12,6 @@ pub enum SpecialPointKind {
     PeriodDoubling,
     /// A complex pair of multipliers crosses the unit circle.
     NeimarkSacker,
-    /// Two real multipliers with product 1 (the Neimark-Sacker test vanishes without a
-    /// complex pair on the unit circle): not a bifurcation.
-    NeutralSaddle,
     /// A local minimum of the contact switching function crosses zero: a grazing trajectory
     /// (MODEL.md Sec. 5), labelled `G<n>` with `n` the impacts per period after it.
     Grazing,
@@ -23,6 +20,13 @@ pub enum SpecialPointKind {
     Merge,
     /// A local maximum of the switching function rises above zero: one impact splits in two.
     Split,
+    /// The only local maximum of the switching function dips below zero: the free flight of a
+    /// single-impact orbit vanishes and the trajectory stays in contact throughout the period
+    /// (the impact merges with its own next period's copy; one impact on both sides).
+    PermanentContact,
+    /// A local maximum of a trajectory in contact throughout rises above zero: free flight
+    /// appears, the reverse of [`SpecialPointKind::PermanentContact`].
+    LiftOff,
     /// The impact count decreases with no extremum crossing zero.
     ImpactVanish,
     /// The impact count increases with no extremum crossing zero.
@@ -31,17 +35,18 @@ pub enum SpecialPointKind {
 
 impl SpecialPointKind {
     /// The label of a point of this kind with `impacts_after` impacts per period after it:
-    /// `G<n>`, `fold`, `period-doubling`, `neimark-sacker`, `neutral-saddle`, `merge`,
-    /// `split`, `impact-vanish`, `impact-appear`.
+    /// `G<n>`, `fold`, `period-doubling`, `neimark-sacker`, `merge`, `split`,
+    /// `permanent-contact`, `lift-off`, `impact-vanish`, `impact-appear`.
     pub fn label(self, impacts_after: usize) -> String {
         match self {
             SpecialPointKind::Fold => "fold".into(),
             SpecialPointKind::PeriodDoubling => "period-doubling".into(),
             SpecialPointKind::NeimarkSacker => "neimark-sacker".into(),
-            SpecialPointKind::NeutralSaddle => "neutral-saddle".into(),
             SpecialPointKind::Grazing => format!("G{impacts_after}"),
             SpecialPointKind::Merge => "merge".into(),
             SpecialPointKind::Split => "split".into(),
+            SpecialPointKind::PermanentContact => "permanent-contact".into(),
+            SpecialPointKind::LiftOff => "lift-off".into(),
             SpecialPointKind::ImpactVanish => "impact-vanish".into(),
             SpecialPointKind::ImpactAppear => "impact-appear".into(),
         }
@@ -51,8 +56,9 @@ impl SpecialPointKind {
 /// A located special point of a branch.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpecialPoint {
-    /// `G1`, `G2`, ..., `fold`, `period-doubling`, `neimark-sacker`, `neutral-saddle`,
-    /// `merge`, `split`, `impact-vanish`, `impact-appear` ([`SpecialPointKind::label`]).
+    /// `G1`, `G2`, ..., `fold`, `period-doubling`, `neimark-sacker`, `merge`, `split`,
+    /// `permanent-contact`, `lift-off`, `impact-vanish`, `impact-appear`
+    /// ([`SpecialPointKind::label`]).
     pub label: String,
     /// The kind of point.
     pub kind: SpecialPointKind,

@@ -5,7 +5,8 @@
 //!   `-1`);
 //! * Neimark-Sacker: `Re prod_{i<j} (mu_i mu_j - 1)` = `det(M (.) M - I)` on the bialternate
 //!   product (zero when a complex pair crosses the unit circle, `mu conj(mu) = 1`; also at a
-//!   neutral saddle, `mu_i mu_j = 1` real, which is labelled apart);
+//!   neutral saddle, `mu_i mu_j = 1` real, which is no bifurcation and not reported: a
+//!   located sign change counts only with a complex pair on the unit circle);
 //! * structure (MODEL.md Sec. 5): the value of each local minimum of the contact switching
 //!   function (zero at grazing), of each local maximum (zero when two contacts merge), and the
 //!   impact count per period. Extrema of two orbits are matched by their time in the period.
@@ -57,6 +58,23 @@ pub fn neimark_sacker_test(multipliers: &[Complex<f64>]) -> f64 {
         }
     }
     acc.re
+}
+
+/// A multiplier is complex when its imaginary part exceeds this fraction of its modulus
+/// (eigenvalues of a real matrix that are real come out with rounding-level imaginary parts).
+const COMPLEX_FRACTION: f64 = 1e-8;
+
+/// A located Neimark-Sacker point's complex pair is on the unit circle when its modulus is
+/// within this of 1 (the location's precision in the parameter leaves the modulus this close).
+const UNIT_CIRCLE_DISTANCE: f64 = 1e-3;
+
+/// Whether a complex pair of `multipliers` lies on the unit circle: what tells a true
+/// Neimark-Sacker point from a neutral saddle (two real multipliers with product 1, where the
+/// bialternate test also vanishes but no bifurcation happens).
+pub(crate) fn has_complex_pair_on_unit_circle(multipliers: &[Complex<f64>]) -> bool {
+    multipliers.iter().any(|m| {
+        m.im.abs() > COMPLEX_FRACTION * m.norm() && (m.norm() - 1.0).abs() < UNIT_CIRCLE_DISTANCE
+    })
 }
 
 /// Which kind of extremum of the switching function a structure test follows.
@@ -241,12 +259,14 @@ mod tests {
             maxima: vec![],
             impacts: 0,
             duration: 1.0,
+            permanent_contact: false,
         };
         let b = OrbitStructure {
             minima: vec![(0.01, -0.01), (0.5, 0.3)],
             maxima: vec![],
             impacts: 1,
             duration: 1.0,
+            permanent_contact: false,
         };
         let tests = structure_changes(&a, &b);
         assert_eq!(tests.len(), 1, "{tests:?}");
@@ -256,6 +276,7 @@ mod tests {
             maxima: vec![],
             impacts: 0,
             duration: 1.0,
+            permanent_contact: false,
         };
         assert_eq!(tests[0].value(0.5, &mid), 0.002);
         assert!((tests[0].linear_root() - 0.5).abs() < 1e-15);

@@ -46,6 +46,7 @@ impl PeriodicProblem for Quadratic {
                 maxima: vec![(0.375, max)],
                 impacts,
                 duration: 1.0,
+                permanent_contact: false,
             },
         })
     }
