@@ -11,6 +11,7 @@ use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
 use crate::output::write_atomically;
 use crate::plot::{render_svg, Marker, Panel, Series, Stroke, PHASE_PERIOD_DEG};
@@ -114,7 +115,15 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         merge_ranges(ranges)
     });
     if args.json {
+        let options = json!({
+            "floor_nm": settings.z_limit_nm,
+            "min_amplitude_ratio": settings.min_amplitude_ratio,
+            "max_step_nm": settings.max_step,
+            "max_points": settings.max_points,
+            "retract": args.retract,
+        });
         let mut object = json!({
+            "inputs": orbit_inputs_json("continue", options, &case, &model, &settings.orbit),
             "case": case.name,
             "free_amplitude_nm": model.free_amplitude_nm(),
             "first_contact_z_nm": model.grazing_separation_nm(),

@@ -10,6 +10,8 @@ use clap::Args;
 use serde_json::json;
 use std::path::PathBuf;
 
+use crate::digits;
+use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
 use crate::output::write_atomically;
 use crate::plot::render_svg;
@@ -66,10 +68,10 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         _ => bail!("give exactly one of --z and --amplitude-ratio"),
     };
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&orbit_json(&case.name, &model, &orbit))?
-        );
+        let mut object = orbit_json(&case.name, &model, &orbit);
+        let options = json!({ "z_nm": args.z, "amplitude_ratio": args.amplitude_ratio });
+        object["inputs"] = orbit_inputs_json("simulate", options, &case, &model, &settings);
+        println!("{}", serde_json::to_string_pretty(&object)?);
     } else {
         print!("{}", summary(&case.name, &model, &orbit));
     }
@@ -191,15 +193,15 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
         model.free_phase_deg()
     );
     let k = orbit.multiplicity;
+    let per_period = digits::impacts_per_period(orbit.impacts_per_orbit(), k);
     if k > 1 {
         let _ = writeln!(
             s,
-            "impacts per period: {} ({} over the orbit's {k} drive periods)",
-            orbit.impacts_per_period(),
+            "impacts per period: {per_period} ({} over the orbit's {k} drive periods)",
             orbit.impacts_per_orbit()
         );
     } else {
-        let _ = writeln!(s, "impacts per period: {}", orbit.impacts_per_orbit());
+        let _ = writeln!(s, "impacts per period: {per_period}");
     }
     let time_origin = if k > 1 { "the orbit's start" } else { "t = 0" };
     for (i, impact) in observables.impacts.iter().enumerate() {

@@ -30,7 +30,7 @@ pub fn trajectory_panels(
     let title = format!(
         "Z = {:.4} nm, A/A0 = {ratio:.3}, {} impact(s) per period",
         orbit.z_nm,
-        orbit.impacts_per_period()
+        crate::digits::impacts_per_period(orbit.impacts_per_orbit(), orbit.multiplicity)
     );
     let series = |label: &str, value: fn(&afm::TrajectorySample) -> f64| Series {
         label: label.to_string(),

@@ -1,0 +1,272 @@
+//! Every command's output against the schema document, `docs/output-schema.md`: each key the
+//! real binary prints is listed there with the type it has, each listed key is printed by some
+//! run, and the CSV columns are the JSON keys in the documented order.
+
+mod common;
+use common::drumroll;
+
+use serde_json::Value;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The schema document's rows: section heading -> (key path -> allowed JSON types).
+type Schema = BTreeMap<String, BTreeMap<String, BTreeSet<&'static str>>>;
+
+fn document() -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/output-schema.md");
+    std::fs::read_to_string(path).expect("docs/output-schema.md")
+}
+
+/// The JSON types a documented type admits (`number or null` admits both).
+fn allowed(text: &str) -> BTreeSet<&'static str> {
+    let mut types = BTreeSet::new();
+    for word in text.split(" or ") {
+        types.insert(match word.trim() {
+            "number" => "number",
+            "integer" => "integer",
+            "string" => "string",
+            "boolean" => "boolean",
+            "array" => "array",
+            "object" => "object",
+            "null" => "null",
+            other => panic!("unknown type `{other}` in the schema"),
+        });
+    }
+    types
+}
+
+/// The key tables of the document, by the section (`## ...` heading) they stand in.
+fn schema(text: &str) -> Schema {
+    let mut schema = Schema::new();
+    let mut section = String::new();
+    for line in text.lines() {
+        if let Some(heading) = line.strip_prefix("## ") {
+            section = heading.to_string();
+            continue;
+        }
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        // `| `key` | type | unit | meaning |`: cells 1 and 2 (cell 0 is before the first bar).
+        if cells.len() < 5 || !cells[1].starts_with('`') {
+            continue;
+        }
+        let Some(key) = cells[1].strip_prefix('`').and_then(|k| k.strip_suffix('`')) else {
+            continue;
+        };
+        if section.starts_with("Special point labels") {
+            continue;
+        }
+        schema
+            .entry(section.clone())
+            .or_default()
+            .insert(key.to_string(), allowed(cells[2]));
+    }
+    schema
+}
+
+fn json_type(value: &Value) -> &'static str {
+    match value {
+        Value::Null => "null",
+        Value::Bool(_) => "boolean",
+        Value::Number(n) if n.is_f64() => "number",
+        Value::Number(_) => "integer",
+        Value::String(_) => "string",
+        Value::Array(_) => "array",
+        Value::Object(_) => "object",
+    }
+}
+
+/// Every key path of `value` under `path` with the types seen there. The keys of the
+/// `retract` object are those of the top level (the schema documents them once).
+fn flatten(value: &Value, path: &str, seen: &mut BTreeMap<String, BTreeSet<&'static str>>) {
+    if !path.is_empty() {
+        seen.entry(path.to_string())
+            .or_default()
+            .insert(json_type(value));
+    }
+    match value {
+        Value::Object(map) => {
+            for (key, child) in map {
+                let child_path = match path {
+                    "" => key.clone(),
+                    "retract" => key.clone(),
+                    _ => format!("{path}.{key}"),
+                };
+                flatten(child, &child_path, seen);
+            }
+        }
+        Value::Array(items) => {
+            for item in items {
+                flatten(item, &format!("{path}[]"), seen);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The standard output of `drumroll ARGS`, required to succeed.
+fn stdout_of(args: &[&str]) -> String {
+    let output = drumroll().args(args).output().expect("runs");
+    assert!(
+        output.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout).expect("utf-8")
+}
+
+/// Check the outputs of `runs` (each parsed into JSON values) against `section` and the
+/// `inputs` section: every key printed is documented with its type, and every key of
+/// `section` is printed by one of the runs.
+fn check(schema: &Schema, section: &str, runs: &[Vec<Value>]) -> BTreeSet<String> {
+    let documented = &schema[section];
+    let inputs = &schema["The `inputs` object"];
+    let mut seen = BTreeMap::new();
+    for run in runs {
+        for value in run {
+            flatten(value, "", &mut seen);
+        }
+    }
+    for (path, types) in &seen {
+        // An array's element objects are documented by their keys (`points[].z_nm`).
+        if path.ends_with("[]") && types.len() == 1 && types.contains("object") {
+            continue;
+        }
+        let allowed = documented
+            .get(path)
+            .or_else(|| inputs.get(path))
+            .unwrap_or_else(|| panic!("{section}: `{path}` is printed but not documented"));
+        assert!(
+            types.is_subset(allowed),
+            "{section}: `{path}` is printed as {types:?}, documented as {allowed:?}"
+        );
+    }
+    for path in documented.keys() {
+        assert!(
+            seen.contains_key(path),
+            "{section}: `{path}` is documented but no run printed it"
+        );
+    }
+    seen.into_keys().collect()
+}
+
+#[test]
+fn every_command_prints_exactly_the_documented_keys_and_types() {
+    let schema = schema(&document());
+    let one = |args: &[&str]| vec![serde_json::from_str::<Value>(&stdout_of(args)).expect("JSON")];
+    let mut printed = BTreeSet::new();
+
+    // simulate: a period-1 orbit with impacts, the period-4 orbit at 72 kHz (a period
+    // without gap minimum: `null`), and one found by its amplitude ratio.
+    let simulate = [
+        one(&[
+            "simulate",
+            "--case",
+            "biolever-mica",
+            "--z",
+            "8.5",
+            "--json",
+        ]),
+        one(&[
+            "simulate",
+            "--case",
+            "biolever-mica",
+            "--drive-frequency",
+            "72",
+            "--z",
+            "0.5",
+            "--json",
+        ]),
+        one(&["simulate", "--amplitude-ratio", "0.9", "--json"]),
+    ];
+    printed.extend(check(&schema, "`drumroll simulate --json`", &simulate));
+
+    // continue: the MAClever on mica with its retract (folds, bistable range).
+    let continued = [one(&[
+        "continue",
+        "--case",
+        "maclever-mica",
+        "--retract",
+        "--json",
+    ])];
+    printed.extend(check(&schema, "`drumroll continue --json`", &continued));
+
+    // approach, JSON Lines: the inputs line, then records of both directions.
+    let text = stdout_of(&[
+        "approach",
+        "--from",
+        "8.8",
+        "--to",
+        "8.79",
+        "--rate",
+        "10",
+        "--retract",
+        "--jsonl",
+    ]);
+    let lines: Vec<Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one object per line"))
+        .collect();
+    assert!(lines[0].get("inputs").is_some() && lines[0].get("cycle").is_none());
+    printed.extend(check(
+        &schema,
+        "`drumroll approach` (CSV, `--jsonl`)",
+        &[lines],
+    ));
+
+    // Every documented key of the inputs object is printed by some command.
+    for path in schema["The `inputs` object"].keys() {
+        assert!(
+            printed.contains(path),
+            "`{path}` is documented, never printed"
+        );
+    }
+}
+
+#[test]
+fn csv_columns_are_the_documented_json_keys_in_order() {
+    let text = document();
+    let schema = schema(&text);
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let csv = directory.path().join("branch.csv");
+    stdout_of(&[
+        "continue",
+        "--floor",
+        "9.5",
+        "--csv",
+        csv.to_str().expect("utf-8 path"),
+    ]);
+    let written = std::fs::read_to_string(&csv).expect("CSV");
+    let header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    assert_eq!(header[0], "direction");
+    let points = &schema["`drumroll continue --json`"];
+    for column in &header[1..] {
+        let types = points
+            .get(&format!("points[].{column}"))
+            .unwrap_or_else(|| panic!("CSV column `{column}` is no JSON point key"));
+        assert!(!types.contains("array") && !types.contains("object"));
+    }
+    // The CSV section lists the columns in the header's order.
+    let section = text
+        .split("## `drumroll continue --csv FILE`")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .expect("the CSV section");
+    let listed: Vec<&str> = section
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|word| header.contains(word))
+        .collect();
+    assert_eq!(listed, header);
+
+    // approach's CSV header is the documented line, each column a record key.
+    let sweep = stdout_of(&["approach", "--from", "8.8", "--to", "8.79", "--rate", "10"]);
+    let header = sweep.lines().next().expect("header");
+    assert!(
+        text.contains(&format!("`{header}`")),
+        "header {header} not documented"
+    );
+    let records = &schema["`drumroll approach` (CSV, `--jsonl`)"];
+    for column in header.split(',') {
+        assert!(records.contains_key(column), "column `{column}`");
+    }
+}
