@@ -6,7 +6,7 @@
 /// fraction with three decimals (`1/3 = 0.333`).
 pub fn impacts_per_period(impacts_per_orbit: usize, multiplicity: usize) -> String {
     let k = multiplicity.max(1);
-    if impacts_per_orbit % k == 0 {
+    if impacts_per_orbit.is_multiple_of(k) {
         (impacts_per_orbit / k).to_string()
     } else {
         format!(
