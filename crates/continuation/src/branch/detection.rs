@@ -1,0 +1,243 @@
+//! Special points in a continuation step: every test function that changes sign between the
+//! step's two orbits, located along the step by root finding (MODEL.md Sec. 5 and
+//! [`crate::test_function`]): structure changes (grazing, merge, split, impact count) first,
+//! then the smooth tests (fold, period doubling, Neimark-Sacker) between their brackets.
+
+use super::Continuation;
+use crate::error::ContinuationError;
+use crate::location::{Location, Sample, Segment};
+use crate::problem::PeriodicProblem;
+use crate::special_point::{SpecialPoint, SpecialPointKind};
+use crate::test_function::{
+    has_complex_pair_on_unit_circle, neimark_sacker_test, period_doubling_test, ExtremumKind,
+    StructureTest,
+};
+
+/// A test function of a corrected orbit on a step.
+type SampleTest = fn(&Sample) -> f64;
+
+impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
+    /// Locate every sign change of a test function in the step held by `segment`.
+    pub(super) fn locate_all(
+        &self,
+        segment: &Segment<'_, P>,
+        structure: &[StructureTest],
+        index: usize,
+        jumped: bool,
+        smooth_tests: bool,
+    ) -> Result<Vec<SpecialPoint>, ContinuationError> {
+        let mut found: Vec<(f64, SpecialPoint)> = Vec::new();
+        let breaks =
+            self.locate_structure_changes(segment, structure, index, jumped, &mut found)?;
+        if smooth_tests {
+            self.locate_smooth_changes(segment, &breaks, index, &mut found)?;
+        }
+        found.sort_by(|x, y| x.0.total_cmp(&y.0));
+        Ok(found.into_iter().map(|(_, s)| s).collect())
+    }
+
+    /// Locate each structure test's sign change in the step (grazing, merge, split, impact
+    /// count) into `found` as `(sigma, point)`; returns the brackets `(low, high)` of the
+    /// segment's samples around each, between which the smooth tests are located.
+    fn locate_structure_changes(
+        &self,
+        segment: &Segment<'_, P>,
+        structure: &[StructureTest],
+        index: usize,
+        jumped: bool,
+        found: &mut Vec<(f64, SpecialPoint)>,
+    ) -> Result<Vec<(usize, usize)>, ContinuationError> {
+        let tolerance = self.settings.location_tolerance;
+        let max_iterations = self.settings.location_max_iterations;
+        let mut breaks: Vec<(usize, usize)> = Vec::new();
+        for test in structure {
+            let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
+            // Across a corner, a failed trial lies past the structure change (B side).
+            let failure = if jumped {
+                value(&segment.get(1))
+            } else {
+                f64::NAN
+            };
+            let location = segment.locate(0, 1, &value, failure, tolerance, max_iterations)?;
+            let kind = match *test {
+                StructureTest::Extremum {
+                    kind: ExtremumKind::Minimum,
+                    ..
+                } => SpecialPointKind::Grazing,
+                StructureTest::Extremum {
+                    kind: ExtremumKind::Maximum,
+                    value_a,
+                    ..
+                } => {
+                    if value_a >= 0.0 {
+                        SpecialPointKind::Merge
+                    } else {
+                        SpecialPointKind::Split
+                    }
+                }
+                StructureTest::ImpactCount { n_a, n_b } => {
+                    if n_b < n_a {
+                        SpecialPointKind::ImpactVanish
+                    } else {
+                        SpecialPointKind::ImpactAppear
+                    }
+                }
+            };
+            breaks.push((location.low.unwrap_or(0), location.high.unwrap_or(1)));
+            found.push(self.special_point(segment, kind, &location, location.converged, index));
+        }
+        Ok(breaks)
+    }
+
+    /// Locate the sign changes of the smooth (tangent and multiplier) tests, fold and, with
+    /// `detect_bifurcations`, period doubling and Neimark-Sacker, into `found`: within the
+    /// intervals between the structure brackets `breaks` where the test changes sign
+    /// continuously, else (a sign change across a structure change) at that bracket, not
+    /// converged.
+    fn locate_smooth_changes(
+        &self,
+        segment: &Segment<'_, P>,
+        breaks: &[(usize, usize)],
+        index: usize,
+        found: &mut Vec<(f64, SpecialPoint)>,
+    ) -> Result<(), ContinuationError> {
+        let tolerance = self.settings.location_tolerance;
+        let max_iterations = self.settings.location_max_iterations;
+        let mut smooth: Vec<(SpecialPointKind, SampleTest)> = Vec::new();
+        smooth.push((SpecialPointKind::Fold, |s: &Sample| {
+            s.tangent[s.tangent.len() - 1]
+        }));
+        if self.settings.detect_bifurcations {
+            smooth.push((SpecialPointKind::PeriodDoubling, |s: &Sample| {
+                period_doubling_test(&s.multipliers)
+            }));
+            smooth.push((SpecialPointKind::NeimarkSacker, |s: &Sample| {
+                neimark_sacker_test(&s.multipliers)
+            }));
+        }
+        let sign = |g: f64| g < 0.0;
+        let a0 = segment.get(0);
+        let b1 = segment.get(1);
+        for (kind, test) in smooth {
+            let (ga, gb) = (test(&a0), test(&b1));
+            if !(ga.is_finite() && gb.is_finite()) || sign(ga) == sign(gb) {
+                continue;
+            }
+            // Intervals between the structure brackets, in sigma order.
+            let mut cuts: Vec<(f64, usize, usize)> = breaks
+                .iter()
+                .map(|&(l, h)| (segment.get(l).sigma, l, h))
+                .collect();
+            cuts.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let mut intervals = Vec::new();
+            let mut lo = 0;
+            for &(_, l, h) in &cuts {
+                intervals.push((lo, l));
+                lo = h;
+            }
+            intervals.push((lo, 1));
+            let continuous = intervals.iter().copied().find(|&(l, h)| {
+                let (gl, gh) = (test(&segment.get(l)), test(&segment.get(h)));
+                gl.is_finite() && gh.is_finite() && sign(gl) != sign(gh)
+            });
+            let (kind, location) = match continuous {
+                Some((l, h)) => {
+                    let location =
+                        segment.locate(l, h, &test, f64::NAN, tolerance, max_iterations)?;
+                    (kind, location)
+                }
+                None => {
+                    // The sign change happens across a structure change (a jump).
+                    let Some(&(_, l, h)) = cuts.iter().find(|&&(_, l, h)| {
+                        sign(test(&segment.get(l))) != sign(test(&segment.get(h)))
+                    }) else {
+                        continue;
+                    };
+                    let location = Location {
+                        point: Some(segment.get(l)),
+                        low: Some(l),
+                        high: Some(h),
+                        parameters: (segment.get(l).parameter(), segment.get(h).parameter()),
+                        converged: false,
+                        iterations: 0,
+                    };
+                    (kind, location)
+                }
+            };
+            // The Neimark-Sacker test also vanishes where two real multipliers have product 1
+            // (a neutral saddle): no bifurcation of the branch, so not a special point.
+            if kind == SpecialPointKind::NeimarkSacker
+                && !location
+                    .point
+                    .as_ref()
+                    .is_some_and(|s| has_complex_pair_on_unit_circle(&s.multipliers))
+            {
+                continue;
+            }
+            let converged = location.converged && continuous.is_some();
+            found.push(self.special_point(segment, kind, &location, converged, index));
+        }
+        Ok(())
+    }
+
+    /// Assemble a special point from a location.
+    fn special_point(
+        &self,
+        segment: &Segment<'_, P>,
+        kind: SpecialPointKind,
+        location: &Location,
+        converged: bool,
+        index: usize,
+    ) -> (f64, SpecialPoint) {
+        let low = segment.get(location.low.unwrap_or(0));
+        let high = segment.get(location.high.unwrap_or(1));
+        let (pl, ph) = location.parameters;
+        let point = location.point.clone().unwrap_or_else(|| low.clone());
+        let n = point.u.len() - 1;
+        // A merge into, or a split out of, contact throughout the period has its own name.
+        let kind = match kind {
+            SpecialPointKind::Merge if high.map.structure.permanent_contact => {
+                SpecialPointKind::PermanentContact
+            }
+            SpecialPointKind::Split if low.map.structure.permanent_contact => {
+                SpecialPointKind::LiftOff
+            }
+            kind => kind,
+        };
+        let (mut impacts_before, mut impacts_after) =
+            (low.map.structure.impacts, high.map.structure.impacts);
+        // A location converged onto the structure change itself can leave both bracket ends on
+        // one side of it (the extremum a rounding error from zero at both); the counts are then
+        // read at the ends of the step, regular points on either side.
+        if impacts_before == impacts_after
+            && matches!(
+                kind,
+                SpecialPointKind::Grazing
+                    | SpecialPointKind::Merge
+                    | SpecialPointKind::Split
+                    | SpecialPointKind::PermanentContact
+                    | SpecialPointKind::LiftOff
+            )
+        {
+            impacts_before = segment.get(0).map.structure.impacts;
+            impacts_after = segment.get(1).map.structure.impacts;
+        }
+        (
+            point.sigma,
+            SpecialPoint {
+                label: kind.label(impacts_after),
+                kind,
+                parameter: point.parameter(),
+                bracket: (pl.min(ph), pl.max(ph)),
+                precision: (pl - ph).abs(),
+                converged,
+                impacts_before,
+                impacts_after,
+                state: point.u.rows(0, n).into_owned(),
+                multipliers: point.multipliers.clone(),
+                iterations: location.iterations,
+                branch_index: index,
+            },
+        )
+    }
+}
