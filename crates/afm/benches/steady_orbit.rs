@@ -8,7 +8,9 @@
 //!
 //! both as a branch would (`steady_orbit_in`, one workspace for the repetitions); also from
 //! the neighbour without the workspace (`steady_orbit`, whose period maps each build a new
-//! solver), and from a cold start (the free orbit plus transients); the Newton iterations
+//! solver), and without a previous orbit: by transients from the free orbit
+//! (`OrbitStart::Transient`) and by walking the approach branch from the free orbit
+//! (`OrbitStart::Approach`, the cold start); the Newton iterations
 //! (neighbour/predicted) and the work of one period map with the monodromy: right-hand-side
 //! evaluations (DOP853 stages), steps (exact-flow, DOP853 and Taylor-series steps) and, of
 //! those, series steps.
@@ -75,7 +77,7 @@ fn main() {
     let settings = SteadyOrbitSettings::default();
     println!("steady orbit, Biolever on mica, A0 = 10 nm (median of repetitions)");
     println!(
-        "{:>6} {:>10} {:>8} {:>12} {:>9} {:>12} {:>9} {:>13} {:>9} {:>7} {:>12} {:>8} {:>9}",
+        "{:>6} {:>10} {:>8} {:>12} {:>9} {:>12} {:>9} {:>13} {:>12} {:>11} {:>7} {:>12} {:>8} {:>9}",
         "A/A0",
         "Z (nm)",
         "impacts",
@@ -84,7 +86,8 @@ fn main() {
         "predicted us",
         "(CPU us)",
         "no workspace",
-        "cold us",
+        "transient us",
+        "approach us",
         "iters",
         "RHS evals/T",
         "steps/T",
@@ -124,8 +127,13 @@ fn main() {
                 .expect("warm");
             std::hint::black_box(orbit);
         });
-        let cold_us = median_us(51, || {
-            let orbit = steady_orbit(&model, z, OrbitStart::Cold, &settings).expect("cold");
+        let transient_us = median_us(51, || {
+            let orbit =
+                steady_orbit(&model, z, OrbitStart::Transient, &settings).expect("transient");
+            std::hint::black_box(orbit);
+        });
+        let approach_us = median_us(51, || {
+            let orbit = steady_orbit(&model, z, OrbitStart::Approach, &settings).expect("approach");
             std::hint::black_box(orbit);
         });
         let mut at_z = model.clone();
@@ -141,7 +149,7 @@ fn main() {
         )
         .expect("period map");
         println!(
-            "{:>6.2} {:>10.6} {:>8} {:>12.1} {:>9.1} {:>12.1} {:>9.1} {:>13.1} {:>9.1} {:>7} {:>12} {:>8} {:>9}",
+            "{:>6.2} {:>10.6} {:>8} {:>12.1} {:>9.1} {:>12.1} {:>9.1} {:>13.1} {:>12.1} {:>11.1} {:>7} {:>12} {:>8} {:>9}",
             ratio,
             z,
             target.observables().impacts.len(),
@@ -150,7 +158,8 @@ fn main() {
             predicted_us,
             predicted_cpu_us,
             fresh_us,
-            cold_us,
+            transient_us,
+            approach_us,
             format!("{}/{}", warm.iterations, predicted.iterations),
             period.statistics.rhs_evaluations,
             // `steps` counts the exact-flow steps too.

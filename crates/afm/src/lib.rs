@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 pub mod amplitude_ratio;
+pub mod approach_start;
 pub mod bifurcation_diagram;
 pub mod cantilever;
 pub mod case;

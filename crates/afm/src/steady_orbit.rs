@@ -17,6 +17,7 @@ use hybrid::{
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
+use crate::approach_start::{walk_approach, WalkEnd};
 use crate::error::AfmError;
 use crate::model::TappingModel;
 use crate::observables::{observe_orbit_in, observe_period_in, OrbitObservables};
@@ -56,7 +57,7 @@ pub struct SteadyOrbitSettings {
     /// Newton on the stroboscopic map; the tolerance is on the state residual
     /// `|P(x) - x|` in nm and nm/us (default 1e-10, the brief's target).
     pub newton: NewtonSettings,
-    /// Periods integrated from a cold start before Newton (default 20; the slowest free decay,
+    /// Periods integrated from the free orbit's state before Newton for [`OrbitStart::Transient`] (default 20; the slowest free decay,
     /// `exp(-w_1 t / (2 Q_1))`, loses a factor `exp(-pi / Q_1)` per period, about 1e-36 over 20
     /// periods for the paper's cantilevers). Range 0..=100000.
     pub transient_periods: usize,
@@ -270,8 +271,14 @@ impl SteadyOrbitWorkspace {
 /// integrated (see [`steady_orbit`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum OrbitStart<'a> {
-    /// The free steady state after `transient_periods` periods.
-    Cold,
+    /// The orbit of the quasi-static approach, without a previous orbit: the free orbit above
+    /// first contact, else the approach branch walked down from it
+    /// ([`crate::approach_start`]), at the cost of a few loose Newton steps.
+    Approach,
+    /// The attractor a transient from the free steady state reaches: `transient_periods`
+    /// periods from the free orbit's state at `Z`, then Newton. Where orbits coexist, it may
+    /// be another than the approach's.
+    Transient,
     /// A state near the orbit, such as a neighbouring orbit's on the branch. From an orbit
     /// 0.01 nm away in `Z` at the paper's Fig. 1 points the state is 3e-4 to 2e-2 nm off,
     /// so the first Newton map, whose only use is the first update, is integrated at a loose
@@ -289,16 +296,28 @@ pub enum OrbitStart<'a> {
 }
 
 impl<'a> OrbitStart<'a> {
-    /// `Near(x)` for `Some(x)`, `Cold` for `None`.
-    pub fn near_or_cold(state: Option<&'a [f64]>) -> Self {
-        state.map_or(Self::Cold, Self::Near)
+    /// `Near(x)` for `Some(x)`, `Transient` for `None`.
+    pub fn near_or_transient(state: Option<&'a [f64]>) -> Self {
+        state.map_or(Self::Transient, Self::Near)
+    }
+
+    /// The name of the start in outputs: `approach`, `transient`, `near` or `predicted`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Approach => "approach",
+            Self::Transient => "transient",
+            Self::Near(_) => "near",
+            Self::Predicted(_) => "predicted",
+        }
     }
 }
 
 /// The steady orbit of `model` at separation `z_nm`.
 ///
-/// Newton starts from `start` (see [`OrbitStart`]); a cold start first integrates
-/// `transient_periods` periods from the free steady state. If Newton does not converge, or
+/// Newton starts from `start` (see [`OrbitStart`]): without a previous orbit,
+/// [`OrbitStart::Approach`] gives the orbit of the quasi-static approach and
+/// [`OrbitStart::Transient`] the attractor after `transient_periods` periods from the free
+/// steady state. If Newton does not converge, or
 /// converges to an orbit that repels (so that it is not what a cantilever would settle on),
 /// the map is iterated until a state recurs after `k <= max_multiplicity` periods and Newton
 /// is applied to the `k`-th iterate.
@@ -346,7 +365,11 @@ pub fn steady_orbit_in(
     let (initial, predicted) = match start {
         OrbitStart::Near(x) => (x.to_vec(), false),
         OrbitStart::Predicted(x) => (x.to_vec(), true),
-        OrbitStart::Cold => (
+        OrbitStart::Approach => match walk_approach(&model, z_nm, settings, workspace)? {
+            WalkEnd::Predicted(x) => (x, true),
+            WalkEnd::Near(x) => (x, false),
+        },
+        OrbitStart::Transient => (
             iterate(
                 &model,
                 &model.free_state(),
@@ -517,7 +540,7 @@ impl MapSensitivities {
 
 /// `dx/dZ = -(M - I)^{-1} dP/dZ` from the monodromy `M` and `dP/dZ` of one map; `None` if
 /// `M - I` is singular or the result is not finite.
-fn branch_tangent(
+pub(crate) fn branch_tangent(
     monodromy: &DMatrix<f64>,
     parameter_derivative: &[f64],
     z_nm: f64,
@@ -761,7 +784,7 @@ const FIRST_ITERATE_TOLERANCE: f64 = 1e-9;
 /// A first Newton map at [`FIRST_ITERATE_TOLERANCE`] whose residual is below this (nm) is
 /// computed again at full tolerance: the loose map's own error is part of such a residual (its
 /// residual at converged Fig. 1 orbits measured 2e-11 to 2e-8 nm), and the start is close
-/// enough for full-tolerance Newton (after the transient periods of a cold start, typically).
+/// enough for full-tolerance Newton (after transient periods, typically).
 /// From a neighbouring orbit on the branch 0.01 nm away, the residual is 3e-4 to 2e-2 nm.
 const LOOSE_RESIDUAL_FLOOR: f64 = 1e3 * FIRST_ITERATE_TOLERANCE;
 
@@ -771,7 +794,7 @@ const LOOSE_RESIDUAL_FLOOR: f64 = 1e3 * FIRST_ITERATE_TOLERANCE;
 /// the monodromy at A/A0 = 0.5 costs 0.58M instructions, against 0.67M with the tangents at
 /// the state's order and 0.36M without the monodromy), unless `settings` ask for
 /// error-controlled sensitivities (`sensitivity_tolerance`), which only the coupled method has.
-fn newton_maps(settings: &Settings) -> Settings {
+pub(crate) fn newton_maps(settings: &Settings) -> Settings {
     Settings {
         sensitivity_method: if settings.sensitivity_tolerance.is_none() {
             SensitivityMethod::Decoupled
@@ -784,7 +807,7 @@ fn newton_maps(settings: &Settings) -> Settings {
 
 /// `settings` for the first Newton map of [`shoot_observed`]: tolerances no tighter than
 /// [`FIRST_ITERATE_TOLERANCE`].
-fn first_iterate(settings: &Settings) -> Settings {
+pub(crate) fn first_iterate(settings: &Settings) -> Settings {
     Settings {
         relative_tolerance: settings.relative_tolerance.max(FIRST_ITERATE_TOLERANCE),
         absolute_tolerance: settings.absolute_tolerance.max(FIRST_ITERATE_TOLERANCE),
@@ -805,7 +828,7 @@ fn crossings_only(settings: &Settings) -> Settings {
 
 /// One period map from `x` with `sensitivity`, crossings only ([`crossings_only`]), on the
 /// workspace's buffers for it.
-fn period_map(
+pub(crate) fn period_map(
     model: &TappingModel,
     x: &[f64],
     sensitivity: Sensitivity,

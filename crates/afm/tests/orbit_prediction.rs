@@ -43,7 +43,7 @@ fn norm(a: &[f64]) -> f64 {
 /// Orbits 0.04, 0.03, 0.02 and 0.01 nm above `z`, each from the one above it, as an approach
 /// meets them.
 fn approach_to(model: &TappingModel, z: f64, settings: &SteadyOrbitSettings) -> Vec<SteadyOrbit> {
-    let mut above = vec![orbit(model, z + 0.04, OrbitStart::Cold, settings)];
+    let mut above = vec![orbit(model, z + 0.04, OrbitStart::Transient, settings)];
     for k in [3.0, 2.0, 1.0] {
         let start = above.last().expect("orbit").state.clone();
         above.push(orbit(
@@ -66,7 +66,7 @@ fn the_tangent_is_the_slope_of_the_branch() {
     for (sensitivity_tolerance, bound) in [(None, 1e-5), (Some(1e-9), 1e-7)] {
         let settings = settings(sensitivity_tolerance);
         for z in FIGURE_1_Z_NM {
-            let centre = orbit(&model, z, OrbitStart::Cold, &settings);
+            let centre = orbit(&model, z, OrbitStart::Transient, &settings);
             let above = orbit(&model, z + h, OrbitStart::Near(&centre.state), &settings);
             let below = orbit(&model, z - h, OrbitStart::Near(&centre.state), &settings);
             let central: Vec<f64> = above

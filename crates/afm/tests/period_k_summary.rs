@@ -27,7 +27,7 @@ fn a_period_4_orbit_is_summarised_over_its_four_periods() {
     let orbit = steady_orbit(
         &model,
         0.5,
-        OrbitStart::Cold,
+        OrbitStart::Transient,
         &SteadyOrbitSettings::default(),
     )
     .expect("orbit");

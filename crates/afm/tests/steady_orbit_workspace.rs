@@ -20,14 +20,14 @@ fn a_reused_workspace_gives_the_same_orbits() {
         let fresh = steady_orbit(
             &model,
             z,
-            OrbitStart::near_or_cold(fresh_start.as_deref()),
+            OrbitStart::near_or_transient(fresh_start.as_deref()),
             &settings,
         )
         .expect("fresh");
         let reused = steady_orbit_in(
             &model,
             z,
-            OrbitStart::near_or_cold(reused_start.as_deref()),
+            OrbitStart::near_or_transient(reused_start.as_deref()),
             &settings,
             &mut workspace,
         )

@@ -296,7 +296,7 @@ fn cycle_lockin_matches_the_period_observables() {
     let orbit = steady_orbit(
         &model,
         8.0,
-        OrbitStart::Cold,
+        OrbitStart::Transient,
         &SteadyOrbitSettings::default(),
     )
     .expect("orbit");

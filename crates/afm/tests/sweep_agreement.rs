@@ -27,7 +27,8 @@ fn second_minimum(orbit: &SteadyOrbit) -> f64 {
 /// the orbit at the bracket end on the same side; returns (Z_G2, the orbit there).
 fn locate_g2(model: &TappingModel, settings: &SteadyOrbitSettings) -> (f64, SteadyOrbit) {
     // Scan down from 9.5 nm in 0.1 nm steps for the first orbit with two impacts.
-    let mut above = steady_orbit(model, 9.5, OrbitStart::Cold, settings).expect("orbit at 9.5 nm");
+    let mut above =
+        steady_orbit(model, 9.5, OrbitStart::Transient, settings).expect("orbit at 9.5 nm");
     assert_eq!(above.observables().impacts.len(), 1);
     let mut below = None;
     let mut z = 9.5;
@@ -105,7 +106,7 @@ fn sweep_follows_the_steady_orbit_around_g2() {
         let orbit = steady_orbit(
             &model,
             record.z_nm,
-            OrbitStart::near_or_cold(previous.as_ref().map(|o| o.state.as_slice())),
+            OrbitStart::near_or_transient(previous.as_ref().map(|o| o.state.as_slice())),
             &orbit_settings,
         )
         .expect("orbit");

@@ -44,7 +44,7 @@ fn single_impact_orbits() -> (TappingModel, Vec<SteadyOrbit>) {
     .expect("A/A0 = 0.95")];
     for below_first_contact in [0.2, 0.45] {
         let z = model.grazing_separation_nm() - below_first_contact;
-        orbits.push(steady_orbit(&model, z, OrbitStart::Cold, &settings).expect("orbit"));
+        orbits.push(steady_orbit(&model, z, OrbitStart::Transient, &settings).expect("orbit"));
     }
     for orbit in &orbits {
         assert!(orbit.converged && orbit.stable && orbit.multiplicity == 1);
@@ -288,7 +288,7 @@ fn off_resonance_drive_keeps_the_harmonic_balance_but_not_eq3() {
     let orbit = steady_orbit(
         &model,
         model.grazing_separation_nm() - 0.5,
-        OrbitStart::Cold,
+        OrbitStart::Transient,
         &settings,
     )
     .expect("orbit");
@@ -323,7 +323,7 @@ fn refuses_what_the_theory_does_not_describe() {
     let mut orbit = steady_orbit(
         &model,
         model.grazing_separation_nm() - 0.3,
-        OrbitStart::Cold,
+        OrbitStart::Transient,
         &settings,
     )
     .expect("orbit");

@@ -74,7 +74,7 @@ fn orbit(
             if !z.is_finite() {
                 bail!("--z {z}: the separation must be a finite number of nm");
             }
-            steady_orbit(model, z, OrbitStart::Cold, settings)
+            steady_orbit(model, z, OrbitStart::Transient, settings)
                 .with_context(|| format!("no steady orbit at Z = {z} nm"))
         }
         (None, ratio) => {
