@@ -85,6 +85,7 @@ mod tests {
             tangent: Some(cubics.iter().map(slope).collect()),
             whole_orbit: OrbitObservables::default(),
             periods: Vec::new(),
+            period_states: Vec::new(),
         }
     }
 

@@ -150,6 +150,11 @@ pub struct SteadyOrbit {
     /// periodic (an impact running across the window's end joins one running across its
     /// start), so per-period impact counts come from [`SteadyOrbit::period_breakdown`].
     pub periods: Vec<OrbitObservables>,
+    /// The state at the start of each of the `k` drive periods (`x(j T)`, `j = 0..k`), the
+    /// first being [`SteadyOrbit::state`] (nm, nm/us): the same orbit started a period later
+    /// has the state `x(T)` at `t = 0`.
+    #[serde(skip)]
+    pub period_states: Vec<Vec<f64>>,
 }
 
 /// One drive period of a period-`k` orbit: the per-period breakdown of its observables.
@@ -177,6 +182,18 @@ pub struct PeriodBreakdown {
 }
 
 impl SteadyOrbit {
+    /// Whether `other` is the same orbit as this one: the same multiplicity `k`, and the state
+    /// of `other` within `tolerance` (nm, nm/us; [`state_distance`]) of this orbit's state at
+    /// the start of one of its `k` periods (a period-`k` orbit found from another start may be
+    /// the same cycle entered `j` periods later).
+    pub fn is_same_orbit(&self, other: &SteadyOrbit, tolerance: f64) -> bool {
+        self.multiplicity == other.multiplicity
+            && self
+                .period_states
+                .iter()
+                .any(|x| state_distance(x, &other.state) <= tolerance)
+    }
+
     /// The observables of the whole orbit (all `k` periods; see [`SteadyOrbit::whole_orbit`]).
     pub fn observables(&self) -> &OrbitObservables {
         &self.whole_orbit
@@ -409,12 +426,13 @@ pub fn steady_orbit_in(
             converged: true,
             iterations: first.iterations,
             residual: first.residual,
-            state: first.state,
+            state: first.state.clone(),
             stable: true,
             multipliers: first_multipliers,
             tangent: first_tangent,
             whole_orbit: first.observables.clone(),
             periods: vec![first.observables],
+            period_states: vec![first.state],
         });
     }
 
@@ -448,23 +466,9 @@ pub fn steady_orbit_in(
         let Some((k, distance)) = recurrence else {
             continue;
         };
-        let problem = HybridPeriodicProblem::new(model.clone(), k, settings.integration.clone())?;
-        let shot = shoot(&problem, &states[last], z_nm, &settings.newton)?;
-        let multipliers = floquet_multipliers(&shot.period_map.monodromy);
-        let tangent = branch_tangent(
-            &shot.period_map.monodromy,
-            shot.period_map.parameter_derivative.as_slice(),
-            z_nm,
-        );
-        let attempt = Attempt {
-            multiplicity: k,
-            state: shot.state.as_slice().to_vec(),
-            iterations: shot.iterations,
-            residual: shot.residual,
-            multipliers,
-            tangent,
-        };
-        if shot.converged {
+        let (attempt, converged) = shoot_period(&model, k, &states[last], settings)?;
+        if converged {
+            let attempt = minimal_period(&model, attempt, settings, workspace)?;
             return finish(&model, attempt, settings, workspace);
         }
         failed_at[k] = distance;
@@ -498,6 +502,64 @@ const RECURRENCE_DISTANCE: f64 = 1e-4;
 /// taken 9.6 s at the ghost of the MAClever-on-mica orbit that vanishes at its fold (1e-8 nm
 /// below it: every state recurs within 2e-3 nm, and every multiplicity was shot each period).
 const RETRY_FACTOR: f64 = 0.1;
+
+/// Newton on the `k`-th iterate of the stroboscopic map from `x`: the attempt and whether it
+/// converged.
+fn shoot_period(
+    model: &TappingModel,
+    k: usize,
+    x: &[f64],
+    settings: &SteadyOrbitSettings,
+) -> Result<(Attempt, bool), AfmError> {
+    let z_nm = model.parameter();
+    let problem = HybridPeriodicProblem::new(model.clone(), k, settings.integration.clone())?;
+    let shot = shoot(&problem, x, z_nm, &settings.newton)?;
+    let attempt = Attempt {
+        multiplicity: k,
+        state: shot.state.as_slice().to_vec(),
+        iterations: shot.iterations,
+        residual: shot.residual,
+        multipliers: floquet_multipliers(&shot.period_map.monodromy),
+        tangent: branch_tangent(
+            &shot.period_map.monodromy,
+            shot.period_map.parameter_derivative.as_slice(),
+            z_nm,
+        ),
+    };
+    Ok((attempt, shot.converged))
+}
+
+/// A converged fixed point of the `k`-th iterate may be one of a shorter period `d` (a divisor
+/// of `k`), found at `k` because Newton at `d` had failed from an earlier, farther state: the
+/// orbit is then shot again at the least such `d` whose state recurs within
+/// [`MINIMAL_PERIOD_DISTANCE`] times the Newton tolerance, so that its multiplicity is its
+/// least period and its multipliers those of `P^d`.
+fn minimal_period(
+    model: &TappingModel,
+    attempt: Attempt,
+    settings: &SteadyOrbitSettings,
+    workspace: &mut SteadyOrbitWorkspace,
+) -> Result<Attempt, AfmError> {
+    let k = attempt.multiplicity;
+    let mut x = attempt.state.clone();
+    for d in 1..k {
+        x = iterate(model, &x, 1, &settings.integration, workspace)?;
+        let recurs = state_distance(&x, &attempt.state)
+            <= MINIMAL_PERIOD_DISTANCE * settings.newton.tolerance;
+        if k.is_multiple_of(d) && recurs {
+            let (shorter, converged) = shoot_period(model, d, &attempt.state, settings)?;
+            if converged {
+                return Ok(shorter);
+            }
+        }
+    }
+    Ok(attempt)
+}
+
+/// A converged period-`k` state that recurs after `d < k` periods within this many Newton
+/// tolerances is an orbit of period `d`: the states of a true period-`k` orbit `d` periods
+/// apart are distinct orbit points, far farther apart.
+const MINIMAL_PERIOD_DISTANCE: f64 = 100.0;
 
 /// A shooting's outcome on the `multiplicity`-th iterate of the map, before its observables.
 struct Attempt {
@@ -882,8 +944,10 @@ fn finish(
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<SteadyOrbit, AfmError> {
     let mut periods = Vec::with_capacity(attempt.multiplicity);
+    let mut period_states = Vec::with_capacity(attempt.multiplicity);
     let mut x = attempt.state.clone();
     for _ in 0..attempt.multiplicity {
+        period_states.push(x.clone());
         let (flow, observables) = observe_period_in(
             model,
             0.0,
@@ -920,5 +984,6 @@ fn finish(
         tangent: attempt.tangent,
         whole_orbit,
         periods,
+        period_states,
     })
 }

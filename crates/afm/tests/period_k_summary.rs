@@ -129,3 +129,58 @@ fn a_gap_minimum_far_above_the_sample_is_not_a_near_impact() {
     assert_eq!(GapMinimumKind::of(1.0001, a0), GapMinimumKind::Clear);
     assert_eq!(GapMinimumKind::of(1e6, a0), GapMinimumKind::Clear);
 }
+
+/// The period-4 orbit reached from the approach and from a transient is one orbit entered at
+/// different periods of its cycle or the same: `is_same_orbit` compares the state with every
+/// period start of the cycle. Each period start, taken as a state, is the same orbit; the
+/// orbit at another separation is not.
+#[test]
+fn one_period_4_orbit_from_either_start_is_the_same_orbit() {
+    let model = driven_at_72_khz(0.5);
+    let settings = SteadyOrbitSettings::default();
+    let approach = steady_orbit(&model, 0.5, OrbitStart::Approach, &settings).expect("orbit");
+    let transient = steady_orbit(&model, 0.5, OrbitStart::Transient, &settings).expect("orbit");
+    assert_eq!((approach.multiplicity, transient.multiplicity), (4, 4));
+    assert!(approach.is_same_orbit(&transient, 1e-6));
+    for j in 0..4 {
+        let mut shifted = approach.clone();
+        shifted.state = approach.period_states[j].clone();
+        assert!(
+            transient.is_same_orbit(&shifted, 1e-6),
+            "entered at period {j}"
+        );
+    }
+    let elsewhere = steady_orbit(&model, 0.6, OrbitStart::Approach, &settings).expect("orbit");
+    assert!(!approach.is_same_orbit(&elsewhere, 1e-6));
+}
+
+/// A period-1 orbit is reported with multiplicity 1 even when the search shoots it as a fixed
+/// point of a higher iterate: on the MAClever on mica of the experiment at Z = -9 nm (slow
+/// transients, largest multiplier 0.907), the transient start used to report it as period 2
+/// with identical periods. The reference: its state is a fixed point of the period map itself,
+/// integrated here directly (residual below 1e-8 nm, 100 times Newton's tolerance).
+#[test]
+fn a_period_1_orbit_found_at_a_higher_iterate_has_multiplicity_1() {
+    let case = builtin_case("maclever-mica-experiment").expect("built-in case");
+    let mut model = TappingModel::from_case(&case).expect("model");
+    model
+        .set_separation(Separation::Constant(-9.0))
+        .expect("finite separation");
+    let settings = SteadyOrbitSettings::default();
+    for start in [OrbitStart::Transient, OrbitStart::Approach] {
+        let orbit = steady_orbit(&model, -9.0, start, &settings).expect("orbit");
+        assert!(orbit.converged && orbit.stable, "{}", start.name());
+        assert_eq!(orbit.multiplicity, 1, "{}", start.name());
+        let image = flow_map(
+            &model,
+            0.0,
+            &orbit.state,
+            model.period_us(),
+            Sensitivity::None,
+            &Settings::default(),
+        )
+        .expect("period map")
+        .state;
+        assert!(afm::state_distance(&image, &orbit.state) < 1e-8);
+    }
+}

@@ -6,7 +6,7 @@ use afm::{
     SteadyOrbitSettings, TappingModel,
 };
 use anyhow::{bail, Context, Result};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -35,12 +35,68 @@ pub struct SimulateArgs {
     /// the previous one) and stop at the Z where A/A0 equals this ratio (0 < R < 1).
     #[arg(long, allow_negative_numbers = true)]
     pub amplitude_ratio: Option<f64>,
+    /// Which orbit --z reports where several coexist: `approach`, the orbit of the quasi-static
+    /// approach (the one `continue` and the paper report: the free orbit above first contact,
+    /// else the approach branch followed down from it), or `transient`, the attractor that
+    /// transients from the free orbit's state at Z settle on. The other one is reported too
+    /// when it differs.
+    #[arg(long, value_enum, default_value_t = Start::Approach)]
+    pub start: Start,
     /// Print one JSON object instead of the readable summary.
     #[arg(long)]
     pub json: bool,
     /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+}
+
+/// The orbit `simulate --z` reports where several coexist (see [`SimulateArgs::start`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Start {
+    /// The orbit of the quasi-static approach.
+    Approach,
+    /// The attractor of transients from the free orbit's state.
+    Transient,
+}
+
+impl Start {
+    /// The steady-orbit search's start for this choice.
+    fn orbit_start(self) -> OrbitStart<'static> {
+        match self {
+            Self::Approach => OrbitStart::Approach,
+            Self::Transient => OrbitStart::Transient,
+        }
+    }
+
+    /// The other choice.
+    fn other(self) -> Self {
+        match self {
+            Self::Approach => Self::Transient,
+            Self::Transient => Self::Approach,
+        }
+    }
+
+    /// The name in outputs.
+    fn name(self) -> &'static str {
+        self.orbit_start().name()
+    }
+}
+
+/// Two converged orbits at one `Z` are different orbits when their states at `t = 0` differ by
+/// more than this (nm and nm/us): far above the 1e-10 residual of either, far below the
+/// distance between coexisting orbits.
+const COEXISTING_DISTANCE: f64 = 1e-6;
+
+/// The orbit the other start reaches at the same `Z`, if it is a different converged orbit.
+fn coexisting_orbit(
+    model: &TappingModel,
+    orbit: &SteadyOrbit,
+    start: Start,
+    settings: &SteadyOrbitSettings,
+) -> Option<SteadyOrbit> {
+    let other = steady_orbit(model, orbit.z_nm, start.other().orbit_start(), settings).ok()?;
+    (other.converged && orbit.converged && !orbit.is_same_orbit(&other, COEXISTING_DISTANCE))
+        .then_some(other)
 }
 
 /// Run `drumroll simulate`.
@@ -52,28 +108,46 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
     let settings = SteadyOrbitSettings::default();
-    let orbit = match (args.z, args.amplitude_ratio) {
+    let (orbit, start, coexisting) = match (args.z, args.amplitude_ratio) {
         (Some(z), None) => {
             if !z.is_finite() {
                 bail!("--z {z}: the separation must be a finite number of nm");
             }
-            steady_orbit(&model, z, OrbitStart::Transient, &settings)
-                .with_context(|| format!("no steady orbit at Z = {z} nm"))?
+            let orbit = steady_orbit(&model, z, args.start.orbit_start(), &settings)
+                .with_context(|| format!("no steady orbit at Z = {z} nm"))?;
+            let coexisting = coexisting_orbit(&model, &orbit, args.start, &settings);
+            (orbit, args.start, coexisting)
         }
         (None, Some(ratio)) => {
             let search = AmplitudeRatioSearch::new(ratio).context("invalid --amplitude-ratio")?;
-            find_amplitude_ratio(&model, &search, &settings)
-                .with_context(|| format!("cannot reach A/A0 = {ratio} on the approach"))?
+            let orbit = find_amplitude_ratio(&model, &search, &settings)
+                .with_context(|| format!("cannot reach A/A0 = {ratio} on the approach"))?;
+            (orbit, Start::Approach, None)
         }
         _ => bail!("give exactly one of --z and --amplitude-ratio"),
     };
     if args.json {
         let mut object = orbit_json(&case.name, &model, &orbit);
-        let options = json!({ "z_nm": args.z, "amplitude_ratio": args.amplitude_ratio });
+        object["start"] = json!(start.name());
+        object["coexisting_orbit"] = coexisting
+            .as_ref()
+            .map_or(serde_json::Value::Null, |other| {
+                let mut other_json = orbit_json(&case.name, &model, other);
+                other_json["start"] = json!(start.other().name());
+                other_json
+            });
+        let options = json!({
+            "z_nm": args.z,
+            "amplitude_ratio": args.amplitude_ratio,
+            "start": start.name(),
+        });
         object["inputs"] = orbit_inputs_json("simulate", options, &case, &model, &settings);
         println!("{}", serde_json::to_string_pretty(&object)?);
     } else {
         print!("{}", summary(&case.name, &model, &orbit));
+        if let Some(other) = &coexisting {
+            print!("{}", coexisting_note(&model, start, other));
+        }
     }
     if let Some(path) = plot_path {
         let panels = trajectory_panels(&model, &orbit, 2)?;
@@ -144,6 +218,19 @@ fn fold_multiplier(orbit: &SteadyOrbit) -> Option<f64> {
         .filter(|m| m.im == 0.0 && (m.re - 1.0).abs() < FOLD_MULTIPLIER_DISTANCE)
         .map(|m| m.re)
         .min_by(|a, b| (a - 1.0).abs().total_cmp(&(b - 1.0).abs()))
+}
+
+/// The table's note on a coexisting orbit that the other start reaches.
+fn coexisting_note(model: &TappingModel, start: Start, other: &SteadyOrbit) -> String {
+    let (ratio, phase) = other.lockin(model.free_amplitude_nm());
+    format!(
+        "another orbit coexists at this Z: the {} start reaches a period-{} orbit with A/A0 = {ratio:.6}, phase {phase:.4} deg, {} impacts per period (drumroll simulate --start {} reports it); the orbit above is the {} start's\n",
+        start.other().name(),
+        other.multiplicity,
+        digits::impacts_per_period(other.impacts_per_orbit(), other.multiplicity),
+        start.other().name(),
+        start.name(),
+    )
 }
 
 /// The readable summary of one steady orbit.

@@ -75,7 +75,8 @@ fn json_type(value: &Value) -> &'static str {
 }
 
 /// Every key path of `value` under `path` with the types seen there. The keys of the
-/// `retract` object are those of the top level (the schema documents them once).
+/// `retract` and `coexisting_orbit` objects are those of the top level (the schema documents
+/// them once).
 fn flatten(value: &Value, path: &str, seen: &mut BTreeMap<String, BTreeSet<&'static str>>) {
     if !path.is_empty() {
         seen.entry(path.to_string())
@@ -87,7 +88,7 @@ fn flatten(value: &Value, path: &str, seen: &mut BTreeMap<String, BTreeSet<&'sta
             for (key, child) in map {
                 let child_path = match path {
                     "" => key.clone(),
-                    "retract" => key.clone(),
+                    "retract" | "coexisting_orbit" => key.clone(),
                     _ => format!("{path}.{key}"),
                 };
                 flatten(child, &child_path, seen);
