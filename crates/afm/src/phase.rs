@@ -9,7 +9,7 @@
 //! Within 2 ulps of the correctly rounded value for `|x| < 2^19 pi` (tested against libm over
 //! 10^6 arguments, including the neighbourhoods of multiples of `pi/2`); beyond that, libm's
 //! `sin_cos` is called. The point is speed: one reduction serves both functions and there is
-//! no branch for huge arguments (measured ~3x cheaper than libm's `cos` under callgrind).
+//! no branch for huge arguments.
 
 // The constants are written with the digits they were published with; each rounds to the
 // intended double.

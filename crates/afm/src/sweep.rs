@@ -53,8 +53,7 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-8;
 /// with one gap minimum per contact) and free flight near the sample (exact steps of a quarter
 /// of the second mode's period, whose gap extrema are half a period apart): four points per
 /// step resolve both with room to spare, and the test against a brute-force sweep with 64
-/// samples per step finds the same impacts in every cycle. It saves 8% of the instructions of
-/// the quick approach benchmark (callgrind, `--samples 4` against 8).
+/// samples per step finds the same impacts in every cycle.
 pub const SAMPLES_PER_STEP: usize = 4;
 
 /// Which way the separation moves.
