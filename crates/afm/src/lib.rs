@@ -1,7 +1,7 @@
 //! `afm`: the cantilever model of Melcher, Xu and Raman, "Multiple impact regimes in liquid
 //! environment dynamic atomic force microscopy", Appl. Phys. Lett. 93, 093111 (2008).
 //!
-//! Eq. 1 of the paper generalised to N eigenmodes (`/work/shared/MODEL.md` section 1),
+//! Eq. 1 of the paper generalised to N eigenmodes (MODEL.md section 1, at the repository root),
 //!
 //! ```text
 //! q_i'' / w_i^2 + q_i' / (w_i Q_i) + q_i = (F_i / k_i) cos(w t) + F_ts(d) / k_i,

@@ -3,7 +3,7 @@
 //! The multipliers are the eigenvalues of the monodromy matrix `M = dP/dx` at a fixed point of
 //! the period map; the orbit is asymptotically stable when every multiplier lies strictly
 //! inside the unit circle (Floquet theory; for hybrid systems the monodromy includes the
-//! saltation matrices of the events, hybrid-api.md).
+//! saltation matrices of the events; the hybrid crate's documentation).
 
 use nalgebra::{Complex, DMatrix};
 

@@ -1,7 +1,7 @@
 //! The periodic-orbit problem of a parametrised hybrid system: its period map is the hybrid
 //! solver's flow map over a whole number of forcing periods from `t0 = 0` (or another section
 //! time), with the monodromy
-//! and `dx/dp` carried through every event by saltation matrices (hybrid-api.md).
+//! and `dx/dp` carried through every event by saltation matrices.
 //!
 //! The orbit structure is read from the flow map: the local minima and maxima of the contact
 //! switching function that the solver locates inside its steps, and the `Down` events on it
