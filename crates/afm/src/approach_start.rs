@@ -203,9 +203,10 @@ fn corrected(
         if !size.is_finite() || size >= previous_residual {
             return Ok(None);
         }
-        let newton_constant = size / (previous_residual * previous_residual);
         let converged = size <= tolerance;
-        let next_converged = newton_constant * size * size <= tolerance;
+        // Newton's constant is measured only once there are two residuals.
+        let next_converged = previous_residual.is_finite()
+            && size / (previous_residual * previous_residual) * size * size <= tolerance;
         if converged || next_converged {
             if next_converged && !converged {
                 let Ok(update) = newton_update(&map.transition, &residual, z_nm) else {
