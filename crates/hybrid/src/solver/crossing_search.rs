@@ -5,7 +5,7 @@ use crate::clock::Clock;
 use crate::event_location::{locate_sign_change, turnaround, CubicHermite};
 use crate::system::{side_sign, HybridSystem, Mode};
 
-use super::tuning::TRIAL_SAMPLES;
+use super::tuning::{HERMITE_FRACTION_TOLERANCE, TRIAL_SAMPLES};
 use super::{clocked_field, Solver};
 
 impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
@@ -138,7 +138,16 @@ pub(super) fn crossing_fraction<S: HybridSystem + ?Sized>(
         }
         let cubic = CubicHermite::new((0.0, g0, r0), (1.0, g1, r1));
         let mut hermite = |s: f64| cubic.derivative(0, s);
-        let bracket = locate_sign_change(0.0, g0, 1.0, g1, &mut hermite, 1e-9, 0.0, None);
+        let bracket = locate_sign_change(
+            0.0,
+            g0,
+            1.0,
+            g1,
+            &mut hermite,
+            HERMITE_FRACTION_TOLERANCE,
+            0.0,
+            None,
+        );
         let theta = bracket.far;
         if earliest.is_none_or(|(e, _)| theta < e) {
             earliest = Some((theta, k));

@@ -186,50 +186,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             mode & !(1 << k)
         };
         if self.sensitivity.transition() {
-            system.vector_field(
-                new_mode,
-                t_event,
-                &self.buffers.z[..n],
-                &mut self.buffers.f_plus,
-            );
-            self.buffers.field.evaluations += 1;
-            let partials =
-                system.switching_gradient(k, t_event, &self.buffers.x, &mut self.buffers.gradient);
-            let hdot = partials.t
-                + self
-                    .buffers
-                    .gradient
-                    .iter()
-                    .zip(&self.buffers.f_minus)
-                    .map(|(a, b)| a * b)
-                    .sum::<f64>();
-            let reset_jacobian = if reset {
-                &self.buffers.reset_jacobian
-            } else {
-                &self.buffers.identity
-            };
-            if !reset {
-                self.buffers.reset_dxdp.fill(0.0);
-            }
-            let nn = n * n;
-            let (_, rest) = self.buffers.z.split_at_mut(n);
-            let (phi, s) = rest.split_at_mut(nn);
-            let parameter = if self.sensitivity.parameter() {
-                Some((&mut s[..n], &self.buffers.reset_dxdp[..], partials.p))
-            } else {
-                None
-            };
-            self.buffers.saltation.apply(
-                reset_jacobian,
-                &self.buffers.f_minus,
-                &self.buffers.f_plus,
-                &self.buffers.gradient,
-                hdot,
-                phi,
-                parameter,
-                t_event,
-                k,
-            )?;
+            self.saltation_update(k, new_mode, t_event, reset)?;
         }
         self.statistics.rhs_evaluations = self.buffers.field.evaluations;
         self.statistics.events += 1;
@@ -254,6 +211,66 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         })
     }
 
+    /// Carry the transition matrix and parameter sensitivity in `z` through the event on
+    /// surface `k` at `t_event` into `new_mode` (with the reset map's Jacobian if `reset`):
+    /// the saltation matrix from the fields on both sides (`f_minus`, set by the caller, and
+    /// `f_plus`) and the surface's gradient.
+    fn saltation_update(
+        &mut self,
+        k: usize,
+        new_mode: Mode,
+        t_event: f64,
+        reset: bool,
+    ) -> Result<(), HybridError> {
+        let (system, n) = (self.system, self.n);
+        system.vector_field(
+            new_mode,
+            t_event,
+            &self.buffers.z[..n],
+            &mut self.buffers.f_plus,
+        );
+        self.buffers.field.evaluations += 1;
+        let partials =
+            system.switching_gradient(k, t_event, &self.buffers.x, &mut self.buffers.gradient);
+        let hdot = partials.t
+            + self
+                .buffers
+                .gradient
+                .iter()
+                .zip(&self.buffers.f_minus)
+                .map(|(a, b)| a * b)
+                .sum::<f64>();
+        let reset_jacobian = if reset {
+            &self.buffers.reset_jacobian
+        } else {
+            &self.buffers.identity
+        };
+        if !reset {
+            self.buffers.reset_dxdp.fill(0.0);
+        }
+        let nn = n * n;
+        let (_, rest) = self.buffers.z.split_at_mut(n);
+        let (phi, s) = rest.split_at_mut(nn);
+        let parameter = if self.sensitivity.parameter() {
+            Some((&mut s[..n], &self.buffers.reset_dxdp[..], partials.p))
+        } else {
+            None
+        };
+        self.buffers.saltation.apply(
+            reset_jacobian,
+            &self.buffers.f_minus,
+            &self.buffers.f_plus,
+            &self.buffers.gradient,
+            hdot,
+            phi,
+            parameter,
+            t_event,
+            k,
+        )?;
+        Ok(())
+    }
+
+    /// Copy the transition matrix carried in `z` into the matrix [`Solver::transition`] returns.
     pub(super) fn sync_transition(&mut self) {
         if self.sensitivity.transition() {
             let n = self.n;

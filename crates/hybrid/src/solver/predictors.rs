@@ -2,13 +2,15 @@
 
 use crate::system::{side_sign, HybridSystem, Mode};
 
+use super::tuning::{PREDICTION_DIFFERENCE, RESOLVABLE_EPSILONS};
+
 /// Whether a crossing `distance` ahead of `t0` is far enough to land a step on:
 /// `1024 eps |t0|`, a few hundred rounding steps of time. Nearer, a step cannot hold it
 /// (a Zeno accumulation, or a state on the surface whose rounding puts the crossing next to
 /// it): the step is left to the controller, and a crossing inside the accepted step to the
 /// event location.
 pub(super) fn resolvable(distance: f64, t0: f64) -> bool {
-    distance > 1024.0 * f64::EPSILON * t0.abs()
+    distance > RESOLVABLE_EPSILONS * f64::EPSILON * t0.abs()
 }
 
 /// The predicted time from `t0` to the first crossing of any switching surface, with that
@@ -26,7 +28,7 @@ pub(super) fn predict_crossing<S: HybridSystem + ?Sized>(
     t0: f64,
     h: f64,
 ) -> Option<(f64, usize)> {
-    let delta = 1e-4 * h;
+    let delta = PREDICTION_DIFFERENCE * h;
     if !(delta > 0.0 && delta.is_finite()) {
         return None;
     }

@@ -8,6 +8,7 @@ use crate::extrema::Clearance;
 use crate::system::{side_sign, HybridSystem, Mode};
 use crate::taylor::TAYLOR_ORDER;
 
+use super::tuning::BOUND_ROUNDING_MARGIN;
 use super::{Solver, StepKind};
 
 impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
@@ -55,7 +56,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 f64::INFINITY
             };
             // A margin for the rounding of the root.
-            span = span.min(clear * (1.0 - 1e-9));
+            span = span.min(clear * (1.0 - BOUND_ROUNDING_MARGIN));
         }
         Some(span)
     }
@@ -71,7 +72,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         (0..self.surfaces).all(|k| {
             let (r0, r1) = (rates[k * p], rates[k * p + p - 1]);
             // A margin for the rounding of the bound's product.
-            r0 * r1 > 0.0 && r0.abs() + r1.abs() > bounds[k] * dt * (1.0 + 1e-9)
+            r0 * r1 > 0.0 && r0.abs() + r1.abs() > bounds[k] * dt * (1.0 + BOUND_ROUNDING_MARGIN)
         })
     }
 

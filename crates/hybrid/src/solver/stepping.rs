@@ -3,7 +3,7 @@
 
 use crate::error::HybridError;
 use crate::extrema::Clearance;
-use crate::system::{HybridSystem, MAX_SURFACES};
+use crate::system::{HybridSystem, Mode, MAX_SURFACES};
 
 use super::dense_output::state_in_step;
 use super::{Solver, StepKind, StepOutcome};
@@ -55,6 +55,47 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         // Sample h and dh/dt, locate extrema, then the earliest crossing.
         let time_tolerance =
             self.settings.event_time_tolerance * t0.abs().max(t1.abs()).max(t1 - t0);
+        self.search_step(mode, t0, t1, time_tolerance)?;
+        let crossing = self.earliest_crossing(mode, t0, t1, time_tolerance);
+        match crossing {
+            None => {
+                self.buffers.z.copy_from_slice(&self.buffers.z_new);
+                self.t = t1;
+                self.sync_transition();
+                self.buffers.samples.carry_over();
+                if self.kind == StepKind::RungeKutta {
+                    self.buffers.rk.reuse_last_derivative();
+                    self.first_same_as_last = true;
+                }
+                self.buffers
+                    .extrema
+                    .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
+                Ok(if t1 == t_end {
+                    StepOutcome::EndTime
+                } else {
+                    StepOutcome::Internal
+                })
+            }
+            Some((k, bracket)) => {
+                let event = self.fire(k, bracket, time_tolerance)?;
+                self.buffers.extrema.retain(|e| e.t <= event.t);
+                self.buffers
+                    .extrema
+                    .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
+                Ok(StepOutcome::Event(event))
+            }
+        }
+    }
+    /// Sample `h_k` and `dh_k/dt` over the step `[t0, t1]` just taken and locate its extrema,
+    /// unless the step is proven to hold nothing interior samples would find (then it is
+    /// sampled at its ends only; see the module docs).
+    fn search_step(
+        &mut self,
+        mode: Mode,
+        t0: f64,
+        t1: f64,
+        time_tolerance: f64,
+    ) -> Result<(), HybridError> {
         // The curvature bounds of the step (if the system gives them): a step they prove
         // monotone holds no extremum; with a finite extremum height, a step, or a sample
         // interval of it, that they prove farther than the height from every surface is not
@@ -86,90 +127,76 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 || (bounded && self.monotone_by_curvature(t1 - t0, &bounds))
         };
         if !clear {
-            self.statistics.sampled_steps += 1;
-            let system = self.system;
-            let n = self.n;
-            let kind = self.kind;
-            let dense = (&self.buffers.rk, &self.buffers.taylor);
-            let z_start = &self.buffers.z_start;
-            let z_new = &self.buffers.z_new;
-            let clock = (self.clock, self.sigma_start);
-            let mut state_at = |t: f64, out: &mut [f64]| {
-                state_in_step(
-                    system, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, out,
-                );
-            };
-            // Exact steps: every interior state from one call (a linear flow reuses its
-            // transition over one spacing). Taylor steps: from one pass over the series, at
-            // the sample times `Samples::sample` takes (each the value `state_in_step` gives).
-            let grid = match kind {
-                StepKind::Exact => {
-                    let count = self.buffers.samples.points() - 1;
-                    system.exact_flow_grid(
-                        mode,
-                        t0,
-                        &z_start[..n],
-                        t1 - t0,
-                        count,
-                        &mut self.buffers.grid,
-                    );
-                    Some(&self.buffers.grid[..])
-                }
-                StepKind::Taylor => {
-                    let mut grid = std::mem::take(&mut self.buffers.grid);
-                    self.series_grid(t0, t1, &mut grid);
-                    self.buffers.grid = grid;
-                    Some(&self.buffers.grid[..])
-                }
-                _ => None,
-            };
-            self.buffers.samples.sample(
-                system,
-                mode,
-                t0,
-                t1,
-                &mut state_at,
-                grid,
-                &mut self.buffers.x,
-            )?;
-            self.buffers.samples.locate_extrema(
-                system,
-                mode,
-                &mut state_at,
-                &mut self.buffers.x,
-                time_tolerance,
-                clearance,
-                &mut self.buffers.extrema,
+            self.sample_inside(mode, t0, t1, time_tolerance, clearance)?;
+        }
+        Ok(())
+    }
+
+    /// Sample the step `[t0, t1]` at its interior points and locate the extrema of every
+    /// `h_k` between them (skipping sample intervals `clearance` proves clear).
+    fn sample_inside(
+        &mut self,
+        mode: Mode,
+        t0: f64,
+        t1: f64,
+        time_tolerance: f64,
+        clearance: Option<Clearance<'_>>,
+    ) -> Result<(), HybridError> {
+        self.statistics.sampled_steps += 1;
+        let system = self.system;
+        let n = self.n;
+        let kind = self.kind;
+        let dense = (&self.buffers.rk, &self.buffers.taylor);
+        let z_start = &self.buffers.z_start;
+        let z_new = &self.buffers.z_new;
+        let clock = (self.clock, self.sigma_start);
+        let mut state_at = |t: f64, out: &mut [f64]| {
+            state_in_step(
+                system, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, out,
             );
-        }
-        let crossing = self.earliest_crossing(mode, t0, t1, time_tolerance);
-        match crossing {
-            None => {
-                self.buffers.z.copy_from_slice(&self.buffers.z_new);
-                self.t = t1;
-                self.sync_transition();
-                self.buffers.samples.carry_over();
-                if self.kind == StepKind::RungeKutta {
-                    self.buffers.rk.reuse_last_derivative();
-                    self.first_same_as_last = true;
-                }
-                self.buffers
-                    .extrema
-                    .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
-                Ok(if t1 == t_end {
-                    StepOutcome::EndTime
-                } else {
-                    StepOutcome::Internal
-                })
+        };
+        // Exact steps: every interior state from one call (a linear flow reuses its
+        // transition over one spacing). Taylor steps: from one pass over the series, at
+        // the sample times `Samples::sample` takes (each the value `state_in_step` gives).
+        let grid = match kind {
+            StepKind::Exact => {
+                let count = self.buffers.samples.points() - 1;
+                system.exact_flow_grid(
+                    mode,
+                    t0,
+                    &z_start[..n],
+                    t1 - t0,
+                    count,
+                    &mut self.buffers.grid,
+                );
+                Some(&self.buffers.grid[..])
             }
-            Some((k, bracket)) => {
-                let event = self.fire(k, bracket, time_tolerance)?;
-                self.buffers.extrema.retain(|e| e.t <= event.t);
-                self.buffers
-                    .extrema
-                    .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
-                Ok(StepOutcome::Event(event))
+            StepKind::Taylor => {
+                let mut grid = std::mem::take(&mut self.buffers.grid);
+                self.series_grid(t0, t1, &mut grid);
+                self.buffers.grid = grid;
+                Some(&self.buffers.grid[..])
             }
-        }
+            _ => None,
+        };
+        self.buffers.samples.sample(
+            system,
+            mode,
+            t0,
+            t1,
+            &mut state_at,
+            grid,
+            &mut self.buffers.x,
+        )?;
+        self.buffers.samples.locate_extrema(
+            system,
+            mode,
+            &mut state_at,
+            &mut self.buffers.x,
+            time_tolerance,
+            clearance,
+            &mut self.buffers.extrema,
+        );
+        Ok(())
     }
 }

@@ -7,7 +7,9 @@ use crate::taylor::{
     surface_ahead, tangent_control, ClockPolynomial, Ridge, SurfaceAhead, TaylorStep, TAYLOR_ORDER,
 };
 
-use super::tuning::{MAX_RETARGETS, MIN_SERIES_FRACTION, RELEASE_LOOKAHEAD, ROOT_OVERSHOOT};
+use super::tuning::{
+    MAX_RETARGETS, MIN_SERIES_FRACTION, RELEASE_LOOKAHEAD, RETARGET_MOVE, ROOT_OVERSHOOT,
+};
 use super::{Solver, StepKind};
 
 impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
@@ -36,11 +38,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             return Ok(None);
         }
         self.check_attempts()?;
-        let (t0, n) = (self.t, self.n);
-        let (rtol, atol) = (
-            self.settings.relative_tolerance,
-            self.settings.absolute_tolerance,
-        );
+        let t0 = self.t;
         let onset = match (half_power, self.entered) {
             (Some(k), Some((entered, t_event))) if k == entered => Some(t_event),
             _ => None,
@@ -61,36 +59,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let mut recentred = 0;
         let (sigma0, length, t1) = loop {
             let sigma0 = clock.sigma(t0);
-            let polynomial = match clock {
-                Clock::Time => ClockPolynomial {
-                    start: t0,
-                    rate: 1.0,
-                    curvature: 0.0,
-                },
-                Clock::SquareRoot { .. } => ClockPolynomial {
-                    start: t0,
-                    rate: 2.0 * sigma0.abs(),
-                    curvature: if sigma0 < 0.0 { -1.0 } else { 1.0 },
-                },
-            };
-            let taylor = &mut self.buffers.taylor;
-            if !taylor.expand(system, mode, polynomial, &self.buffers.z[..n]) {
+            let polynomial = clock_polynomial(clock, t0, sigma0);
+            let Some(mut reach) = self.expand_series(polynomial) else {
                 return Ok(None);
-            }
-            let mut reach = TaylorStep::reach(&taylor.state, rtol, atol);
-            if self.sensitivity.transition() {
-                // The tangents' order was fixed with the workspace (it fits these settings).
-                let (_, tolerance) = tangent_control(&self.settings);
-                taylor.expand_tangents(
-                    system,
-                    mode,
-                    &self.buffers.z[n..],
-                    self.sensitivity.parameter(),
-                );
-                if let Some(tolerance) = tolerance {
-                    reach = reach.min(TaylorStep::reach(&taylor.tangents, tolerance, tolerance));
-                }
-            }
+            };
             // On a square-root clock centred ahead, the step ends at its reference at the
             // latest. (On the time clock `sigma0 = t0` may be negative: it is never ahead.)
             let ahead = matches!(clock, Clock::SquareRoot { .. }) && sigma0 < 0.0;
@@ -99,9 +71,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 reach = reach.min(-sigma0);
             }
             // The half-power surface's first zero along the series: within the step, the
-            // crossing the step must hold; beyond it, the prediction for the next step. A ridge
-            // before it (the surface approached and left without a crossing) bounds the
-            // series' radius, which the step keeps well inside.
+            // crossing the step must hold; beyond it, the prediction for the next step.
             let crossing = match half_power {
                 Some(k) => {
                     let upto = if ahead {
@@ -109,28 +79,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     } else {
                         RELEASE_LOOKAHEAD * reach
                     };
-                    let surface = self.surface_ahead(k, upto);
-                    if let Some(ridge) = surface.ridge {
-                        // Kept in time units for the steps after it.
-                        self.ridge = Some(Ridge {
-                            at: polynomial.time(ridge.at),
-                            half_width: ridge.half_width * polynomial.time_rate(ridge.at),
-                        });
-                    }
-                    // The ridge's distance in this series' clock offset, at its rate here.
-                    let radius = self.ridge.map(|ridge| {
-                        let rate = polynomial.time_rate(0.0);
-                        Ridge {
-                            at: (ridge.at - t0) / rate,
-                            half_width: ridge.half_width / rate,
-                        }
-                        .radius_from(0.0)
-                    });
-                    if let Some(radius) = radius.filter(|r| r.is_finite()) {
-                        reach = reach.min(TaylorStep::radius_reach(radius));
+                    let (zero, radius_reach) = self.half_power_zero(k, polynomial, upto);
+                    if let Some(radius_reach) = radius_reach {
+                        reach = reach.min(radius_reach);
                         landing = landing && reach >= -sigma0;
                     }
-                    surface.zero.map(|s| polynomial.time(s))
+                    zero
                 }
                 None => None,
             };
@@ -142,7 +96,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             // and the next step chooses again.
             let retarget = crossing.filter(|&t_cross| match clock {
                 Clock::SquareRoot { reference } if ahead => {
-                    landing && reference - t_cross > 10.0 * ROOT_OVERSHOOT * (reference - t0)
+                    landing
+                        && reference - t_cross > RETARGET_MOVE * ROOT_OVERSHOOT * (reference - t0)
                 }
                 _ => t_cross <= clock.time(sigma0 + reach) && nearer_than_onset(t_cross),
             });
@@ -159,22 +114,113 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 return Ok(None);
             }
             self.predicted_crossing = crossing;
-            let t_reach = clock.time(sigma0 + reach);
-            let max_step = self.settings.max_step;
-            break if t_reach >= t_end {
-                (sigma0, clock.sigma(t_end) - sigma0, t_end)
-            } else if t_reach - t0 > max_step {
-                let length = clock.clock_step(t0, max_step);
-                (sigma0, length, clock.time(sigma0 + length))
-            } else {
-                (sigma0, reach, t_reach)
-            };
+            break self.series_step_length(clock, sigma0, reach, t_end);
         };
         // A series whose reach collapses (a start next to a non-smooth point it is not centred
         // on) would crawl: the Runge-Kutta step's landings handle that.
         if t1 < t_end && t1 - t0 < MIN_SERIES_FRACTION * self.last_series_step {
             return Ok(None);
         }
+        self.finish_taylor_step(clock, sigma0, length, t1).map(Some)
+    }
+
+    /// Expand the series of the state (and, with sensitivities, of the tangents) from the
+    /// current state on the clock `polynomial`; the reach of the step it allows (in the clock
+    /// offset), or `None` where the system cannot form the series.
+    fn expand_series(&mut self, polynomial: ClockPolynomial) -> Option<f64> {
+        let (system, mode, n) = (self.system, self.mode, self.n);
+        let taylor = &mut self.buffers.taylor;
+        if !taylor.expand(system, mode, polynomial, &self.buffers.z[..n]) {
+            return None;
+        }
+        let mut reach = TaylorStep::reach(
+            &taylor.state,
+            self.settings.relative_tolerance,
+            self.settings.absolute_tolerance,
+        );
+        if self.sensitivity.transition() {
+            // The tangents' order was fixed with the workspace (it fits these settings).
+            let (_, tolerance) = tangent_control(&self.settings);
+            taylor.expand_tangents(
+                system,
+                mode,
+                &self.buffers.z[n..],
+                self.sensitivity.parameter(),
+            );
+            if let Some(tolerance) = tolerance {
+                reach = reach.min(TaylorStep::reach(&taylor.tangents, tolerance, tolerance));
+            }
+        }
+        Some(reach)
+    }
+
+    /// The first zero in `(0, upto]` of the half-power surface `k` along the series just
+    /// expanded on `polynomial`, as a time, and the reach (in the clock offset) to which a
+    /// ridge of the surface limits the series, if one was seen: a ridge (the surface approached
+    /// and left without a crossing) bounds the series' radius, which the step keeps well
+    /// inside. The ridge is kept, in time units, for the later steps in the mode.
+    fn half_power_zero(
+        &mut self,
+        k: usize,
+        polynomial: ClockPolynomial,
+        upto: f64,
+    ) -> (Option<f64>, Option<f64>) {
+        let t0 = self.t;
+        let surface = self.surface_ahead(k, upto);
+        if let Some(ridge) = surface.ridge {
+            // Kept in time units for the steps after it.
+            self.ridge = Some(Ridge {
+                at: polynomial.time(ridge.at),
+                half_width: ridge.half_width * polynomial.time_rate(ridge.at),
+            });
+        }
+        // The ridge's distance in this series' clock offset, at its rate here.
+        let radius = self.ridge.map(|ridge| {
+            let rate = polynomial.time_rate(0.0);
+            Ridge {
+                at: (ridge.at - t0) / rate,
+                half_width: ridge.half_width / rate,
+            }
+            .radius_from(0.0)
+        });
+        let radius_reach = radius
+            .filter(|r| r.is_finite())
+            .map(TaylorStep::radius_reach);
+        (surface.zero.map(|s| polynomial.time(s)), radius_reach)
+    }
+
+    /// The step the series allows from reading `sigma0` of `clock`: `(sigma0, length in the
+    /// clock, end time)`, its `reach` cut at `t_end` and at `max_step`.
+    fn series_step_length(
+        &self,
+        clock: Clock,
+        sigma0: f64,
+        reach: f64,
+        t_end: f64,
+    ) -> (f64, f64, f64) {
+        let t0 = self.t;
+        let t_reach = clock.time(sigma0 + reach);
+        let max_step = self.settings.max_step;
+        if t_reach >= t_end {
+            (sigma0, clock.sigma(t_end) - sigma0, t_end)
+        } else if t_reach - t0 > max_step {
+            let length = clock.clock_step(t0, max_step);
+            (sigma0, length, clock.time(sigma0 + length))
+        } else {
+            (sigma0, reach, t_reach)
+        }
+    }
+
+    /// Take the series step of `length` (in the clock offset) on `clock` from reading
+    /// `sigma0`, ending at `t1`: `z_new` from the series, the counters; returns `t1`.
+    fn finish_taylor_step(
+        &mut self,
+        clock: Clock,
+        sigma0: f64,
+        length: f64,
+        t1: f64,
+    ) -> Result<f64, HybridError> {
+        let (t0, n) = (self.t, self.n);
         let taylor = &mut self.buffers.taylor;
         taylor.length = length;
         let (x1, tangents) = self.buffers.z_new.split_at_mut(n);
@@ -194,7 +240,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.steps_in_mode += 1;
         self.statistics.steps += 1;
         self.statistics.series_steps += 1;
-        Ok(Some(t1))
+        Ok(t1)
     }
 
     /// The first zero in `(0, upto]` of surface `k` (affine) along the last Taylor series, in
@@ -228,5 +274,23 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         power[1] += drift * taylor.clock.rate;
         power[2] += drift * taylor.clock.curvature;
         power
+    }
+}
+
+/// The time along a step on `clock` from `t0` (reading `sigma0`) as a polynomial in the
+/// clock offset ([`ClockPolynomial`]): `t0 + s` on the time clock, `t0 + 2 |sigma0| s +
+/// sign(sigma0) s^2` on a square-root clock.
+fn clock_polynomial(clock: Clock, t0: f64, sigma0: f64) -> ClockPolynomial {
+    match clock {
+        Clock::Time => ClockPolynomial {
+            start: t0,
+            rate: 1.0,
+            curvature: 0.0,
+        },
+        Clock::SquareRoot { .. } => ClockPolynomial {
+            start: t0,
+            rate: 2.0 * sigma0.abs(),
+            curvature: if sigma0 < 0.0 { -1.0 } else { 1.0 },
+        },
     }
 }

@@ -32,17 +32,13 @@ pub(super) const PROBE_OVERSHOOT: f64 = 0.05;
 /// After entering a mode through its half-power surface, steps run on the square-root clock
 /// from the event while the time since it is below this many proposed steps. Far from its
 /// reference the clock is the worse one (the solution oscillates ever faster in `sigma`), and
-/// a step that grows there is rejected: with 4 instead of 1 the approach benchmark's sweep
-/// took 13% more instructions (callgrind: 54.0e9 against 47.7e9) and the Fig. 1 period maps
-/// 4-8% more evaluations, for a monodromy 2-20 times more accurate (2.0e-9 and 5.1e-8
-/// relative at A/A0 = 0.95 and 0.5, against 4.2e-8 and 1.1e-7 now; both far below the
-/// 1e-6 that Newton and the Floquet multipliers are granted).
+/// a step that grows there is rejected; a longer span buys a more accurate monodromy (already
+/// far below the 1e-6 Newton and the Floquet multipliers need) for more steps.
 pub(super) const ROOT_CLOCK_SPAN: f64 = 1.0;
 
 /// How many of its own reaches from a Taylor step's start its series is searched for the next
 /// crossing of the half-power surface: this step and about the next one's length (the series
-/// converges out to about four reaches; searching three cost 3% more per period map at A/A0 =
-/// 0.5 for no fewer steps).
+/// converges out to about four reaches; a longer search costs evaluations and saves no steps).
 pub(super) const RELEASE_LOOKAHEAD: f64 = 2.0;
 
 /// A Taylor step shorter than this fraction of the previous one gives way to Runge-Kutta.
@@ -54,3 +50,53 @@ pub(super) const TRIAL_SAMPLES: usize = 16;
 
 /// Re-centred square-root landings allowed per step after a landing passed its crossing.
 pub(super) const MAX_RETARGETS: usize = 3;
+
+/// A re-centred square-root clock must move its reference by more than this many
+/// [`ROOT_OVERSHOOT`]s of the distance: nearer, the clock is already where the crossing is,
+/// and re-centring would repeat the same landing.
+pub(super) const RETARGET_MOVE: f64 = 10.0;
+
+/// A Runge-Kutta step no longer than this many ulps of `|t|` cannot advance time: the step
+/// size has underflowed.
+pub(super) const MIN_STEP_EPSILONS: f64 = 8.0;
+
+/// After a trial with a non-finite error (the state blew up inside it), the next is this
+/// fraction of its length: a drastic cut, as the error estimate says nothing about the scale.
+pub(super) const NON_FINITE_RETRY: f64 = 0.1;
+
+/// The error a step chosen after a rejection aims at (Hairer's controller aims at about
+/// `0.9^8`): a margin below the acceptance threshold 1 for an order that is only estimated.
+pub(super) const REJECTION_TARGET_ERROR: f64 = 0.5;
+
+/// The order in the step length assumed for the error of a landing on a non-smooth crossing:
+/// a Hertz contact's kink gives errors like `s^3.5` (smoother kinks a higher power, so the
+/// landing distance derived from it is conservative).
+pub(super) const FAILED_LANDING_ORDER: f64 = 3.5;
+
+/// The bounds on the ratio of a step chosen after a rejection to the rejected one: at least
+/// a hundredth (an implausibly large error cannot collapse the step), at most 0.9 (a rejected
+/// step is never retried at nearly its length).
+pub(super) const STEP_RATIO_AFTER_REJECTION: (f64, f64) = (0.01, 0.9);
+
+/// The range of error orders in the step estimated from two successive rejections that the
+/// controller trusts: below 0.5 the error barely depends on the step (the estimate is noise),
+/// above 9 it exceeds DOP853's order 8 (not a singularity of the field).
+pub(super) const ORDER_ESTIMATE_RANGE: std::ops::RangeInclusive<f64> = 0.5..=9.0;
+
+/// A crossing nearer than this many ulps of `|t|` cannot be landed on: a few hundred rounding
+/// steps of time, the scale at which a Zeno accumulation or a state on the surface puts it.
+pub(super) const RESOLVABLE_EPSILONS: f64 = 1024.0;
+
+/// The forward difference, in fractions of the proposed step, over which the crossing
+/// predictor takes the derivative of `dh/dt` along the field: small against the step (the
+/// quadratic's curvature is local) and large against rounding.
+pub(super) const PREDICTION_DIFFERENCE: f64 = 1e-4;
+
+/// The tolerance, in fractions of a rejected trial, to which the crossing of its cubic Hermite
+/// estimate of `h` is located: far finer than the estimate itself needs, at negligible cost
+/// (the cubic is evaluated in closed form).
+pub(super) const HERMITE_FRACTION_TOLERANCE: f64 = 1e-9;
+
+/// The relative margin by which a rigorous curvature-bound test is tightened, for the rounding
+/// of its own products and square roots.
+pub(super) const BOUND_ROUNDING_MARGIN: f64 = 1e-9;
