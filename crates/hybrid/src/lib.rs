@@ -36,11 +36,13 @@ mod extrema;
 pub mod flow_map;
 mod saltation;
 pub mod sensitivity;
+mod series_step;
 pub mod settings;
 pub mod solver;
 pub mod system;
 mod tableau;
 pub mod taylor;
+mod variational_field;
 pub mod workspace;
 
 pub use clock::Clock;

@@ -13,9 +13,10 @@ use crate::dop853::Dop853;
 use crate::event::Extremum;
 use crate::extrema::Samples;
 use crate::saltation::Saltation;
-use crate::sensitivity::{Sensitivity, VariationalField};
+use crate::sensitivity::Sensitivity;
+use crate::series_step::TaylorStep;
 use crate::settings::{SensitivityMethod, Settings};
-use crate::taylor::TaylorStep;
+use crate::variational_field::VariationalField;
 
 /// The buffers a [`crate::Solver`] allocates for a state of dimension `n`, a number of switching
 /// surfaces, a [`Sensitivity`] and the sampling and error-control settings that size them.

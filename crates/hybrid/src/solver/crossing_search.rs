@@ -6,7 +6,8 @@ use crate::event_location::{locate_sign_change, turnaround, CubicHermite};
 use crate::system::{side_sign, HybridSystem, Mode};
 
 use super::tuning::{HERMITE_FRACTION_TOLERANCE, TRIAL_SAMPLES};
-use super::{clocked_field, Solver};
+use super::Solver;
+use crate::variational_field::clocked_field;
 
 impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// The time at which surface `k` is crossed within `reach` of the current time, located on

@@ -3,10 +3,11 @@
 
 use crate::clock::Clock;
 use crate::dop853::Dop853;
+use crate::series_step::TaylorStep;
 use crate::system::{HybridSystem, Mode};
-use crate::taylor::TaylorStep;
 
-use super::{clocked_field, Solver, StepKind};
+use super::{Solver, StepKind};
+use crate::variational_field::clocked_field;
 
 impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// The states at the interior sample times ([`Samples::time`]) of the Taylor step `[t0,

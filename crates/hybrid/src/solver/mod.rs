@@ -150,10 +150,10 @@ use nalgebra::DMatrix;
 use crate::clock::Clock;
 use crate::error::HybridError;
 use crate::event::{Event, Extremum};
-use crate::sensitivity::{Sensitivity, VariationalField};
+use crate::sensitivity::Sensitivity;
+use crate::series_step::Ridge;
 use crate::settings::Settings;
 use crate::system::{HybridSystem, Mode, MAX_SURFACES};
-use crate::taylor::Ridge;
 use crate::workspace::{Buffers, SolverWorkspace};
 
 /// Why [`Solver::step`] returned.
@@ -479,32 +479,6 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// The system integrated.
     pub fn system(&self) -> &'a S {
         self.system
-    }
-}
-
-/// The field of `mode` on `clock`: `dz/dsigma = (dt/dsigma) f(t(sigma), z)`, augmented with
-/// the variational equations when `variational` (else only the state part is written).
-pub(crate) fn clocked_field<'b, S: HybridSystem + ?Sized>(
-    field: &'b mut VariationalField,
-    system: &'b S,
-    mode: Mode,
-    clock: Clock,
-    variational: bool,
-) -> impl FnMut(f64, &[f64], &mut [f64]) + 'b {
-    move |sigma: f64, z: &[f64], dz: &mut [f64]| match clock {
-        Clock::Time => field.eval(system, mode, sigma, z, dz, variational),
-        Clock::SquareRoot { .. } => {
-            field.eval(system, mode, clock.time(sigma), z, dz, variational);
-            let rate = clock.rate(sigma);
-            let written = if variational {
-                dz.len()
-            } else {
-                field.state_dim()
-            };
-            for v in &mut dz[..written] {
-                *v *= rate;
-            }
-        }
     }
 }
 

@@ -14,7 +14,8 @@ use super::tuning::{
     PROBE_OVERSHOOT, REJECTION_TARGET_ERROR, RETARGET_MOVE, ROOT_APPROACH, ROOT_CLOCK_SPAN,
     ROOT_OVERSHOOT, STEP_RATIO_AFTER_REJECTION,
 };
-use super::{clocked_field, Solver, StepKind};
+use super::{Solver, StepKind};
+use crate::variational_field::clocked_field;
 
 /// The attempts at one Runge-Kutta step: the clock and step they run on and the crossing they
 /// aim at, as the rejections adjust them.

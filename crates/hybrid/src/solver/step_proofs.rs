@@ -5,8 +5,8 @@
 use crate::bernstein::{stays_above, strict_sign};
 use crate::clock::Clock;
 use crate::extrema::Clearance;
+use crate::series_step::TAYLOR_ORDER;
 use crate::system::{side_sign, HybridSystem, Mode};
-use crate::taylor::TAYLOR_ORDER;
 
 use super::tuning::BOUND_ROUNDING_MARGIN;
 use super::{Solver, StepKind};

@@ -2,10 +2,11 @@
 
 use crate::clock::Clock;
 use crate::error::HybridError;
-use crate::system::{side_sign, HybridSystem};
-use crate::taylor::{
-    surface_ahead, tangent_control, ClockPolynomial, Ridge, SurfaceAhead, TaylorStep, TAYLOR_ORDER,
+use crate::series_step::{
+    surface_ahead, tangent_control, Ridge, SurfaceAhead, TaylorStep, TAYLOR_ORDER,
 };
+use crate::system::{side_sign, HybridSystem};
+use crate::taylor::ClockPolynomial;
 
 use super::tuning::{
     MAX_RETARGETS, MIN_SERIES_FRACTION, RELEASE_LOOKAHEAD, RETARGET_MOVE, ROOT_OVERSHOOT,
