@@ -4,8 +4,9 @@
 //! onset or release). The series themselves are [`crate::taylor`]'s; the solver's use of them
 //! is documented in [`crate::solver`].
 
+use crate::accelerations::TaylorExpansion;
+use crate::mode::Mode;
 use crate::settings::{SensitivityMethod, Settings};
-use crate::system::{HybridSystem, Mode};
 use crate::taylor::{ClockPolynomial, TaylorSeries};
 
 /// The order of the solver's Taylor-series steps. At a tolerance of 1e-12 a series of order 20
@@ -51,7 +52,7 @@ pub(crate) const DECOUPLED_TANGENT_ORDER: usize = 12;
 pub(crate) const DECOUPLED_TANGENT_TOLERANCE: f64 = 1e-5;
 
 /// The rows of `columns` values beyond the tangents' order that the scratch space of
-/// [`HybridSystem::taylor_tangents`] holds without allocating (the AFM model's contact
+/// [`crate::TaylorExpansion::taylor_tangents`] holds without allocating (the AFM model's contact
 /// recurrence keeps one row per power up to the order, and one more).
 pub(crate) const TANGENT_SCRATCH_ROWS: usize = 2;
 
@@ -71,7 +72,7 @@ pub(crate) struct TaylorStep {
     /// `(k, coefficients)`, where the solver formed it for this series (its constant term is
     /// the caller's; cleared by [`TaylorStep::expand`]).
     pub surface: Option<(usize, [f64; TAYLOR_ORDER + 1])>,
-    /// Scratch for [`crate::HybridSystem::taylor_tangents`] and the tangents' row-major
+    /// Scratch for [`crate::TaylorExpansion::taylor_tangents`] and the tangents' row-major
     /// start and value.
     scratch: Vec<f64>,
     rows: Vec<f64>,
@@ -80,7 +81,7 @@ pub(crate) struct TaylorStep {
 impl TaylorStep {
     /// Storage for `n` states and `columns` tangent columns (0: none), the tangents to the
     /// order [`tangent_control`] gives for `settings`, and scratch for
-    /// [`HybridSystem::taylor_tangents`] with room for [`TANGENT_SCRATCH_ROWS`] more rows of
+    /// [`crate::TaylorExpansion::taylor_tangents`] with room for [`TANGENT_SCRATCH_ROWS`] more rows of
     /// `columns` than that order.
     pub fn new(n: usize, columns: usize, settings: &Settings) -> Self {
         let order = tangent_control(settings).0;
@@ -100,9 +101,9 @@ impl TaylorStep {
     }
 
     /// Expand the state of `mode` from `x0` on `clock`; `false` if the system gives no series.
-    pub fn expand<S: HybridSystem + ?Sized>(
+    pub fn expand(
         &mut self,
-        system: &S,
+        expansion: &dyn TaylorExpansion,
         mode: Mode,
         clock: ClockPolynomial,
         x0: &[f64],
@@ -110,14 +111,14 @@ impl TaylorStep {
         self.clock = clock;
         self.surface = None;
         self.state.start_at(x0);
-        system.taylor_series(mode, &clock, &mut self.state)
+        expansion.taylor_series(mode, &clock, &mut self.state)
     }
 
     /// Expand the tangents from `start` (column-major `n x columns`, the solver's layout)
     /// along the state's series.
-    pub fn expand_tangents<S: HybridSystem + ?Sized>(
+    pub fn expand_tangents(
         &mut self,
-        system: &S,
+        expansion: &dyn TaylorExpansion,
         mode: Mode,
         start: &[f64],
         parameter_column: bool,
@@ -125,7 +126,7 @@ impl TaylorStep {
         let n = self.state.dim();
         transpose(start, n, &mut self.rows);
         self.tangents.start_at(&self.rows);
-        system.taylor_tangents(
+        expansion.taylor_tangents(
             mode,
             &self.clock,
             &self.state,

@@ -46,7 +46,7 @@ pub struct Settings {
     /// three impacts per period, default tolerances), monodromy error 1.9e-5 / 4.6e-5 with
     /// `None`; 6e-7 / 2.5e-6 with `Some(1e-8)` (+19% / +16% RHS evaluations); 5e-9 / 4e-8 with
     /// `Some(1e-10)` (+70% / +56%). A system that declares its contact as a half-power surface
-    /// ([`crate::HybridSystem::half_power_surface`], as the AFM model does) is stepped there on
+    /// ([`crate::SwitchingStructure::half_power_surface`], as the AFM model does) is stepped there on
     /// a square-root clock where the Jacobian is smooth: 4.2e-8 / 1.1e-7 with `None`, and fewer
     /// evaluations than stepping in time (see [`crate::solver`]).
     /// Allowed: `1e-16 ..= 1`, and `None` with [`SensitivityMethod::Decoupled`]. Default
@@ -60,7 +60,7 @@ pub struct Settings {
     /// switching-function units; on the negative side (inside a contact) every extremum is
     /// found. Every step is sampled inside and its extrema located, except a step that the
     /// system proves above this height throughout (by
-    /// [`crate::HybridSystem::switching_curvature_bound`], or for an affine `h_k` by the
+    /// [`crate::SwitchingStructure::switching_curvature_bound`], or for an affine `h_k` by the
     /// Bernstein bound of its interpolant): such a step is sampled at its ends only and reports
     /// no extrema; likewise, an extremum between two samples that the curvature bound proves
     /// above the height is neither located nor reported. Crossings are found either way.
@@ -71,7 +71,7 @@ pub struct Settings {
     /// height: it holds no extremum.) Allowed: `>= 0` (infinity allowed).
     pub extremum_height: f64,
     /// Whether a mode whose system gives the Taylor series of its solution
-    /// ([`crate::HybridSystem::taylor_series`]) is stepped by series (order 20 in the step's
+    /// ([`crate::TaylorExpansion::taylor_series`]) is stepped by series (order 20 in the step's
     /// clock, see the solver's module documentation) rather than DOP853. Default `true`;
     /// `false` gives the Runge-Kutta integration everywhere (a reference to compare against).
     pub taylor_series: bool,

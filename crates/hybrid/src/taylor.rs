@@ -9,10 +9,10 @@
 //! solution next to a Hertz contact's onset or release is analytic in `s`, though not in time.
 //!
 //! The solver takes a Taylor step wherever the system gives series of the mode's solution
-//! ([`crate::HybridSystem::taylor_order_limit`] at least 20, the order of the state's series;
+//! ([`crate::TaylorExpansion::taylor_order_limit`] at least 20, the order of the state's series;
 //! the AFM model does in Hertz contact), and Runge-Kutta steps elsewhere (see the solver's
 //! module documentation). The tangents (transition matrix and `dx/dp`) are expanded along the
-//! state's series by the system's [`crate::HybridSystem::taylor_tangents`], to the state's
+//! state's series by the system's [`crate::TaylorExpansion::taylor_tangents`], to the state's
 //! order, or to order 12 under a [`crate::SensitivityMethod::Decoupled`] integration, whose steps then
 //! also keep the tangents' last two terms below 1e-5.
 

@@ -87,7 +87,7 @@ pub(crate) struct Buffers {
     pub flow_dxdp: Vec<f64>,
     pub product: DMatrix<f64>,
     /// `grad_x h_k` of every surface (`k n .. (k + 1) n`) when all are affine
-    /// ([`crate::HybridSystem::switching_is_affine`]).
+    /// ([`crate::SwitchingStructure::switching_is_affine`]).
     pub affine_gradients: Vec<f64>,
     /// `dh_k/dt` at fixed state of every surface when all are affine.
     pub affine_drifts: Vec<f64>,

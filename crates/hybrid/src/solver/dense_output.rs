@@ -1,6 +1,7 @@
 //! The solver's dense output: the state (and its sensitivities) anywhere inside the last
 //! step, from DOP853's interpolant, the Taylor series or the exact flow.
 
+use crate::accelerations::ExactFlow;
 use crate::clock::Clock;
 use crate::dop853::Dop853;
 use crate::series_step::TaylorStep;
@@ -82,8 +83,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 self.buffers.taylor.state.evaluate(s, x);
             }
             StepKind::Exact => {
+                let Some(flow) = self.accelerations.exact_flow else {
+                    return;
+                };
                 if m == self.n {
-                    self.system.exact_flow(
+                    flow.exact_flow(
                         self.step_mode,
                         self.step_start,
                         &self.buffers.z_start[..self.n],
@@ -94,7 +98,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                     );
                 } else {
                     let mut full = vec![0.0; self.n];
-                    self.system.exact_flow(
+                    flow.exact_flow(
                         self.step_mode,
                         self.step_start,
                         &self.buffers.z_start[..self.n],
@@ -187,8 +191,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
 
 /// The state at `t` in the current (not yet accepted) step: dense output or exact flow.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn state_in_step<S: HybridSystem + ?Sized>(
-    system: &S,
+pub(super) fn state_in_step(
+    exact_flow: Option<&dyn ExactFlow>,
     kind: StepKind,
     mode: Mode,
     (rk, taylor): (&Dop853, &TaylorStep),
@@ -213,7 +217,9 @@ pub(super) fn state_in_step<S: HybridSystem + ?Sized>(
         StepKind::RungeKutta => rk.interpolate(z_start, (clock.sigma(t) - sigma0) / rk.h, out),
         StepKind::Taylor => taylor.state.evaluate(clock.sigma(t) - sigma0, out),
         StepKind::Exact => {
-            system.exact_flow(mode, t0, &z_start[..n], t - t0, out, None, None);
+            if let Some(flow) = exact_flow {
+                flow.exact_flow(mode, t0, &z_start[..n], t - t0, out, None, None);
+            }
         }
         StepKind::None => out.copy_from_slice(&z_start[..n]),
     }

@@ -74,6 +74,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 }
             }
             let system = self.system;
+            let exact_flow = self.accelerations.exact_flow;
             let n = self.n;
             let kind = self.kind;
             let dense = (&self.buffers.rk, &self.buffers.taylor);
@@ -83,7 +84,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let x = &mut self.buffers.x;
             let mut g = |t: f64| {
                 state_in_step(
-                    system, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, x,
+                    exact_flow, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, x,
                 );
                 side * system.switching(k, t, x)
             };

@@ -16,8 +16,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.check_attempts()?;
         let mode = self.mode;
         let limit = self
-            .system
-            .exact_step_limit(mode)
+            .accelerations
+            .exact_flow
+            .map_or(f64::INFINITY, |flow| flow.exact_step_limit(mode))
             .min(self.settings.max_step);
         if limit.is_nan() || limit <= 0.0 {
             return Err(HybridError::InvalidSettings {
@@ -55,32 +56,33 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let n = self.n;
         let (x_start, _) = self.buffers.z_start.split_at(n);
         let (x_new, rest) = self.buffers.z_new.split_at_mut(n);
-        match self.sensitivity {
-            Sensitivity::None => {
-                self.system
-                    .exact_flow(mode, t0, x_start, dt, x_new, None, None);
-            }
-            Sensitivity::Transition => {
-                self.system.exact_flow(
-                    mode,
-                    t0,
-                    x_start,
-                    dt,
-                    x_new,
-                    Some(&mut self.buffers.flow_transition),
-                    None,
-                );
-            }
-            Sensitivity::TransitionAndParameter => {
-                self.system.exact_flow(
-                    mode,
-                    t0,
-                    x_start,
-                    dt,
-                    x_new,
-                    Some(&mut self.buffers.flow_transition),
-                    Some(&mut self.buffers.flow_dxdp),
-                );
+        if let Some(flow) = self.accelerations.exact_flow {
+            match self.sensitivity {
+                Sensitivity::None => {
+                    flow.exact_flow(mode, t0, x_start, dt, x_new, None, None);
+                }
+                Sensitivity::Transition => {
+                    flow.exact_flow(
+                        mode,
+                        t0,
+                        x_start,
+                        dt,
+                        x_new,
+                        Some(&mut self.buffers.flow_transition),
+                        None,
+                    );
+                }
+                Sensitivity::TransitionAndParameter => {
+                    flow.exact_flow(
+                        mode,
+                        t0,
+                        x_start,
+                        dt,
+                        x_new,
+                        Some(&mut self.buffers.flow_transition),
+                        Some(&mut self.buffers.flow_dxdp),
+                    );
+                }
             }
         }
         if self.sensitivity.transition() {

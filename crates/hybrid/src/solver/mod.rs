@@ -39,7 +39,7 @@
 //!   (a minimum and a maximum between the same two samples) are not seen, and nor is a dip
 //!   through a surface that lies between them.
 //! * Steps proven clear. With a finite `Settings::extremum_height` and a system that bounds
-//!   `|h_k''|` ([`HybridSystem::switching_curvature_bound`]), a step on the positive side of
+//!   `|h_k''|` ([`crate::SwitchingStructure::switching_curvature_bound`]), a step on the positive side of
 //!   every surface whose chord between its end values stays above the height even when bent
 //!   by `M dt^2 / 8` is sampled at its ends only, and reports no extrema; an exact-flow step is
 //!   stretched (beyond `exact_step_limit`) as far as `h_k(t0) + h_k'(t0) s - M s^2 / 2` stays
@@ -50,7 +50,7 @@
 //!   between) and is sampled at its ends only. None of these can hide a crossing: the bound
 //!   is rigorous.
 //! * Steps settled on their interpolant. Where every `h_k` is affine in the state and time
-//!   ([`HybridSystem::switching_is_affine`]), its interpolant over a Runge-Kutta step is a
+//!   ([`crate::SwitchingStructure::switching_is_affine`]), its interpolant over a Runge-Kutta step is a
 //!   polynomial of degree 7 in the step's clock (20 over a Taylor step: the series itself), and the Bernstein coefficients of it and of
 //!   its derivative bound them on the whole step (`crate::bernstein`). A step on which every
 //!   `h_k` is proven strictly monotone (both end rates of that sign too), or above the surface
@@ -82,7 +82,7 @@
 //! # Half-power surfaces: the square-root clock
 //!
 //! Where a mode's field contains `|h_k|^{3/2}` (Hertz contact;
-//! [`HybridSystem::half_power_surface`]), the solution next to a transversal crossing `t_c`
+//! [`crate::SwitchingStructure::half_power_surface`]), the solution next to a transversal crossing `t_c`
 //! behaves like `|t - t_c|^{7/2}`: a step in time that starts or ends there has an error of
 //! order 3.5 in its length, whatever the method's order, so onset and release used to cost a
 //! geometric sequence of short steps each, and the variational equations (whose Jacobian goes
@@ -103,10 +103,10 @@
 //! # Taylor-series steps
 //!
 //! Where the system gives the Taylor series of the mode's solution
-//! ([`HybridSystem::taylor_series`]; the AFM model in Hertz contact), a step is one series of
+//! ([`crate::TaylorExpansion::taylor_series`]; the AFM model in Hertz contact), a step is one series of
 //! order 20 in the step's clock offset (`crate::taylor`), as long as its last two terms stay
 //! below the tolerance (Jorba and Zou 2005); the tangents come from the system's tangent series
-//! along it ([`HybridSystem::taylor_tangents`]). The clock is the one in which the solution is
+//! along it ([`crate::TaylorExpansion::taylor_tangents`]). The clock is the one in which the solution is
 //! analytic up to its nearest non-smooth point: the square-root clock from the crossing that
 //! entered the mode, until the crossing out of it that the last series predicts (its first
 //! zero of the half-power surface within two reaches) is nearer (the series of a step is
@@ -147,6 +147,7 @@ mod tuning;
 
 use nalgebra::DMatrix;
 
+use crate::accelerations::Accelerations;
 use crate::clock::Clock;
 use crate::error::HybridError;
 use crate::event::{Event, Extremum};
@@ -207,6 +208,8 @@ enum StepKind {
 /// the state-transition matrix and parameter sensitivity through events (saltation).
 pub struct Solver<'a, S: HybridSystem + ?Sized> {
     system: &'a S,
+    /// The system's optional accelerations ([`HybridSystem::accelerations`]).
+    accelerations: Accelerations<'a>,
     settings: Settings,
     sensitivity: Sensitivity,
     n: usize,
@@ -312,7 +315,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         buffers.flow_transition.fill_with_identity();
         buffers.reset_dxdp.fill(0.0);
         buffers.flow_dxdp.fill(0.0);
-        let affine_switching = (0..surfaces).all(|k| system.switching_is_affine(k));
+        let accelerations = system.accelerations();
+        let affine_switching = (0..surfaces).all(|k| accelerations.switching_is_affine(k));
         if affine_switching {
             for k in 0..surfaces {
                 let partials = system.switching_gradient(
@@ -326,6 +330,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
         let mut solver = Self {
             system,
+            accelerations,
             sensitivity,
             n,
             surfaces,

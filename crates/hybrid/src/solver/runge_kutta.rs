@@ -66,7 +66,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     pub(super) fn runge_kutta_step(&mut self, t_end: f64) -> Result<f64, HybridError> {
         let mode = self.mode;
         let t0 = self.t;
-        let half_power = self.system.half_power_surface(mode);
+        let half_power = self.accelerations.half_power_surface(mode);
         let (rate, h) = self.start_runge_kutta_step();
         // The square root of the time since the event that entered the mode through its
         // half-power surface while that is within a few steps, else time.

@@ -30,7 +30,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let side = side_sign(mode, k);
             let margin = side * self.buffers.samples.values[k * p] - height;
             let rate = side * self.buffers.samples.rates[k * p];
-            let bound = self.system.switching_curvature_bound(
+            let bound = self.accelerations.switching_curvature_bound(
                 k,
                 mode,
                 t0,
@@ -159,7 +159,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     }
 
     /// The system's bound `M_k` on `|h_k''|` over the step `[t0, t1]` for every surface
-    /// ([`HybridSystem::switching_curvature_bound`]), written into `bounds`; `false` (and
+    /// ([`crate::SwitchingStructure::switching_curvature_bound`]), written into `bounds`; `false` (and
     /// nothing usable written) when the system gives none, or a bound is NaN or negative.
     pub(super) fn curvature_bounds(
         &self,
@@ -169,7 +169,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         bounds: &mut [f64],
     ) -> bool {
         (0..self.surfaces).all(|k| {
-            match self.system.switching_curvature_bound(
+            match self.accelerations.switching_curvature_bound(
                 k,
                 mode,
                 t0,

@@ -40,7 +40,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let mode = self.mode;
         self.buffers.z_start.copy_from_slice(&self.buffers.z);
         self.proven_clear = false;
-        let t1 = if self.system.has_exact_flow(mode) {
+        let t1 = if self.accelerations.has_exact_flow(mode) {
             self.exact_step(t_end)?
         } else if let Some(t1) = self.taylor_step(t_end)? {
             t1
@@ -144,6 +144,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     ) -> Result<(), HybridError> {
         self.statistics.sampled_steps += 1;
         let system = self.system;
+        let exact_flow = self.accelerations.exact_flow;
         let n = self.n;
         let kind = self.kind;
         let dense = (&self.buffers.rk, &self.buffers.taylor);
@@ -152,7 +153,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let clock = (self.clock, self.sigma_start);
         let mut state_at = |t: f64, out: &mut [f64]| {
             state_in_step(
-                system, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, out,
+                exact_flow, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, out,
             );
         };
         // Exact steps: every interior state from one call (a linear flow reuses its
@@ -161,14 +162,16 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let grid = match kind {
             StepKind::Exact => {
                 let count = self.buffers.samples.points() - 1;
-                system.exact_flow_grid(
-                    mode,
-                    t0,
-                    &z_start[..n],
-                    t1 - t0,
-                    count,
-                    &mut self.buffers.grid,
-                );
+                if let Some(flow) = exact_flow {
+                    flow.exact_flow_grid(
+                        mode,
+                        t0,
+                        &z_start[..n],
+                        t1 - t0,
+                        count,
+                        &mut self.buffers.grid,
+                    );
+                }
                 Some(&self.buffers.grid[..])
             }
             StepKind::Taylor => {

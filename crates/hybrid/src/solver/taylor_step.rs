@@ -29,12 +29,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// sensitivities, the tangents' series come along, to the order and (where set) under the
     /// tolerance of [`tangent_control`], which then also limits the step.
     pub(super) fn taylor_step(&mut self, t_end: f64) -> Result<Option<f64>, HybridError> {
-        let system = self.system;
         let mode = self.mode;
-        if !self.settings.taylor_series || system.taylor_order_limit(mode) < TAYLOR_ORDER {
+        let accelerations = self.accelerations;
+        if !self.settings.taylor_series || accelerations.taylor_order_limit(mode) < TAYLOR_ORDER {
             return Ok(None);
         }
-        let half_power = system.half_power_surface(mode);
+        let half_power = accelerations.half_power_surface(mode);
         if half_power.is_some() && !self.affine_switching {
             return Ok(None);
         }
@@ -129,9 +129,10 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// current state on the clock `polynomial`; the reach of the step it allows (in the clock
     /// offset), or `None` where the system cannot form the series.
     fn expand_series(&mut self, polynomial: ClockPolynomial) -> Option<f64> {
-        let (system, mode, n) = (self.system, self.mode, self.n);
+        let (mode, n) = (self.mode, self.n);
+        let expansion = self.accelerations.taylor?;
         let taylor = &mut self.buffers.taylor;
-        if !taylor.expand(system, mode, polynomial, &self.buffers.z[..n]) {
+        if !taylor.expand(expansion, mode, polynomial, &self.buffers.z[..n]) {
             return None;
         }
         let mut reach = TaylorStep::reach(
@@ -143,7 +144,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             // The tangents' order was fixed with the workspace (it fits these settings).
             let (_, tolerance) = tangent_control(&self.settings);
             taylor.expand_tangents(
-                system,
+                expansion,
                 mode,
                 &self.buffers.z[n..],
                 self.sensitivity.parameter(),
