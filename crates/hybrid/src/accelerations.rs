@@ -103,7 +103,7 @@ pub trait ExactFlow {
     /// solver may skip extrema (finite [`crate::Settings::extremum_height`]) and the system
     /// bounds the switching functions' curvature
     /// ([`SwitchingStructure::switching_curvature_bound`]), steps proven clear of every surface
-    /// are stretched beyond it.
+    /// are stretched beyond it. The default is `f64::INFINITY` (no limit).
     fn exact_step_limit(&self, mode: Mode) -> f64 {
         let _ = mode;
         f64::INFINITY
@@ -162,9 +162,8 @@ pub trait ExactFlow {
 /// Taylor series of the solution of a mode (by the recurrences of automatic differentiation;
 /// see [`crate::taylor`]), which the solver sums as one step of high order.
 pub trait TaylorExpansion {
-    /// The highest order to which [`TaylorExpansion::taylor_series`] expands the solution of mode
-    /// `mode`; 0 where it gives no Taylor series (see [`crate::taylor`]
-    /// for their use).
+    /// The highest order to which [`TaylorExpansion::taylor_series`] expands the solution of
+    /// mode `mode`; 0 where it gives no Taylor series (see [`crate::taylor`] for their use).
     fn taylor_order_limit(&self, mode: Mode) -> usize;
 
     /// The Taylor coefficients, to `series.order()`, of the solution of `dx/ds = (dt/ds)
@@ -175,20 +174,21 @@ pub trait TaylorExpansion {
     /// To be called only for modes with a positive [`TaylorExpansion::taylor_order_limit`] and
     /// orders up to it. A clock with `rate == 0` starts at the reference of a square-root clock,
     /// which a step starts from only at the crossing of the mode's
-    /// [`SwitchingStructure::half_power_surface`] that entered the mode: the state is on that surface.
+    /// [`SwitchingStructure::half_power_surface`] that entered the mode: the state is on that
+    /// surface.
     fn taylor_series(&self, mode: Mode, clock: &ClockPolynomial, series: &mut TaylorSeries)
         -> bool;
 
     /// The Taylor coefficients, to `tangents.order()` (at most `state.order()`; the solver asks for
     /// fewer under [`crate::SensitivityMethod::Decoupled`]), of a tangent matrix `V` (`n` rows,
     /// `tangents.dim() / n` columns) along the solution whose series is `state` (from
-    /// [`TaylorExpansion::taylor_series`] with the same `mode` and `clock`): `dV/ds = (dt/ds) J(t(s),
-    /// x(s)) V`, plus `(dt/ds) df/dp` on the last column when `parameter_column`. Each coefficient
-    /// of `tangents` is a row-major matrix (component `row * columns + column`: the recurrences
-    /// then run along rows of contiguous columns); the constant terms hold `V` at `s = 0`, and
-    /// every other coefficient is written. `scratch` is free space the implementation may
-    /// resize; the solver's has capacity for `(tangents.order() + 2) * columns` values, so
-    /// that an implementation needing no more allocates nothing in a step.
+    /// [`TaylorExpansion::taylor_series`] with the same `mode` and `clock`): `dV/ds = (dt/ds)
+    /// J(t(s), x(s)) V`, plus `(dt/ds) df/dp` on the last column when `parameter_column`. Each
+    /// coefficient of `tangents` is a row-major matrix (component `row * columns + column`: the
+    /// recurrences then run along rows of contiguous columns); the constant terms hold `V` at `s =
+    /// 0`, and every other coefficient is written. `scratch` is free space the implementation may
+    /// resize; the solver's has capacity for `(tangents.order() + 2) * columns` values, so that an
+    /// implementation needing no more allocates nothing in a step.
     ///
     /// To be called only where [`TaylorExpansion::taylor_series`] returned `true` for `state`.
     fn taylor_tangents(
@@ -207,8 +207,8 @@ pub trait TaylorExpansion {
 /// step next to a surface that enters a field through half-integer powers. Every method's
 /// default is "unknown".
 pub trait SwitchingStructure {
-    /// Whether `h_k` is affine in the state and in time, `h_k(t, x) = g . x + b t + c` with
-    /// `g` and `b` constant (as [`crate::HybridSystem::switching_gradient`] gives them, read once per
+    /// Whether `h_k` is affine in the state and in time, `h_k(t, x) = g . x + b t + c` with `g` and
+    /// `b` constant (as [`crate::HybridSystem::switching_gradient`] gives them, read once per
     /// solver). The default is `false`.
     ///
     /// Over a Runge-Kutta or Taylor step the interpolant of such an `h_k` is a polynomial in

@@ -10,9 +10,9 @@ use crate::settings::{SensitivityMethod, Settings};
 use crate::taylor::{ClockPolynomial, TaylorSeries};
 
 /// The order of the solver's Taylor-series steps. At a tolerance of 1e-12 a series of order 20
-/// reaches about a quarter of its radius of convergence (`1e-12^(1/20)`); through a Hertz
-/// contact of the Biolever on mica that is 8 steps per contact against ~30 DOP853 attempts
-/// (orders 16 / 24 / 30: 12 / 6 / 5 steps, each dearer as the order squared).
+/// reaches about a quarter of its radius of convergence (`1e-12^(1/20)`): a few steps through
+/// a Hertz contact, where DOP853 takes tens of attempts. A higher order takes fewer steps, each
+/// dearer as the order squared; a lower one more.
 pub(crate) const TAYLOR_ORDER: usize = 20;
 
 /// The order of the tangent series and the tolerance on their last two terms (limiting the
@@ -32,23 +32,16 @@ pub(crate) fn tangent_control(settings: &Settings) -> (usize, Option<f64>) {
 
 /// The order of the tangent series on the steps of a [`crate::SensitivityMethod::Decoupled`]
 /// integration (the state's stays [`TAYLOR_ORDER`]): enough for Newton (the monodromy over a
-/// period of the Biolever on mica at tolerance 1e-12 within 1.3e-6 and 2.3e-6 relative at
-/// A/A0 = 0.95 and 0.5, against 6e-9 and 4e-8 at the state's order; `cargo run --release -p
-/// afm --example monodromy_error`), at under half the cost. Order 14 was as accurate at
-/// tolerance 1e-12 (1.0e-6 and 2.3e-6) and more so at the first Newton map's 1e-9 (4.9e-7
-/// and 1.9e-4 against 8.7e-4 and 1.6e-4), for 3.3% more instructions per steady orbit from
-/// its neighbour at A/A0 = 0.5 (1.765M against 1.708M) and 4.8% at 0.9. Along approach
-/// branches in 0.01 to 0.02 nm steps (scratch driver, callgrind) order 12 took 1.9%, 0.7% and
-/// 3.7% fewer instructions for the Biolever on mica, MAClever on mica and Biolever on the
-/// soft sample, with the same Newton iterations except 12 more of 965 MAClever orbits taking
-/// 3 instead of 2; orders 10, 11 and 13 were slower or less accurate.
+/// period within about 1e-6 relative at tolerance 1e-12, where the state's order gives about
+/// 1e-8; `cargo run --release -p afm --example monodromy_error` measures it), at under half
+/// the cost of the state's order. A higher order costs more per step for the same Newton
+/// iterations; a lower one loses accuracy.
 pub(crate) const DECOUPLED_TANGENT_ORDER: usize = 12;
 
 /// The tangent series' tolerance (relative and absolute) on the steps of a
 /// [`crate::SensitivityMethod::Decoupled`] integration. It binds only where the state's is
-/// looser: at 1e-8 the monodromy above comes within 2.0e-3 and 2.3e-3 (at order 14, where
-/// this was chosen, 3e-4 and 8e-4; there 1e-6 gave 1e-5 and 4e-5 for 3% more instructions per
-/// steady orbit from its neighbour, 1e-4 gave 7e-3).
+/// looser (a first, loose Newton map), where it keeps the monodromy within a few 1e-3: enough
+/// for the iteration to contract. Tighter costs more steps for no fewer iterations.
 pub(crate) const DECOUPLED_TANGENT_TOLERANCE: f64 = 1e-5;
 
 /// The rows of `columns` values beyond the tangents' order that the scratch space of
@@ -79,10 +72,10 @@ pub(crate) struct TaylorStep {
 }
 
 impl TaylorStep {
-    /// Storage for `n` states and `columns` tangent columns (0: none), the tangents to the
-    /// order [`tangent_control`] gives for `settings`, and scratch for
-    /// [`crate::TaylorExpansion::taylor_tangents`] with room for [`TANGENT_SCRATCH_ROWS`] more rows of
-    /// `columns` than that order.
+    /// Storage for `n` states and `columns` tangent columns (0: none), the tangents to the order
+    /// [`tangent_control`] gives for `settings`, and scratch for
+    /// [`crate::TaylorExpansion::taylor_tangents`] with room for [`TANGENT_SCRATCH_ROWS`] more rows
+    /// of `columns` than that order.
     pub fn new(n: usize, columns: usize, settings: &Settings) -> Self {
         let order = tangent_control(settings).0;
         Self {
@@ -151,10 +144,10 @@ impl TaylorStep {
     /// a shallow minimum between two deep ones (just after two contacts merge) has branch points
     /// off the real axis next to that ridge ([`surface_ahead`]), and series steps across it,
     /// accepted by the state's terms alone, left errors of up to 1.5e-6 nm in the period map
-    /// and 4e-3 in the monodromy (MAClever on soft, A0 = 3 nm, up to 2e-5 nm past the merge at
-    /// 1.6263 nm). Measured there with this bound: at most 1.3e-11 nm and 2.4e-8 (relative),
-    /// against DOP853 at 1e-13, for 27 to 40 series steps per period instead of 11; a quarter
-    /// of the radius took 52 to 77 and was no more accurate, three quarters 21 to 30 (9e-8).
+    /// and 4e-3 in the monodromy (MAClever on soft, A0 = 3 nm, just past the merge at 1.6263
+    /// nm). Within half the radius the errors stay at the tolerance's level (tested in
+    /// `afm/tests/contact_ridge.rs`); a smaller fraction costs more steps for no accuracy, a
+    /// larger one loses it.
     pub fn radius_reach(radius: f64) -> f64 {
         0.5 * radius
     }
@@ -229,8 +222,8 @@ impl Ridge {
 ///   safeguarding Newton's method to the last bits. Two zeros between neighbouring samples go
 ///   unseen: the solver uses this only to choose a step's clock, and finds crossings inside a
 ///   step by its own tests. (The solver looks up to two steps' reach ahead, so the samples are
-///   a quarter of a step apart, where the series' radius is about four steps; 16 samples cost
-///   1.6% more of an orbit at A/A0 = 0.5 and gave the same outputs.)
+///   a quarter of a step apart, where the series' radius is about four steps: denser samples
+///   would find nothing more.)
 /// * a ridge before it: the first point (the start or a sample) nearer the surface than both
 ///   its neighbours (`side h` a local minimum, still on the mode's side; at the start, falling
 ///   towards the surface), the minimum `g_m = side h(s_m) > 0` located as the zero of the

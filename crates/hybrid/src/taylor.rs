@@ -10,11 +10,11 @@
 //!
 //! The solver takes a Taylor step wherever the system gives series of the mode's solution
 //! ([`crate::TaylorExpansion::taylor_order_limit`] at least 20, the order of the state's series;
-//! the AFM model does in Hertz contact), and Runge-Kutta steps elsewhere (see the solver's
-//! module documentation). The tangents (transition matrix and `dx/dp`) are expanded along the
-//! state's series by the system's [`crate::TaylorExpansion::taylor_tangents`], to the state's
-//! order, or to order 12 under a [`crate::SensitivityMethod::Decoupled`] integration, whose steps then
-//! also keep the tangents' last two terms below 1e-5.
+//! the AFM model does in Hertz contact), and Runge-Kutta steps elsewhere (see the solver's module
+//! documentation). The tangents (transition matrix and `dx/dp`) are expanded along the state's
+//! series by the system's [`crate::TaylorExpansion::taylor_tangents`], to the state's order, or to
+//! order 12 under a [`crate::SensitivityMethod::Decoupled`] integration, whose steps then also keep
+//! the tangents' last two terms below 1e-5.
 
 /// The time along a step as a polynomial in the step's clock offset `s` (the clock reading
 /// minus its reading at the step start): `t(s) = start + rate s + curvature s^2`. On the time

@@ -39,26 +39,25 @@
 //!   (a minimum and a maximum between the same two samples) are not seen, and nor is a dip
 //!   through a surface that lies between them.
 //! * Steps proven clear. With a finite `Settings::extremum_height` and a system that bounds
-//!   `|h_k''|` ([`crate::SwitchingStructure::switching_curvature_bound`]), a step on the positive side of
-//!   every surface whose chord between its end values stays above the height even when bent
+//!   `|h_k''|` ([`crate::SwitchingStructure::switching_curvature_bound`]), a step on the positive
+//!   side of every surface whose chord between its end values stays above the height even when bent
 //!   by `M dt^2 / 8` is sampled at its ends only, and reports no extrema; an exact-flow step is
-//!   stretched (beyond `exact_step_limit`) as far as `h_k(t0) + h_k'(t0) s - M s^2 / 2` stays
-//!   above the height. In a step that is sampled, a sample interval whose chord bent by
-//!   `M spacing^2 / 8` stays above the height is not searched for an extremum (free flight
-//!   between contacts, whose gap minima clear the sample). At any height, a step whose end
-//!   rates have one sign and `|r0| + |r1| > M dt` is monotone (the rate cannot reach zero in
-//!   between) and is sampled at its ends only. None of these can hide a crossing: the bound
-//!   is rigorous.
+//!   stretched (beyond `exact_step_limit`) as far as `h_k(t0) + h_k'(t0) s - M s^2 / 2` stays above
+//!   the height. In a step that is sampled, a sample interval whose chord bent by `M spacing^2 / 8`
+//!   stays above the height is not searched for an extremum (free flight between contacts, whose
+//!   gap minima clear the sample). At any height, a step whose end rates have one sign and `|r0| +
+//!   |r1| > M dt` is monotone (the rate cannot reach zero in between) and is sampled at its ends
+//!   only. None of these can hide a crossing: the bound is rigorous.
 //! * Steps settled on their interpolant. Where every `h_k` is affine in the state and time
-//!   ([`crate::SwitchingStructure::switching_is_affine`]), its interpolant over a Runge-Kutta step is a
-//!   polynomial of degree 7 in the step's clock (20 over a Taylor step: the series itself), and the Bernstein coefficients of it and of
-//!   its derivative bound them on the whole step (`crate::bernstein`). A step on which every
-//!   `h_k` is proven strictly monotone (both end rates of that sign too), or above the surface
-//!   and the extremum height, is sampled at its ends only: it holds no extremum the samples
-//!   could find, and at most one crossing per surface, which the signs at its ends show and
-//!   which is located on the interpolant as usual. Inside a Hertz contact every step but the
-//!   one holding the deepest indentation is monotone. The bound is rigorous for the
-//!   interpolant, which is what sampling inspects too.
+//!   ([`crate::SwitchingStructure::switching_is_affine`]), its interpolant over a Runge-Kutta step
+//!   is a polynomial of degree 7 in the step's clock (20 over a Taylor step: the series itself),
+//!   and the Bernstein coefficients of it and of its derivative bound them on the whole step
+//!   (`crate::bernstein`). A step on which every `h_k` is proven strictly monotone (both end rates
+//!   of that sign too), or above the surface and the extremum height, is sampled at its ends only:
+//!   it holds no extremum the samples could find, and at most one crossing per surface, which the
+//!   signs at its ends show and which is located on the interpolant as usual. Inside a Hertz
+//!   contact every step but the one holding the deepest indentation is monotone. The bound is
+//!   rigorous for the interpolant, which is what sampling inspects too.
 //!
 //! # Step-size control
 //!
@@ -82,13 +81,13 @@
 //! # Half-power surfaces: the square-root clock
 //!
 //! Where a mode's field contains `|h_k|^{3/2}` (Hertz contact;
-//! [`crate::SwitchingStructure::half_power_surface`]), the solution next to a transversal crossing `t_c`
-//! behaves like `|t - t_c|^{7/2}`: a step in time that starts or ends there has an error of
-//! order 3.5 in its length, whatever the method's order, so onset and release used to cost a
-//! geometric sequence of short steps each, and the variational equations (whose Jacobian goes
-//! like `|h|^{1/2}`) carried errors the state-only controller did not see. In
-//! `sigma = sign(t - t_c) sqrt|t - t_c|` the same solution is smooth, so such steps run on a
-//! square-root clock (`crate::clock`):
+//! [`crate::SwitchingStructure::half_power_surface`]), the solution next to a transversal crossing
+//! `t_c` behaves like `|t - t_c|^{7/2}`: a step in time that starts or ends there has an error of
+//! order 3.5 in its length, whatever the method's order, so onset and release would cost a
+//! geometric sequence of short steps each, and the variational equations (whose Jacobian goes like
+//! `|h|^{1/2}`) would carry errors the state-only controller does not see. In `sigma = sign(t -
+//! t_c) sqrt|t - t_c|` the same solution is smooth, so such steps run on a square-root clock
+//! (`crate::clock`):
 //!
 //! * after entering the mode through the surface, from the event, while the time since it is
 //!   below `ROOT_CLOCK_SPAN` proposed steps;
@@ -103,36 +102,29 @@
 //! # Taylor-series steps
 //!
 //! Where the system gives the Taylor series of the mode's solution
-//! ([`crate::TaylorExpansion::taylor_series`]; the AFM model in Hertz contact), a step is one series of
-//! order 20 in the step's clock offset (`crate::taylor`), as long as its last two terms stay
-//! below the tolerance (Jorba and Zou 2005); the tangents come from the system's tangent series
-//! along it ([`crate::TaylorExpansion::taylor_tangents`]). The clock is the one in which the solution is
-//! analytic up to its nearest non-smooth point: the square-root clock from the crossing that
-//! entered the mode, until the crossing out of it that the last series predicts (its first
-//! zero of the half-power surface within two reaches) is nearer (the series of a step is
-//! re-centred on a crossing inside its own reach on that condition too, so that no series is
-//! expanded next to the entering crossing's half power: a grazing contact, shorter than that
-//! reach, is one step on the clock of its onset); then the square-root clock
-//! centred `ROOT_OVERSHOOT` past that predicted crossing, re-centred on the zero of its own
-//! series when they differ, so that the step landing on its reference holds the crossing, which
-//! is then located on the series like any other. A ridge of that surface (approached and left
-//! without a crossing: the indentation's shallow minimum between two merged contacts), seen
-//! ahead on the series or passed earlier in the mode, puts branch points of `|h|^{1/2}` next to
-//! the real axis that the state's last terms do not show: the step then stays within half
-//! their distance (`crate::taylor::surface_ahead`, `TaylorStep::radius_reach`). The series is
-//! the step's dense output, and
-//! its polynomial in the switching function carries the Bernstein tests above. A system that
-//! gives no series, a series that cannot be formed (a grazing touch), a crossing predicted past
-//! the reference, or a reach collapsing below `1e-3` of the last series step hands the step to
-//! DOP853. Measured on one period at `A/A0 = 0.5` (Biolever on mica, three impacts, tolerance
-//! 1e-12): 24 series steps and 2 DOP853 steps for the three contacts, where DOP853 alone took
-//! 74 accepted and 21 rejected steps (1357 evaluations of the field).
-//!
-//! Measured on one period of the Biolever on mica (`cargo run --release -p afm --example
-//! monodromy_error`, state-only error control): at `A/A0 = 0.95` 461 RHS evaluations instead of
-//! 633 stepping in time, and the monodromy matrix within 4.2e-8 (relative) of a run with the
-//! sensitivities under error control instead of 2.4e-5; at `A/A0 = 0.5` (three impacts) 1378
-//! instead of 1946, and 1.1e-7 instead of 5.5e-5.
+//! ([`crate::TaylorExpansion::taylor_series`]; the AFM model in Hertz contact), a step is one
+//! series of order 20 in the step's clock offset (`crate::taylor`), as long as its last two terms
+//! stay below the tolerance (Jorba and Zou 2005); the tangents come from the system's tangent
+//! series along it ([`crate::TaylorExpansion::taylor_tangents`]). The clock is the one in which the
+//! solution is analytic up to its nearest non-smooth point: the square-root clock from the crossing
+//! that entered the mode, until the crossing out of it that the last series predicts (its first
+//! zero of the half-power surface within two reaches) is nearer (the series of a step is re-centred
+//! on a crossing inside its own reach on that condition too, so that no series is expanded next to
+//! the entering crossing's half power: a grazing contact, shorter than that reach, is one step on
+//! the clock of its onset); then the square-root clock centred `ROOT_OVERSHOOT` past that predicted
+//! crossing, re-centred on the zero of its own series when they differ, so that the step landing on
+//! its reference holds the crossing, which is then located on the series like any other. A ridge of
+//! that surface (approached and left without a crossing: the indentation's shallow minimum between
+//! two merged contacts), seen ahead on the series or passed earlier in the mode, puts branch points
+//! of `|h|^{1/2}` next to the real axis that the state's last terms do not show: the step then
+//! stays within half their distance (`crate::series_step::surface_ahead`,
+//! `TaylorStep::radius_reach`). The series is the step's dense output, and its polynomial in the
+//! switching function carries the Bernstein tests above. A system that gives no series, a series
+//! that cannot be formed (a grazing touch), a crossing predicted past the reference, or a reach
+//! collapsing below `1e-3` of the last series step hands the step to DOP853. Through a Hertz
+//! contact a series step replaces tens of DOP853 attempts, and on the square-root clock the
+//! monodromy matrix is accurate to the state's tolerance without error control of the sensitivities
+//! (`cargo run --release -p afm --example monodromy_error` compares the methods).
 
 mod crossing_search;
 mod dense_output;

@@ -159,8 +159,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     }
 
     /// The system's bound `M_k` on `|h_k''|` over the step `[t0, t1]` for every surface
-    /// ([`crate::SwitchingStructure::switching_curvature_bound`]), written into `bounds`; `false` (and
-    /// nothing usable written) when the system gives none, or a bound is NaN or negative.
+    /// ([`crate::SwitchingStructure::switching_curvature_bound`]), written into `bounds`; `false`
+    /// (and nothing usable written) when the system gives none, or a bound is NaN or negative.
     pub(super) fn curvature_bounds(
         &self,
         mode: Mode,
