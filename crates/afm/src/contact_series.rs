@@ -384,7 +384,7 @@ const COLUMN_BLOCK: usize = 8;
 mod tests {
     use hybrid::{
         ClockPolynomial, Direction, HybridSystem, Sensitivity, Settings, Solver, StepOutcome,
-        TaylorSeries,
+        TaylorExpansion, TaylorSeries,
     };
     use nalgebra::DMatrix;
 

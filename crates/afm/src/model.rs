@@ -4,7 +4,8 @@
 use std::f64::consts::PI;
 
 use hybrid::{
-    ClockPolynomial, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials, TaylorSeries,
+    Accelerations, ClockPolynomial, ExactFlow, HybridSystem, LinearisationBuffers, Mode,
+    SwitchingPartials, SwitchingStructure, TaylorExpansion, TaylorSeries,
 };
 use nalgebra::DMatrix;
 
@@ -45,7 +46,7 @@ pub(crate) struct ModalConstants {
 }
 
 /// The grid counts `c = 1..=KEPT_GRIDS` over the standard exact step whose spacings'
-/// transitions are kept: the solver asks [`HybridSystem::exact_flow_grid`] for
+/// transitions are kept: the solver asks [`hybrid::ExactFlow::exact_flow_grid`] for
 /// `samples_per_step + 1` intervals (9 with its default, 5 in a sweep), so any
 /// `samples_per_step` up to 15 is served without recomputing them.
 const KEPT_GRIDS: usize = 16;
@@ -538,13 +539,6 @@ impl HybridSystem for TappingModel {
         self.modal_tangent_rates(slope, tangents, tangent_rates, parameter_column);
     }
 
-    /// In contact the Hertz force is `c (-d)^{3/2}`: the gap is the half-power surface of
-    /// the contact mode, and the solver integrates next to contact onset and release in the
-    /// square root of the time from them.
-    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
-        Self::in_contact(mode).then_some(0)
-    }
-
     /// `h_0 = d = Z(t) + sum_i q_i`, nm.
     fn switching(&self, _k: usize, t: f64, x: &[f64]) -> f64 {
         self.gap(t, x)
@@ -553,11 +547,6 @@ impl HybridSystem for TappingModel {
     /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in both modes), nm/us.
     fn switching_rate(&self, _k: usize, _mode: Mode, _t: f64, x: &[f64]) -> f64 {
         self.gap_rate(x)
-    }
-
-    /// The gap `Z(t) + sum_i q_i` is affine: `Z(t)` is a constant or a linear ramp.
-    fn switching_is_affine(&self, _k: usize) -> bool {
-        true
     }
 
     /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'`; `dh/dt|_x = Z'(t)`; `dh/dZ = 1`.
@@ -577,60 +566,18 @@ impl HybridSystem for TappingModel {
         }
     }
 
-    /// In contact, 40: the contact flow's Taylor series come from the recurrences of automatic
-    /// differentiation (module `contact_series`), whose intermediate series live on the stack.
-    fn taylor_order_limit(&self, mode: Mode) -> usize {
-        if Self::in_contact(mode) {
-            contact_series::MAX_ORDER
-        } else {
-            0
+    /// The free flight's closed-form flow, the contact's Taylor series, and the gap's shape
+    /// (affine; its curvature bounded in free flight; a half-power surface in contact).
+    fn accelerations(&self) -> Accelerations<'_> {
+        Accelerations {
+            exact_flow: Some(self),
+            taylor: Some(self),
+            switching: Some(self),
         }
     }
+}
 
-    /// In contact, the series of Eq. 1 with the Hertz force in the step's clock (module
-    /// `contact_series`); `false` in free flight (which has its exact flow).
-    fn taylor_series(
-        &self,
-        mode: Mode,
-        clock: &ClockPolynomial,
-        series: &mut TaylorSeries,
-    ) -> bool {
-        Self::in_contact(mode)
-            && contact_series::contact_state_series(
-                &self.modes,
-                self.hertz.coefficient,
-                self.drive.angular_frequency,
-                &self.separation,
-                clock,
-                series,
-            )
-    }
-
-    /// In contact, the series of the variational equations along the contact series (module
-    /// `contact_series`).
-    fn taylor_tangents(
-        &self,
-        mode: Mode,
-        clock: &ClockPolynomial,
-        state: &TaylorSeries,
-        tangents: &mut TaylorSeries,
-        parameter_column: bool,
-        scratch: &mut Vec<f64>,
-    ) {
-        if Self::in_contact(mode) {
-            contact_series::contact_tangent_series(
-                &self.modes,
-                self.hertz.coefficient,
-                &self.separation,
-                clock,
-                state,
-                tangents,
-                parameter_column,
-                scratch,
-            );
-        }
-    }
-
+impl ExactFlow for TappingModel {
     fn has_exact_flow(&self, mode: Mode) -> bool {
         mode == FREE_FLIGHT
     }
@@ -642,44 +589,6 @@ impl HybridSystem for TappingModel {
         } else {
             f64::INFINITY
         }
-    }
-
-    /// In free flight, a bound on the gap's curvature `|d''| = |Z'' + sum_i q_i''|` over
-    /// `[t0, t0 + dt]` (any `dt`), nm/us^2; `Z'' = 0` for both separation laws. Each mode is its
-    /// steady drive response `p_i = alpha_i cos(w t) + beta_i sin(w t)` plus a homogeneous part
-    /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
-    /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
-    /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
-    /// (extrema inside the sample, the gap's minima, are always wanted).
-    fn switching_curvature_bound(
-        &self,
-        _k: usize,
-        mode: Mode,
-        t0: f64,
-        x0: &[f64],
-        _dt: f64,
-    ) -> Option<f64> {
-        if Self::in_contact(mode) {
-            return None;
-        }
-        let w = self.drive.angular_frequency;
-        let (sin, cos) = phase::sin_cos(w * t0);
-        let bound = self
-            .modes
-            .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
-                let (y, dy) = (x0[2 * i] - p, x0[2 * i + 1] - dp);
-                let [alpha, beta] = m.oscillator.steady_coefficients();
-                let steady = w * w * alpha.hypot(beta);
-                let homogeneous = (m.omega_squared.sqrt() + m.damping)
-                    * (dy * dy + m.omega_squared * y * y).sqrt();
-                steady + homogeneous
-            })
-            .sum::<f64>();
-        // Slack for the rounding of the sums (relative 1e-12) and of `y` (absolute).
-        bound.is_finite().then_some(bound * (1.0 + 1e-12) + 1e-12)
     }
 
     /// The free flight at `count` equally spaced times: one homogeneous transition over the
@@ -774,6 +683,114 @@ impl HybridSystem for TappingModel {
         if let Some(dxdp) = dxdp {
             dxdp.fill(0.0);
         }
+    }
+}
+
+impl TaylorExpansion for TappingModel {
+    /// In contact, 40: the contact flow's Taylor series come from the recurrences of automatic
+    /// differentiation (module `contact_series`), whose intermediate series live on the stack.
+    fn taylor_order_limit(&self, mode: Mode) -> usize {
+        if Self::in_contact(mode) {
+            contact_series::MAX_ORDER
+        } else {
+            0
+        }
+    }
+
+    /// In contact, the series of Eq. 1 with the Hertz force in the step's clock (module
+    /// `contact_series`); `false` in free flight (which has its exact flow).
+    fn taylor_series(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        series: &mut TaylorSeries,
+    ) -> bool {
+        Self::in_contact(mode)
+            && contact_series::contact_state_series(
+                &self.modes,
+                self.hertz.coefficient,
+                self.drive.angular_frequency,
+                &self.separation,
+                clock,
+                series,
+            )
+    }
+
+    /// In contact, the series of the variational equations along the contact series (module
+    /// `contact_series`).
+    fn taylor_tangents(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        state: &TaylorSeries,
+        tangents: &mut TaylorSeries,
+        parameter_column: bool,
+        scratch: &mut Vec<f64>,
+    ) {
+        if Self::in_contact(mode) {
+            contact_series::contact_tangent_series(
+                &self.modes,
+                self.hertz.coefficient,
+                &self.separation,
+                clock,
+                state,
+                tangents,
+                parameter_column,
+                scratch,
+            );
+        }
+    }
+}
+
+impl SwitchingStructure for TappingModel {
+    /// In contact the Hertz force is `c (-d)^{3/2}`: the gap is the half-power surface of
+    /// the contact mode, and the solver integrates next to contact onset and release in the
+    /// square root of the time from them.
+    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
+        Self::in_contact(mode).then_some(0)
+    }
+
+    /// The gap `Z(t) + sum_i q_i` is affine: `Z(t)` is a constant or a linear ramp.
+    fn switching_is_affine(&self, _k: usize) -> bool {
+        true
+    }
+
+    /// In free flight, a bound on the gap's curvature `|d''| = |Z'' + sum_i q_i''|` over
+    /// `[t0, t0 + dt]` (any `dt`), nm/us^2; `Z'' = 0` for both separation laws. Each mode is its
+    /// steady drive response `p_i = alpha_i cos(w t) + beta_i sin(w t)` plus a homogeneous part
+    /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
+    /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
+    /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
+    /// (extrema inside the sample, the gap's minima, are always wanted).
+    fn switching_curvature_bound(
+        &self,
+        _k: usize,
+        mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        _dt: f64,
+    ) -> Option<f64> {
+        if Self::in_contact(mode) {
+            return None;
+        }
+        let w = self.drive.angular_frequency;
+        let (sin, cos) = phase::sin_cos(w * t0);
+        let bound = self
+            .modes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
+                let (y, dy) = (x0[2 * i] - p, x0[2 * i + 1] - dp);
+                let [alpha, beta] = m.oscillator.steady_coefficients();
+                let steady = w * w * alpha.hypot(beta);
+                let homogeneous = (m.omega_squared.sqrt() + m.damping)
+                    * (dy * dy + m.omega_squared * y * y).sqrt();
+                steady + homogeneous
+            })
+            .sum::<f64>();
+        // Slack for the rounding of the sums (relative 1e-12) and of `y` (absolute).
+        bound.is_finite().then_some(bound * (1.0 + 1e-12) + 1e-12)
     }
 }
 

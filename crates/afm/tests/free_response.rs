@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use afm::trigonometric::TrigonometricPolynomial;
 use afm::{Drive, FreeResponse, Separation, TappingModel};
-use hybrid::HybridSystem;
+use hybrid::{ExactFlow, HybridSystem};
 
 fn biolever_model() -> TappingModel {
     TappingModel::new(

@@ -5,7 +5,7 @@ mod common;
 
 use afm::model::{CONTACT, FREE_FLIGHT};
 use afm::{Separation, TappingModel};
-use hybrid::HybridSystem;
+use hybrid::{ExactFlow, HybridSystem};
 use nalgebra::DMatrix;
 
 /// A three-mode cantilever (nothing may hard-wire N = 2), over-damped third mode included.

@@ -352,7 +352,7 @@ fn cycle_lockin_matches_the_period_observables() {
 fn free_flight_fourier_matches_quadrature_of_the_exact_flow() {
     use afm::free_flight_fourier::FreeFlightFourier;
     use afm::{Separation, TappingModel};
-    use hybrid::HybridSystem;
+    use hybrid::ExactFlow;
     let nodes = [
         0.183_434_642_495_649_8,
         0.525_532_409_916_329,

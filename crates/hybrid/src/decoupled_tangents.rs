@@ -10,9 +10,9 @@
 //! its order through contact onset and release.
 
 use crate::clock::Clock;
-use crate::sensitivity::{Sensitivity, VariationalField};
-use crate::solver::clocked_field;
+use crate::sensitivity::Sensitivity;
 use crate::system::{HybridSystem, Mode};
+use crate::variational_field::{clocked_field, VariationalField};
 
 /// Stages of the method.
 const STAGES: usize = 7;

@@ -3,10 +3,8 @@
 //! with separate tolerances for time and for the function value. Where the solver has the
 //! switching function's values and rates at both ends of the interval (its samples), the
 //! search starts from the zero of their cubic Hermite interpolant, refined by secant steps and
-//! closed by two evaluations a tolerance apart; Illinois finishes what that leaves. On the
-//! quick approach benchmark this takes 2.1% of the instructions away (the closures that
-//! evaluate the state during location are called 35% fewer times for crossings, 14% for
-//! extrema).
+//! closed by two evaluations a tolerance apart; Illinois finishes what that leaves (the state
+//! is then interpolated fewer times than by Illinois from the bracket ends alone).
 
 use std::cell::Cell;
 

@@ -96,7 +96,7 @@ impl Samples {
 
     /// Sample `h_k` and `dh_k/dt` (in `mode`) at the step's points between `t0` and `t1`;
     /// with `grid`, the interior states are read from it (interior point `i` at
-    /// `grid[(i - 1) n .. i n]`, as [`HybridSystem::exact_flow_grid`] writes them) instead of
+    /// `grid[(i - 1) n .. i n]`, as [`crate::ExactFlow::exact_flow_grid`] writes them) instead of
     /// `state_at`.
     ///
     /// # Errors

@@ -7,8 +7,6 @@
 
 use nalgebra::DMatrix;
 
-use crate::system::{HybridSystem, Mode};
-
 /// Which derivatives of the flow to integrate with the state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Sensitivity {
@@ -44,7 +42,7 @@ impl Sensitivity {
 }
 
 /// Scratch space for the Jacobian `J = df/dx` (`n x n`) and `df/dp` (length `n`) of one point,
-/// in which the default [`HybridSystem::variational_field`] forms them.
+/// in which the default [`crate::HybridSystem::variational_field`] forms them.
 #[derive(Debug, Clone)]
 pub struct LinearisationBuffers {
     /// `df/dx`, `n x n`.
@@ -60,67 +58,6 @@ impl LinearisationBuffers {
             jacobian: DMatrix::zeros(n, n),
             dfdp: vec![0.0; n],
         }
-    }
-}
-
-/// The augmented right-hand side `[f, J Phi, J s + df/dp]` of one mode, with preallocated
-/// linearisation buffers and a count of vector-field evaluations.
-pub(crate) struct VariationalField {
-    n: usize,
-    sensitivity: Sensitivity,
-    buffers: LinearisationBuffers,
-    /// Number of calls of `HybridSystem::vector_field` made through this object.
-    pub evaluations: usize,
-}
-
-impl VariationalField {
-    pub fn new(n: usize, sensitivity: Sensitivity) -> Self {
-        Self {
-            n,
-            sensitivity,
-            buffers: LinearisationBuffers::new(n),
-            evaluations: 0,
-        }
-    }
-
-    /// Dimension `n` of the state (the leading part of the augmented state).
-    pub fn state_dim(&self) -> usize {
-        self.n
-    }
-
-    /// Evaluate `dz/dt` at `(t, z)` in `mode`; with `variational == false` only the state part
-    /// `dz[..n]` is written.
-    #[inline(always)]
-    pub fn eval<S: HybridSystem + ?Sized>(
-        &mut self,
-        system: &S,
-        mode: Mode,
-        t: f64,
-        z: &[f64],
-        dz: &mut [f64],
-        variational: bool,
-    ) {
-        let n = self.n;
-        self.evaluations += 1;
-        if !variational || !self.sensitivity.transition() {
-            system.vector_field(mode, t, &z[..n], &mut dz[..n]);
-            return;
-        }
-        // The columns of Phi (and s) follow the state, column-major and contiguous.
-        let parameter = self.sensitivity.parameter();
-        let columns = if parameter { n + 1 } else { n };
-        let (x, tangents) = z.split_at(n);
-        let (dx, tangent_rates) = dz.split_at_mut(n);
-        system.variational_field(
-            mode,
-            t,
-            x,
-            dx,
-            &tangents[..columns * n],
-            &mut tangent_rates[..columns * n],
-            parameter,
-            &mut self.buffers,
-        );
     }
 }
 

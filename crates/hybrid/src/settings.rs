@@ -42,13 +42,12 @@ pub struct Settings {
     ///
     /// Where the Jacobian is not smooth in time (Hertz contact, `J ~ sqrt(-h)` at contact
     /// onset and release), stepping in time with `None` leaves the sensitivities with relative
-    /// errors ~1e-5: measured over one period of the paper's Biolever on mica (one impact /
-    /// three impacts per period, default tolerances), monodromy error 1.9e-5 / 4.6e-5 with
-    /// `None`; 6e-7 / 2.5e-6 with `Some(1e-8)` (+19% / +16% RHS evaluations); 5e-9 / 4e-8 with
-    /// `Some(1e-10)` (+70% / +56%). A system that declares its contact as a half-power surface
-    /// ([`crate::HybridSystem::half_power_surface`], as the AFM model does) is stepped there on
-    /// a square-root clock where the Jacobian is smooth: 4.2e-8 / 1.1e-7 with `None`, and fewer
-    /// evaluations than stepping in time (see [`crate::solver`]).
+    /// errors ~1e-5 (over one period of the paper's Biolever on mica at default tolerances);
+    /// `Some(1e-8)` brings the monodromy to ~1e-6 and `Some(1e-10)` to ~1e-8, for about a
+    /// fifth and two thirds more evaluations of the field. A system that declares its contact
+    /// as a half-power surface ([`crate::SwitchingStructure::half_power_surface`], as the AFM
+    /// model does) is stepped there on a square-root clock where the Jacobian is smooth: ~1e-7
+    /// with `None`, and fewer evaluations than stepping in time (see [`crate::solver`]).
     /// Allowed: `1e-16 ..= 1`, and `None` with [`SensitivityMethod::Decoupled`]. Default
     /// `None`.
     pub sensitivity_tolerance: Option<f64>,
@@ -60,7 +59,7 @@ pub struct Settings {
     /// switching-function units; on the negative side (inside a contact) every extremum is
     /// found. Every step is sampled inside and its extrema located, except a step that the
     /// system proves above this height throughout (by
-    /// [`crate::HybridSystem::switching_curvature_bound`], or for an affine `h_k` by the
+    /// [`crate::SwitchingStructure::switching_curvature_bound`], or for an affine `h_k` by the
     /// Bernstein bound of its interpolant): such a step is sampled at its ends only and reports
     /// no extrema; likewise, an extremum between two samples that the curvature bound proves
     /// above the height is neither located nor reported. Crossings are found either way.
@@ -71,7 +70,7 @@ pub struct Settings {
     /// height: it holds no extremum.) Allowed: `>= 0` (infinity allowed).
     pub extremum_height: f64,
     /// Whether a mode whose system gives the Taylor series of its solution
-    /// ([`crate::HybridSystem::taylor_series`]) is stepped by series (order 20 in the step's
+    /// ([`crate::TaylorExpansion::taylor_series`]) is stepped by series (order 20 in the step's
     /// clock, see the solver's module documentation) rather than DOP853. Default `true`;
     /// `false` gives the Runge-Kutta integration everywhere (a reference to compare against).
     pub taylor_series: bool,
@@ -98,9 +97,8 @@ pub enum SensitivityMethod {
     /// `(step / time scale)^6` per step. Over one period of the Biolever on mica (A/A0 = 0.95
     /// and 0.5, default tolerances; contacts by series) the monodromy is within 1.3e-6 and
     /// 2.3e-6 relative of a tight DOP853 reference, against 6.1e-9 and 4.2e-8 coupled (`cargo
-    /// run --release -p afm --example monodromy_error`), for 14% fewer instructions in the
-    /// period map with the monodromy at A/A0 = 0.5 (callgrind: 0.58M against 0.67M; 0.36M
-    /// without it). Enough for Newton iterations, which need the Jacobian only well
+    /// run --release -p afm --example monodromy_error`), at a lower cost per period map.
+    /// Enough for Newton iterations, which need the Jacobian only well
     /// enough to contract (each iteration then also reduces the error by about that relative
     /// amount instead of only squaring it), and for stability; not where the derivative of the
     /// numerical flow itself is wanted. `sensitivity_tolerance` must be `None`.

@@ -13,9 +13,10 @@ use crate::dop853::Dop853;
 use crate::event::Extremum;
 use crate::extrema::Samples;
 use crate::saltation::Saltation;
-use crate::sensitivity::{Sensitivity, VariationalField};
+use crate::sensitivity::Sensitivity;
+use crate::series_step::TaylorStep;
 use crate::settings::{SensitivityMethod, Settings};
-use crate::taylor::TaylorStep;
+use crate::variational_field::VariationalField;
 
 /// The buffers a [`crate::Solver`] allocates for a state of dimension `n`, a number of switching
 /// surfaces, a [`Sensitivity`] and the sampling and error-control settings that size them.
@@ -86,7 +87,7 @@ pub(crate) struct Buffers {
     pub flow_dxdp: Vec<f64>,
     pub product: DMatrix<f64>,
     /// `grad_x h_k` of every surface (`k n .. (k + 1) n`) when all are affine
-    /// ([`crate::HybridSystem::switching_is_affine`]).
+    /// ([`crate::SwitchingStructure::switching_is_affine`]).
     pub affine_gradients: Vec<f64>,
     /// `dh_k/dt` at fixed state of every surface when all are affine.
     pub affine_drifts: Vec<f64>,

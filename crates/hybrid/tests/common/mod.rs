@@ -2,7 +2,9 @@
 #![allow(clippy::needless_range_loop)]
 #![allow(dead_code)]
 
-use hybrid::{Direction, HybridSystem, Mode, SwitchingPartials};
+use hybrid::{
+    Accelerations, Direction, ExactFlow, HybridSystem, Mode, SwitchingPartials, SwitchingStructure,
+};
 use nalgebra::DMatrix;
 
 /// Forced damped linear oscillator `x'' + 2 zeta omega x' + omega^2 x = A cos(w t)`, state
@@ -110,6 +112,15 @@ impl HybridSystem for ForcedOscillator {
         g[1] = 0.0;
         SwitchingPartials::default()
     }
+    fn accelerations(&self) -> Accelerations<'_> {
+        Accelerations {
+            exact_flow: Some(self),
+            ..Accelerations::NONE
+        }
+    }
+}
+
+impl ExactFlow for ForcedOscillator {
     fn has_exact_flow(&self, _mode: Mode) -> bool {
         self.exact_flow_limit.is_some()
     }
@@ -168,9 +179,6 @@ impl HybridSystem for Rotation {
     fn dim(&self) -> usize {
         2
     }
-    fn switching_is_affine(&self, _k: usize) -> bool {
-        self.affine
-    }
     fn surface_count(&self) -> usize {
         1
     }
@@ -201,21 +209,21 @@ impl HybridSystem for Rotation {
         g[1] = 0.0;
         SwitchingPartials::default()
     }
+    fn accelerations(&self) -> Accelerations<'_> {
+        Accelerations {
+            exact_flow: Some(self),
+            switching: Some(self),
+            ..Accelerations::NONE
+        }
+    }
+}
+
+impl ExactFlow for Rotation {
     fn has_exact_flow(&self, _mode: Mode) -> bool {
         self.exact_flow_limit.is_some()
     }
     fn exact_step_limit(&self, _mode: Mode) -> f64 {
         self.exact_flow_limit.unwrap_or(f64::INFINITY)
-    }
-    fn switching_curvature_bound(
-        &self,
-        _k: usize,
-        _mode: Mode,
-        _t0: f64,
-        x0: &[f64],
-        _dt: f64,
-    ) -> Option<f64> {
-        self.curvature_bound.then(|| x0[0].hypot(x0[1]))
     }
     fn exact_flow(
         &self,
@@ -239,6 +247,22 @@ impl HybridSystem for Rotation {
         if let Some(p) = dxdp {
             p.fill(0.0);
         }
+    }
+}
+
+impl SwitchingStructure for Rotation {
+    fn switching_is_affine(&self, _k: usize) -> bool {
+        self.affine
+    }
+    fn switching_curvature_bound(
+        &self,
+        _k: usize,
+        _mode: Mode,
+        _t0: f64,
+        x0: &[f64],
+        _dt: f64,
+    ) -> Option<f64> {
+        self.curvature_bound.then(|| x0[0].hypot(x0[1]))
     }
 }
 
@@ -352,12 +376,6 @@ impl HybridSystem for HertzOscillator {
     fn dim(&self) -> usize {
         2
     }
-    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
-        (self.half_power && mode & 1 != 0).then_some(0)
-    }
-    fn switching_is_affine(&self, _k: usize) -> bool {
-        self.affine
-    }
     fn surface_count(&self) -> usize {
         1
     }
@@ -407,6 +425,21 @@ impl HybridSystem for HertzOscillator {
         g[0] = -1.0;
         g[1] = 0.0;
         SwitchingPartials { t: 0.0, p: 1.0 }
+    }
+    fn accelerations(&self) -> Accelerations<'_> {
+        Accelerations {
+            switching: Some(self),
+            ..Accelerations::NONE
+        }
+    }
+}
+
+impl SwitchingStructure for HertzOscillator {
+    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
+        (self.half_power && mode & 1 != 0).then_some(0)
+    }
+    fn switching_is_affine(&self, _k: usize) -> bool {
+        self.affine
     }
 }
 
