@@ -18,7 +18,6 @@
 #![warn(missing_docs)]
 
 pub mod amplitude_ratio;
-pub mod approach_start;
 pub mod bifurcation_diagram;
 pub mod cantilever;
 pub mod case;
@@ -34,6 +33,7 @@ pub mod gauss_legendre;
 pub mod hertz;
 pub mod impact_numbers;
 pub mod lockin;
+mod modal_constants;
 pub mod model;
 pub mod observables;
 pub mod orbit_prediction;

@@ -7,6 +7,7 @@
 //! map until a state recurs after `k` periods, then shooting on the `k`-th iterate; an orbit that
 //! settles on none within the budget is reported as not converged, never dressed up as one.
 
+mod approach_walk;
 mod newton;
 mod orbit;
 mod period_maps;
@@ -15,16 +16,14 @@ mod recurrence;
 use continuation::{floquet_multipliers, is_stable, NewtonSettings, Parametrised};
 use hybrid::{HybridSystem, Settings};
 
-pub(crate) use newton::{branch_tangent, newton_maps};
 pub use orbit::{PeriodBreakdown, SteadyOrbit};
-pub(crate) use period_maps::period_map;
 pub use period_maps::SteadyOrbitWorkspace;
 
-use crate::approach_start::{walk_approach, WalkEnd};
 use crate::error::AfmError;
 use crate::model::TappingModel;
 use crate::separation::Separation;
 use crate::validation::invalid;
+use approach_walk::{walk_approach, WalkEnd};
 use newton::shoot_observed;
 use period_maps::iterate;
 use recurrence::{recurrence_search, Attempt};
@@ -116,8 +115,9 @@ impl SteadyOrbitSettings {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum OrbitStart<'a> {
     /// The orbit of the quasi-static approach, without a previous orbit: the free orbit above
-    /// first contact, else the approach branch walked down from it
-    /// ([`crate::approach_start`]), at the cost of a few loose Newton steps.
+    /// first contact, else the approach branch walked down from it in steps of `Z`, each a
+    /// loose Newton from the cubic prediction of the last two orbits, jumping by transients
+    /// where the branch ends (a fold), as the quasi-static approach does.
     Approach,
     /// The attractor a transient from the free steady state reaches: `transient_periods`
     /// periods from the free orbit's state at `Z`, then Newton. Where orbits coexist, it may

@@ -21,13 +21,12 @@ use continuation::{floquet_multipliers, hermite_basis, is_stable, newton_update}
 use hybrid::{Sensitivity, Settings};
 use nalgebra::DVector;
 
+use super::newton::{branch_tangent, newton_maps};
+use super::period_maps::period_map;
+use super::{steady_orbit_in, OrbitStart, SteadyOrbitSettings, SteadyOrbitWorkspace};
 use crate::error::AfmError;
 use crate::model::TappingModel;
 use crate::separation::Separation;
-use crate::steady_orbit::{
-    branch_tangent, newton_maps, period_map, steady_orbit_in, OrbitStart, SteadyOrbitSettings,
-    SteadyOrbitWorkspace,
-};
 
 /// The first step of the walk below `Z_G1`, in units of `A0`: the steps grow from it by
 /// [`STEP_GROWTH`]. The first one is taken from the free orbit, whatever its length: the orbit

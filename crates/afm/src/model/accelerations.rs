@@ -1,0 +1,231 @@
+//! The tapping cantilever's optional accelerations of the hybrid solver: the exact free flight,
+//! the Taylor series of the contact, and the shape of the gap as a switching function. They
+//! change how fast an orbit is integrated, never what it is.
+
+use hybrid::{
+    ClockPolynomial, ExactFlow, HybridSystem, Mode, SwitchingStructure, TaylorExpansion,
+    TaylorSeries,
+};
+use nalgebra::DMatrix;
+
+use super::{TappingModel, FREE_FLIGHT};
+use crate::contact_series;
+use crate::modal_constants::{grid_spacing, KEPT_GRIDS};
+use crate::phase;
+
+impl ExactFlow for TappingModel {
+    fn has_exact_flow(&self, mode: Mode) -> bool {
+        mode == FREE_FLIGHT
+    }
+
+    /// A quarter of the shortest of the drive period and the modal periods `2 pi / w_i`, us.
+    fn exact_step_limit(&self, mode: Mode) -> f64 {
+        if mode == FREE_FLIGHT {
+            self.exact_step_limit
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The free flight at `count` equally spaced times: one homogeneous transition over the
+    /// spacing per mode and one rotation of the drive phase, applied `count` times (the
+    /// steady part by angle addition), instead of the exponentials and trigonometric
+    /// functions of a fresh flow per point. Equal to the direct flow up to rounding growing
+    /// with `count` (a few ulps for the solver's 9 points; tested).
+    fn exact_flow_grid(
+        &self,
+        _mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        dt: f64,
+        count: usize,
+        states: &mut [f64],
+    ) {
+        let n = self.dim();
+        let spacing = grid_spacing(dt, count);
+        let w = self.drive.angular_frequency;
+        // The index of the kept spacing, for a grid over the standard step.
+        let kept =
+            (dt == self.exact_step_limit && (1..=KEPT_GRIDS).contains(&count)).then(|| count - 1);
+        let (sin0, cos0) = phase::sin_cos(w * t0);
+        let (sin_step, cos_step) = match kept {
+            Some(c) => self.grid_rotations[c],
+            None => phase::sin_cos(w * spacing),
+        };
+        for (i, m) in self.modes.iter().enumerate() {
+            let phi = match kept {
+                Some(c) => m.grid_transitions[c],
+                None => m.oscillator.homogeneous_transition(spacing),
+            };
+            let start = m.oscillator.steady_state_at_phase(sin0, cos0);
+            let mut y = [x0[2 * i] - start[0], x0[2 * i + 1] - start[1]];
+            let (mut sin, mut cos) = (sin0, cos0);
+            for j in 0..count {
+                y = [
+                    phi[0][0] * y[0] + phi[0][1] * y[1],
+                    phi[1][0] * y[0] + phi[1][1] * y[1],
+                ];
+                (sin, cos) = (
+                    sin * cos_step + cos * sin_step,
+                    cos * cos_step - sin * sin_step,
+                );
+                let steady = m.oscillator.steady_state_at_phase(sin, cos);
+                states[j * n + 2 * i] = steady[0] + y[0];
+                states[j * n + 2 * i + 1] = steady[1] + y[1];
+            }
+        }
+    }
+
+    /// The free flight's closed-form flow (block diagonal, one [`DrivenOscillator`] per mode);
+    /// it does not depend on `Z`, so `dx/dZ = 0`.
+    fn exact_flow(
+        &self,
+        _mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        dt: f64,
+        x: &mut [f64],
+        mut transition: Option<&mut DMatrix<f64>>,
+        dxdp: Option<&mut [f64]>,
+    ) {
+        if let Some(matrix) = transition.as_deref_mut() {
+            matrix.fill(0.0);
+        }
+        let start_phase = phase::sin_cos(self.drive.angular_frequency * t0);
+        let end_phase = phase::sin_cos(self.drive.angular_frequency * (t0 + dt));
+        let standard = dt == self.exact_step_limit;
+        for (i, m) in self.modes.iter().enumerate() {
+            let phi = if standard {
+                m.step_transition
+            } else {
+                m.oscillator.homogeneous_transition(dt)
+            };
+            let state = m.oscillator.flow_with_transition(
+                start_phase,
+                end_phase,
+                [x0[2 * i], x0[2 * i + 1]],
+                &phi,
+            );
+            x[2 * i] = state[0];
+            x[2 * i + 1] = state[1];
+            if let Some(matrix) = transition.as_deref_mut() {
+                for r in 0..2 {
+                    for c in 0..2 {
+                        matrix[(2 * i + r, 2 * i + c)] = phi[r][c];
+                    }
+                }
+            }
+        }
+        if let Some(dxdp) = dxdp {
+            dxdp.fill(0.0);
+        }
+    }
+}
+
+impl TaylorExpansion for TappingModel {
+    /// In contact, 40: the contact flow's Taylor series come from the recurrences of automatic
+    /// differentiation (module `contact_series`), whose intermediate series live on the stack.
+    fn taylor_order_limit(&self, mode: Mode) -> usize {
+        if Self::in_contact(mode) {
+            contact_series::MAX_ORDER
+        } else {
+            0
+        }
+    }
+
+    /// In contact, the series of Eq. 1 with the Hertz force in the step's clock (module
+    /// `contact_series`); `false` in free flight (which has its exact flow).
+    fn taylor_series(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        series: &mut TaylorSeries,
+    ) -> bool {
+        Self::in_contact(mode)
+            && contact_series::contact_state_series(
+                &self.modes,
+                self.hertz.coefficient,
+                self.drive.angular_frequency,
+                &self.separation,
+                clock,
+                series,
+            )
+    }
+
+    /// In contact, the series of the variational equations along the contact series (module
+    /// `contact_series`).
+    fn taylor_tangents(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        state: &TaylorSeries,
+        tangents: &mut TaylorSeries,
+        parameter_column: bool,
+        scratch: &mut Vec<f64>,
+    ) {
+        if Self::in_contact(mode) {
+            contact_series::contact_tangent_series(
+                &self.modes,
+                self.hertz.coefficient,
+                &self.separation,
+                clock,
+                state,
+                tangents,
+                parameter_column,
+                scratch,
+            );
+        }
+    }
+}
+
+impl SwitchingStructure for TappingModel {
+    /// In contact the Hertz force is `c (-d)^{3/2}`: the gap is the half-power surface of
+    /// the contact mode, and the solver integrates next to contact onset and release in the
+    /// square root of the time from them.
+    fn half_power_surface(&self, mode: Mode) -> Option<usize> {
+        Self::in_contact(mode).then_some(0)
+    }
+
+    /// The gap `Z(t) + sum_i q_i` is affine: `Z(t)` is a constant or a linear ramp.
+    fn switching_is_affine(&self, _k: usize) -> bool {
+        true
+    }
+
+    /// In free flight, a bound on the gap's curvature `|d''| = |Z'' + sum_i q_i''|` over
+    /// `[t0, t0 + dt]` (any `dt`), nm/us^2; `Z'' = 0` for both separation laws. Each mode is its
+    /// steady drive response `p_i = alpha_i cos(w t) + beta_i sin(w t)` plus a homogeneous part
+    /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
+    /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
+    /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
+    /// (extrema inside the sample, the gap's minima, are always wanted).
+    fn switching_curvature_bound(
+        &self,
+        _k: usize,
+        mode: Mode,
+        t0: f64,
+        x0: &[f64],
+        _dt: f64,
+    ) -> Option<f64> {
+        if Self::in_contact(mode) {
+            return None;
+        }
+        let w = self.drive.angular_frequency;
+        let (sin, cos) = phase::sin_cos(w * t0);
+        let bound = self
+            .modes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
+                let (y, dy) = (x0[2 * i] - p, x0[2 * i + 1] - dp);
+                let [alpha, beta] = m.oscillator.steady_coefficients();
+                let steady = w * w * alpha.hypot(beta);
+                let homogeneous = (m.omega_squared.sqrt() + m.damping)
+                    * (dy * dy + m.omega_squared * y * y).sqrt();
+                steady + homogeneous
+            })
+            .sum::<f64>();
+        // Slack for the rounding of the sums (relative 1e-12) and of `y` (absolute).
+        bound.is_finite().then_some(bound * (1.0 + 1e-12) + 1e-12)
+    }
+}
