@@ -225,8 +225,19 @@ pub fn approach_diagram(
     model: &TappingModel,
     settings: &DiagramSettings,
 ) -> Result<BifurcationDiagram, AfmError> {
+    approach_diagram_until(model, settings, &mut || false)
+}
+
+/// As [`approach_diagram`], asking `interrupted` after every branch point whether to give up:
+/// when it answers `true` the computation ends with [`AfmError::Interrupted`] (a caller's
+/// Ctrl-C or cancel button).
+pub fn approach_diagram_until(
+    model: &TappingModel,
+    settings: &DiagramSettings,
+    interrupted: &mut dyn FnMut() -> bool,
+) -> Result<BifurcationDiagram, AfmError> {
     let z_start = model.grazing_separation_nm() + 0.02 * model.free_amplitude_nm();
-    diagram(model, &model.free_state(), z_start, settings)
+    diagram_until(model, &model.free_state(), z_start, settings, interrupted)
 }
 
 /// The diagram of `model` continued from the periodic orbit near `x0` at `z_start` in the
@@ -236,6 +247,18 @@ pub fn diagram(
     x0: &[f64],
     z_start: f64,
     settings: &DiagramSettings,
+) -> Result<BifurcationDiagram, AfmError> {
+    diagram_until(model, x0, z_start, settings, &mut || false)
+}
+
+/// As [`diagram`], asking `interrupted` after every branch point whether to give up: when it
+/// answers `true` the computation ends with [`AfmError::Interrupted`].
+pub fn diagram_until(
+    model: &TappingModel,
+    x0: &[f64],
+    z_start: f64,
+    settings: &DiagramSettings,
+    interrupted: &mut dyn FnMut() -> bool,
 ) -> Result<BifurcationDiagram, AfmError> {
     settings.validate()?;
     let mut system = model.clone();
@@ -261,11 +284,17 @@ pub fn diagram(
     let integration = settings.orbit.integration.clone();
     // Observables are computed once per point, inside the stop predicate, and kept.
     let mut observed: Vec<Result<OrbitObservables, AfmError>> = Vec::new();
+    let mut was_interrupted = false;
     let branch = {
         let observed = &mut observed;
+        let was_interrupted = &mut was_interrupted;
         let mut at_point = system.clone();
         Continuation::new(&problem, x0, z_start, continuation_settings)?
             .stop_when(move |point: &BranchPoint| {
+                if interrupted() {
+                    *was_interrupted = true;
+                    return true;
+                }
                 at_point.set_parameter(point.parameter);
                 let observables =
                     orbit_observables(&at_point, point.state.as_slice(), &integration);
@@ -278,6 +307,9 @@ pub fn diagram(
             })
             .run()
     };
+    if was_interrupted {
+        return Err(AfmError::Interrupted);
+    }
     let mut points = Vec::with_capacity(branch.points.len());
     for (point, observables) in branch.points.iter().zip(observed) {
         points.push(diagram_point(point, &observables?));

@@ -72,6 +72,10 @@ pub enum AfmError {
         /// Why the search stopped.
         reason: String,
     },
+    /// The caller asked a long computation to stop (a Ctrl-C), through the callback of
+    /// [`crate::bifurcation_diagram::diagram_until`].
+    #[error("the computation was interrupted")]
+    Interrupted,
     /// Shooting or continuation of a periodic orbit failed.
     #[error("periodic orbit: {0}")]
     Continuation(#[from] continuation::ContinuationError),

@@ -49,8 +49,8 @@ mod validation;
 
 pub use amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
 pub use bifurcation_diagram::{
-    approach_diagram, diagram, BifurcationDiagram, DiagramPoint, DiagramSettings,
-    DiagramSpecialPoint,
+    approach_diagram, approach_diagram_until, diagram, diagram_until, BifurcationDiagram,
+    DiagramPoint, DiagramSettings, DiagramSpecialPoint,
 };
 pub use cantilever::Cantilever;
 pub use case::{Case, CaseFile};

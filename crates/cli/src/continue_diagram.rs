@@ -3,7 +3,8 @@
 //! located, and optionally the retract branch back up.
 
 use afm::{
-    approach_diagram, diagram, BifurcationDiagram, DiagramPoint, DiagramSettings, TappingModel,
+    approach_diagram_until, diagram_until, BifurcationDiagram, Case, DiagramPoint, DiagramSettings,
+    TappingModel,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -61,89 +62,20 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .as_ref()
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
-    let mut settings = DiagramSettings::approach(&model);
-    if let Some(floor) = args.floor {
-        let lowest = -model.free_amplitude_nm();
-        if !(floor >= lowest && floor < model.grazing_separation_nm()) {
-            bail!(
-                "--floor {floor}: allowed [{lowest}, {:.6}) nm, from -A0 up to just below first contact Z_G1",
-                model.grazing_separation_nm()
-            );
-        }
-        settings.z_limit_nm = floor;
-    }
-    if !(0.0..1.0).contains(&args.min_amplitude_ratio) {
-        bail!(
-            "--min-amplitude-ratio {}: allowed 0 <= R < 1",
-            args.min_amplitude_ratio
-        );
-    }
-    settings.min_amplitude_ratio = args.min_amplitude_ratio;
-    if let Some(step) = args.max_step {
-        if !(step.is_finite() && step > 0.0 && step <= model.free_amplitude_nm()) {
-            bail!(
-                "--max-step {step}: allowed 0 < step <= A0 = {} nm",
-                model.free_amplitude_nm()
-            );
-        }
-        settings.max_step = step;
-    }
-    let approach = approach_diagram(&model, &settings)
-        .with_context(|| format!("continuation of case `{}` failed", case.name))?;
-    let retract = if args.retract {
-        let Some(lowest) = approach
-            .points
-            .iter()
-            .min_by(|a, b| a.z_nm.total_cmp(&b.z_nm))
-        else {
-            bail!("the approach produced no point to retract from");
-        };
-        let retract_settings = DiagramSettings {
-            max_step: settings.max_step,
-            ..DiagramSettings::retract(&model)
-        };
-        Some(
-            diagram(&model, &lowest.state, lowest.z_nm, &retract_settings)
-                .context("retract continuation failed")?,
-        )
-    } else {
-        None
-    };
-    let bistable = retract.as_ref().map(|retract| {
-        let mut ranges = approach.bistable_ranges();
-        ranges.extend(retract.bistable_ranges());
-        merge_ranges(ranges)
-    });
+    let settings = diagram_settings(&model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    let run = compute_diagrams(&case, &model, &settings, args.retract, &mut || false)?;
+    let DiagramRun {
+        approach,
+        retract,
+        bistable,
+    } = &run;
     if args.json {
-        let options = json!({
-            "floor_nm": settings.z_limit_nm,
-            "min_amplitude_ratio": settings.min_amplitude_ratio,
-            "max_step_nm": settings.max_step,
-            "max_points": settings.max_points,
-            "retract": args.retract,
-        });
-        let mut object = json!({
-            "inputs": orbit_inputs_json("continue", options, &case, &model, &settings.orbit),
-            "case": case.name,
-            "free_amplitude_nm": model.free_amplitude_nm(),
-            "first_contact_z_nm": model.grazing_separation_nm(),
-            "points": approach.points,
-            "special_points": approach.special_points,
-            "stop": approach.stop,
-            "error": approach.error,
-        });
-        if let Some(retract) = &retract {
-            object["retract"] = json!({
-                "points": retract.points,
-                "special_points": retract.special_points,
-                "stop": retract.stop,
-                "error": retract.error,
-            });
-            object["bistable_ranges_nm"] = json!(bistable);
-        }
-        println!("{}", serde_json::to_string(&object)?);
+        println!(
+            "{}",
+            serde_json::to_string(&continue_json(&case, &model, &settings, &run))?
+        );
     } else {
-        print!("{}", table(&case.name, &model, "approach", &approach));
+        print!("{}", table(&case.name, &model, "approach", approach));
         if let Some(retract) = &retract {
             print!("{}", table(&case.name, &model, "retract", retract));
             match bistable.as_deref() {
@@ -161,7 +93,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         }
     }
     if let Some(path) = csv_path {
-        let mut text = csv_text(&approach, "approach")?;
+        let mut text = csv_text(approach, "approach")?;
         if let Some(retract) = &retract {
             text.push_str(
                 csv_text(retract, "retract")?
@@ -173,7 +105,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     }
     if let Some(path) = plot_path {
         let svg = render_svg(
-            &panels(&model, &approach, retract.as_ref()),
+            &panels(&model, approach, retract.as_ref()),
             1,
             3,
             (520, 440),
@@ -181,6 +113,140 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         write_atomically(&path, svg.as_bytes())?;
     }
     Ok(())
+}
+
+/// The diagram settings of `model` for the options of `continue`: `floor` (nm, in
+/// `[-A0, Z_G1)`, default 0.05 A0), `min_amplitude_ratio` (in `[0, 1)`) and `max_step` (nm, in
+/// `(0, A0]`, default A0/250); errors name the option and its allowed range.
+pub fn diagram_settings(
+    model: &TappingModel,
+    floor: Option<f64>,
+    min_amplitude_ratio: f64,
+    max_step: Option<f64>,
+) -> Result<DiagramSettings> {
+    let mut settings = DiagramSettings::approach(model);
+    if let Some(floor) = floor {
+        let lowest = -model.free_amplitude_nm();
+        if !(floor >= lowest && floor < model.grazing_separation_nm()) {
+            bail!(
+                "--floor {floor}: allowed [{lowest}, {:.6}) nm, from -A0 up to just below first contact Z_G1",
+                model.grazing_separation_nm()
+            );
+        }
+        settings.z_limit_nm = floor;
+    }
+    if !(0.0..1.0).contains(&min_amplitude_ratio) {
+        bail!("--min-amplitude-ratio {min_amplitude_ratio}: allowed 0 <= R < 1");
+    }
+    settings.min_amplitude_ratio = min_amplitude_ratio;
+    if let Some(step) = max_step {
+        if !(step.is_finite() && step > 0.0 && step <= model.free_amplitude_nm()) {
+            bail!(
+                "--max-step {step}: allowed 0 < step <= A0 = {} nm",
+                model.free_amplitude_nm()
+            );
+        }
+        settings.max_step = step;
+    }
+    Ok(settings)
+}
+
+/// The diagrams of one `continue` run: the approach, the retract when asked, and then the
+/// bistable ranges (nm) of the two together.
+#[derive(Debug, Clone)]
+pub struct DiagramRun {
+    /// The approach diagram (`Z` decreasing from above first contact).
+    pub approach: BifurcationDiagram,
+    /// The retract diagram (`Z` increasing from the approach's lowest point), if asked.
+    pub retract: Option<BifurcationDiagram>,
+    /// With a retract: the merged `[Z_low, Z_high]` ranges where two stable orbits coexist.
+    pub bistable: Option<Vec<[f64; 2]>>,
+}
+
+/// The approach diagram of `model` with `settings`, and with `retract` the retract from its
+/// lowest point; `interrupted` is asked after every branch point whether to give up
+/// ([`afm::diagram_until`]).
+pub fn compute_diagrams(
+    case: &Case,
+    model: &TappingModel,
+    settings: &DiagramSettings,
+    retract: bool,
+    interrupted: &mut dyn FnMut() -> bool,
+) -> Result<DiagramRun> {
+    let approach = approach_diagram_until(model, settings, interrupted)
+        .with_context(|| format!("continuation of case `{}` failed", case.name))?;
+    let retract = if retract {
+        let Some(lowest) = approach
+            .points
+            .iter()
+            .min_by(|a, b| a.z_nm.total_cmp(&b.z_nm))
+        else {
+            bail!("the approach produced no point to retract from");
+        };
+        let retract_settings = DiagramSettings {
+            max_step: settings.max_step,
+            ..DiagramSettings::retract(model)
+        };
+        Some(
+            diagram_until(
+                model,
+                &lowest.state,
+                lowest.z_nm,
+                &retract_settings,
+                interrupted,
+            )
+            .context("retract continuation failed")?,
+        )
+    } else {
+        None
+    };
+    let bistable = retract.as_ref().map(|retract| {
+        let mut ranges = approach.bistable_ranges();
+        ranges.extend(retract.bistable_ranges());
+        merge_ranges(ranges)
+    });
+    Ok(DiagramRun {
+        approach,
+        retract,
+        bistable,
+    })
+}
+
+/// The `continue --json` object of `run`, computed with `settings` (docs/output-schema.md).
+pub fn continue_json(
+    case: &Case,
+    model: &TappingModel,
+    settings: &DiagramSettings,
+    run: &DiagramRun,
+) -> serde_json::Value {
+    let options = json!({
+        "floor_nm": settings.z_limit_nm,
+        "min_amplitude_ratio": settings.min_amplitude_ratio,
+        "max_step_nm": settings.max_step,
+        "max_points": settings.max_points,
+        "retract": run.retract.is_some(),
+    });
+    let approach = &run.approach;
+    let mut object = json!({
+        "inputs": orbit_inputs_json("continue", options, case, model, &settings.orbit),
+        "case": case.name,
+        "free_amplitude_nm": model.free_amplitude_nm(),
+        "first_contact_z_nm": model.grazing_separation_nm(),
+        "points": approach.points,
+        "special_points": approach.special_points,
+        "stop": approach.stop,
+        "error": approach.error,
+    });
+    if let Some(retract) = &run.retract {
+        object["retract"] = json!({
+            "points": retract.points,
+            "special_points": retract.special_points,
+            "stop": retract.stop,
+            "error": retract.error,
+        });
+        object["bistable_ranges_nm"] = json!(run.bistable);
+    }
+    object
 }
 
 /// The readable table of special points of one diagram.

@@ -2,7 +2,7 @@
 //! approach curve reaches an amplitude ratio, with its impacts, gap minima and forces.
 
 use afm::{
-    find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, OrbitStart, SteadyOrbit,
+    find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, Case, OrbitStart, SteadyOrbit,
     SteadyOrbitSettings, TappingModel,
 };
 use anyhow::{bail, Context, Result};
@@ -61,7 +61,7 @@ pub enum Start {
 
 impl Start {
     /// The steady-orbit search's start for this choice.
-    fn orbit_start(self) -> OrbitStart<'static> {
+    pub fn orbit_start(self) -> OrbitStart<'static> {
         match self {
             Self::Approach => OrbitStart::Approach,
             Self::Transient => OrbitStart::Transient,
@@ -69,7 +69,7 @@ impl Start {
     }
 
     /// The other choice.
-    fn other(self) -> Self {
+    pub fn other(self) -> Self {
         match self {
             Self::Approach => Self::Transient,
             Self::Transient => Self::Approach,
@@ -77,7 +77,7 @@ impl Start {
     }
 
     /// The name in outputs.
-    fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         self.orbit_start().name()
     }
 }
@@ -88,7 +88,7 @@ impl Start {
 const COEXISTING_DISTANCE: f64 = 1e-6;
 
 /// The orbit the other start reaches at the same `Z`, if it is a different converged orbit.
-fn coexisting_orbit(
+pub fn coexisting_orbit(
     model: &TappingModel,
     orbit: &SteadyOrbit,
     start: Start,
@@ -108,40 +108,29 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
     let settings = SteadyOrbitSettings::default();
-    let (orbit, start, coexisting) = match (args.z, args.amplitude_ratio) {
-        (Some(z), None) => {
-            if !z.is_finite() {
-                bail!("--z {z}: the separation must be a finite number of nm");
-            }
-            let orbit = steady_orbit(&model, z, args.start.orbit_start(), &settings)
-                .with_context(|| format!("no steady orbit at Z = {z} nm"))?;
-            let coexisting = coexisting_orbit(&model, &orbit, args.start, &settings);
-            (orbit, args.start, coexisting)
-        }
-        (None, Some(ratio)) => {
-            let search = AmplitudeRatioSearch::new(ratio).context("invalid --amplitude-ratio")?;
-            let orbit = find_amplitude_ratio(&model, &search, &settings)
-                .with_context(|| format!("cannot reach A/A0 = {ratio} on the approach"))?;
-            (orbit, Start::Approach, None)
-        }
-        _ => bail!("give exactly one of --z and --amplitude-ratio"),
+    let (orbit, start) = orbit_at(&model, args.z, args.amplitude_ratio, args.start, &settings)?;
+    let coexisting = match args.z {
+        Some(_) => coexisting_orbit(&model, &orbit, start, &settings),
+        None => None,
     };
     if args.json {
-        let mut object = orbit_json(&case.name, &model, &orbit);
-        object["start"] = json!(start.name());
-        object["coexisting_orbit"] = coexisting
+        let coexisting = coexisting
             .as_ref()
-            .map_or(serde_json::Value::Null, |other| {
-                let mut other_json = orbit_json(&case.name, &model, other);
-                other_json["start"] = json!(start.other().name());
-                other_json
-            });
+            .map(|other| (other, start.other().name()));
         let options = json!({
             "z_nm": args.z,
             "amplitude_ratio": args.amplitude_ratio,
             "start": start.name(),
         });
-        object["inputs"] = orbit_inputs_json("simulate", options, &case, &model, &settings);
+        let object = simulate_json(
+            &case,
+            &model,
+            &settings,
+            &orbit,
+            start.name(),
+            coexisting,
+            options,
+        );
         println!("{}", serde_json::to_string_pretty(&object)?);
     } else {
         print!("{}", summary(&case.name, &model, &orbit));
@@ -158,6 +147,60 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The steady orbit `simulate` reports: at separation `z` from `start`, or (with
+/// `amplitude_ratio` instead) where the approach reaches that `A/A0`; exactly one of the two is
+/// given. Returns the orbit and the start that found it (`Approach` for an amplitude ratio).
+pub fn orbit_at(
+    model: &TappingModel,
+    z: Option<f64>,
+    amplitude_ratio: Option<f64>,
+    start: Start,
+    settings: &SteadyOrbitSettings,
+) -> Result<(SteadyOrbit, Start)> {
+    match (z, amplitude_ratio) {
+        (Some(z), None) => {
+            if !z.is_finite() {
+                bail!("--z {z}: the separation must be a finite number of nm");
+            }
+            let orbit = steady_orbit(model, z, start.orbit_start(), settings)
+                .with_context(|| format!("no steady orbit at Z = {z} nm"))?;
+            Ok((orbit, start))
+        }
+        (None, Some(ratio)) => {
+            let search = AmplitudeRatioSearch::new(ratio).context("invalid --amplitude-ratio")?;
+            let orbit = find_amplitude_ratio(model, &search, settings)
+                .with_context(|| format!("cannot reach A/A0 = {ratio} on the approach"))?;
+            Ok((orbit, Start::Approach))
+        }
+        _ => bail!("give exactly one of --z and --amplitude-ratio"),
+    }
+}
+
+/// The whole `simulate --json` object: [`orbit_json`] of `orbit` found from the start named
+/// `start` (`approach`, `transient`, `near`, ...), with `coexisting_orbit` (the other start's
+/// orbit and that start's name, or `null`) and `inputs` (the command's `options` and
+/// `settings`).
+pub fn simulate_json(
+    case: &Case,
+    model: &TappingModel,
+    settings: &SteadyOrbitSettings,
+    orbit: &SteadyOrbit,
+    start: &str,
+    coexisting: Option<(&SteadyOrbit, &str)>,
+    options: serde_json::Value,
+) -> serde_json::Value {
+    let mut object = orbit_json(&case.name, model, orbit);
+    object["start"] = json!(start);
+    object["coexisting_orbit"] =
+        coexisting.map_or(serde_json::Value::Null, |(other, other_start)| {
+            let mut other_json = orbit_json(&case.name, model, other);
+            other_json["start"] = json!(other_start);
+            other_json
+        });
+    object["inputs"] = orbit_inputs_json("simulate", options, case, model, settings);
+    object
 }
 
 /// The JSON object of one steady orbit (units in the key names; docs/output-schema.md). Every

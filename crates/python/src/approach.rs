@@ -1,0 +1,108 @@
+//! `Case.approach`: the time-domain approach (and retract) sweep of `drumroll approach`, read
+//! by a lock-in once per block of drive cycles, as a table of records.
+
+use drumroll::approach::{ApproachArgs, CSV_HEADER};
+use drumroll::inputs::inputs_json;
+use drumroll::model_args::ModelArgs;
+use pyo3::prelude::*;
+use serde_json::{json, Value};
+
+use crate::case::Case;
+use crate::convert::{json_to_py, records_to_table};
+use crate::errors::to_py_err;
+use crate::interrupt::without_gil;
+
+/// The options of `Case.approach`, named as in Python (units in the names).
+pub struct ApproachOptions {
+    /// Start separation, nm (default 0.2 nm above first contact).
+    pub from_nm: Option<f64>,
+    /// Floor, nm.
+    pub to_nm: f64,
+    /// Sweep speed, nm/s.
+    pub rate_nm_per_s: f64,
+    /// Retract back up after the approach.
+    pub retract: bool,
+    /// Drive cycles per lock-in reading.
+    pub lockin_cycles: usize,
+    /// Keep every N-th reading.
+    pub every: usize,
+    /// Cycles integrated at the start before the sweep.
+    pub settle_cycles: usize,
+    /// Contact integration tolerance.
+    pub tolerance: f64,
+}
+
+/// The sweep of `case` with `options`: a table (DataFrame, or dict of numpy arrays) with one
+/// row per record and the columns of `drumroll approach`'s CSV; a DataFrame's
+/// `attrs["inputs"]` holds the `inputs` object of `--jsonl`'s first line.
+pub fn compute_approach<'py>(
+    py: Python<'py>,
+    case: &Case,
+    options: &ApproachOptions,
+) -> PyResult<Bound<'py, PyAny>> {
+    let resolved = case.resolved.clone();
+    let args = ApproachArgs {
+        model: ModelArgs {
+            case: None,
+            cantilever: None,
+            sample: None,
+            a0: None,
+            drive_frequency: None,
+        },
+        from: options.from_nm,
+        to: options.to_nm,
+        rate: options.rate_nm_per_s,
+        retract: options.retract,
+        lockin_cycles: options.lockin_cycles,
+        every: options.every,
+        settle_cycles: options.settle_cycles,
+        tolerance: options.tolerance,
+        jsonl: true,
+        out: None,
+        plot: None,
+    };
+    let (records, inputs) =
+        without_gil(py, |interrupted| -> anyhow::Result<(Vec<Value>, Value)> {
+            let model = &resolved.model;
+            let settings = args.settings(model)?;
+            let options = json!({
+                "from_nm": settings.from_nm,
+                "to_nm": settings.to_nm,
+                "rate_nm_per_s": settings.rate_nm_per_s,
+                "retract": settings.retract,
+                "settle_cycles": settings.settle_cycles,
+                "lockin_cycles": settings.lockin_cycles,
+                "every": settings.every,
+            });
+            let inputs = inputs_json(
+                "approach",
+                options,
+                &resolved.case,
+                model,
+                &settings.integration,
+            );
+            let mut sweep = afm::Sweep::new(model, settings).map_err(anyhow::Error::new)?;
+            let mut records = Vec::new();
+            while let Some(record) = sweep.next_record().map_err(|error| {
+                anyhow::Error::new(error).context(format!(
+                    "the sweep of case `{}` failed at Z = {} nm after {} cycles",
+                    resolved.case.name,
+                    sweep.z_nm(),
+                    sweep.cycles_done()
+                ))
+            })? {
+                records.push(serde_json::to_value(record)?);
+                if interrupted() {
+                    break;
+                }
+            }
+            Ok((records, inputs))
+        })?
+        .map_err(to_py_err)?;
+    let columns: Vec<&str> = CSV_HEADER.split(',').collect();
+    let table = records_to_table(py, &records, &columns)?;
+    if let Ok(attrs) = table.getattr("attrs") {
+        attrs.set_item("inputs", json_to_py(py, &inputs)?)?;
+    }
+    Ok(table)
+}

@@ -1,0 +1,331 @@
+//! `drumroll.Case`: a cantilever tapping a sample at a free amplitude and drive frequency
+//! (MODEL.md section 3), resolved into the tapping model, and the computations on it.
+
+use afm::{fixtures, Case as AfmCase, TappingModel};
+use anyhow::Context;
+use drumroll::model_args::ModelArgs;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use serde_json::{json, Value};
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::convert::{json_to_py, py_to_json};
+use crate::errors::to_py_err;
+
+/// A case resolved into its model, shared by the results computed on it.
+#[derive(Debug)]
+pub struct Resolved {
+    /// The case as given.
+    pub case: AfmCase,
+    /// Its tapping model (Eq. 1 with Hertz contact), at first contact `Z = Z_G1`.
+    pub model: TappingModel,
+}
+
+impl Resolved {
+    /// Validate `case` and build its model (errors as the CLI words them).
+    pub fn new(case: AfmCase) -> anyhow::Result<Self> {
+        case.validate("the Python arguments")
+            .context("invalid model parameters")?;
+        let model = TappingModel::from_case(&case)
+            .with_context(|| format!("cannot build the model of case `{}`", case.name))?;
+        Ok(Self { case, model })
+    }
+
+    /// The case in the case files' format with the cantilever and sample inline: what
+    /// `Case.to_dict()` returns and pickling stores.
+    pub fn case_json(&self) -> Value {
+        json!({
+            "name": self.case.name,
+            "description": self.case.description,
+            "cantilever": self.case.cantilever,
+            "sample": self.case.sample,
+            "free_amplitude_nm": self.case.free_amplitude_nm,
+            "drive_frequency_khz": self.case.drive_frequency_khz,
+        })
+    }
+
+    /// The case of [`Resolved::case_json`]'s object (`source` names it in errors).
+    pub fn from_case_json(value: &Value, source: &str) -> anyhow::Result<Self> {
+        let text = |key: &str| value[key].to_string();
+        let number = |key: &str| value[key].as_f64();
+        let Some(free_amplitude_nm) = number("free_amplitude_nm") else {
+            anyhow::bail!("{source}: `free_amplitude_nm` must be a number of nm");
+        };
+        let case = AfmCase {
+            name: value["name"].as_str().unwrap_or("python").to_string(),
+            description: value["description"].as_str().unwrap_or("").to_string(),
+            cantilever: fixtures::parse_cantilever(
+                &format!("{source}: cantilever"),
+                &text("cantilever"),
+            )?,
+            sample: fixtures::parse_sample(&format!("{source}: sample"), &text("sample"))?,
+            free_amplitude_nm,
+            drive_frequency_khz: number("drive_frequency_khz"),
+        };
+        Self::new(case)
+    }
+}
+
+/// A cantilever or sample given from Python: a built-in name, a file path, or a dict in the
+/// files' format.
+#[derive(FromPyObject)]
+pub enum Reference<'py> {
+    /// A built-in name or the path of a JSON file.
+    #[pyo3(transparent, annotation = "str")]
+    Name(String),
+    /// The file's content as a dict.
+    #[pyo3(transparent, annotation = "dict")]
+    Dict(Bound<'py, pyo3::types::PyDict>),
+}
+
+/// Whether a reference names a file (it ends in `.json` or exists) rather than a built-in
+/// fixture, as on the command line.
+fn is_file_reference(reference: &str) -> bool {
+    let path = Path::new(reference);
+    path.extension().is_some_and(|e| e == "json") || path.exists()
+}
+
+fn resolve_cantilever(reference: &Reference<'_>) -> PyResult<afm::Cantilever> {
+    let result = match reference {
+        Reference::Name(name) if is_file_reference(name) => {
+            fixtures::load_cantilever(Path::new(name))
+        }
+        Reference::Name(name) => fixtures::builtin_cantilever(name),
+        Reference::Dict(dict) => fixtures::parse_cantilever(
+            "cantilever (a Python dict)",
+            &py_to_json(dict.as_any())?.to_string(),
+        ),
+    };
+    result.map_err(crate::errors::afm_to_py_err)
+}
+
+fn resolve_sample(reference: &Reference<'_>) -> PyResult<afm::Sample> {
+    let result = match reference {
+        Reference::Name(name) if is_file_reference(name) => fixtures::load_sample(Path::new(name)),
+        Reference::Name(name) => fixtures::builtin_sample(name),
+        Reference::Dict(dict) => fixtures::parse_sample(
+            "sample (a Python dict)",
+            &py_to_json(dict.as_any())?.to_string(),
+        ),
+    };
+    result.map_err(crate::errors::afm_to_py_err)
+}
+
+/// A simulation case: a cantilever tapping a sample at free amplitude `a0` (nm) and a drive
+/// frequency (kHz), resolved into the model of MODEL.md (Eq. 1 with Hertz contact).
+///
+/// `Case("biolever-mica")` takes a built-in case or a case file path;
+/// `Case(cantilever="biolever", sample="soft", a0=10.0)` combines a cantilever and a sample
+/// (built-in names, file paths, or dicts in the files' format). `a0` and
+/// `drive_frequency_khz` override a named case's values. `Case()` is the default case
+/// (`biolever-mica`), as on the command line.
+#[pyclass(module = "drumroll", frozen)]
+pub struct Case {
+    /// The resolved case and its model.
+    pub resolved: Arc<Resolved>,
+}
+
+#[pymethods]
+impl Case {
+    #[new]
+    #[pyo3(signature = (name_or_path=None, *, cantilever=None, sample=None, a0=None, drive_frequency_khz=None))]
+    fn new(
+        py: Python<'_>,
+        name_or_path: Option<String>,
+        cantilever: Option<Reference<'_>>,
+        sample: Option<Reference<'_>>,
+        a0: Option<f64>,
+        drive_frequency_khz: Option<f64>,
+    ) -> PyResult<Self> {
+        let has_dict = matches!(cantilever, Some(Reference::Dict(_)))
+            || matches!(sample, Some(Reference::Dict(_)));
+        let case = if has_dict {
+            let (Some(cantilever), Some(sample), None) = (&cantilever, &sample, &name_or_path)
+            else {
+                return Err(to_py_err(anyhow::anyhow!(
+                    "give either --case, or --cantilever with --sample and --a0"
+                )));
+            };
+            let Some(a0) = a0 else {
+                return Err(to_py_err(anyhow::anyhow!(
+                    "--cantilever and --sample need --a0 (the free amplitude, nm)"
+                )));
+            };
+            let cantilever = resolve_cantilever(cantilever)?;
+            let sample = resolve_sample(sample)?;
+            AfmCase {
+                name: format!("{}-{}", cantilever.name, sample.name),
+                description: String::from("from Python"),
+                cantilever,
+                sample,
+                free_amplitude_nm: a0,
+                drive_frequency_khz,
+            }
+        } else {
+            let name = |r: Option<Reference<'_>>| match r {
+                Some(Reference::Name(name)) => Some(name),
+                _ => None,
+            };
+            let args = ModelArgs {
+                case: name_or_path,
+                cantilever: name(cantilever),
+                sample: name(sample),
+                a0,
+                drive_frequency: drive_frequency_khz,
+            };
+            py.allow_threads(|| args.case()).map_err(to_py_err)?
+        };
+        let resolved = py
+            .allow_threads(|| Resolved::new(case))
+            .map_err(to_py_err)?;
+        Ok(Self {
+            resolved: Arc::new(resolved),
+        })
+    }
+
+    /// The case's name, e.g. `biolever-mica`.
+    #[getter]
+    fn name(&self) -> String {
+        self.resolved.case.name.clone()
+    }
+
+    /// The free amplitude A0 of the photodiode signal u, nm (MODEL.md section 3).
+    #[getter]
+    fn a0(&self) -> f64 {
+        self.resolved.model.free_amplitude_nm()
+    }
+
+    /// The drive frequency, kHz (the case's, else the fundamental f_1).
+    #[getter]
+    fn drive_frequency_khz(&self) -> f64 {
+        self.resolved.model.drive_frequency_khz()
+    }
+
+    /// The drive period T = 1/f, us.
+    #[getter]
+    fn period_us(&self) -> f64 {
+        self.resolved.model.period_us()
+    }
+
+    /// First contact Z_G1: the separation where the free orbit's lowest gap is zero, nm.
+    #[getter]
+    fn first_contact_z_nm(&self) -> f64 {
+        self.resolved.model.grazing_separation_nm()
+    }
+
+    /// The phase of the free orbit (no contact), degrees (a lag; MODEL.md section 4).
+    #[getter]
+    fn free_phase_deg(&self) -> f64 {
+        self.resolved.model.free_phase_deg()
+    }
+
+    /// The steady periodic orbit at separation `z` (nm), or, with `amplitude_ratio` instead,
+    /// where the quasi-static approach reaches that A/A0 (refined to 1e-9 nm), as
+    /// `drumroll simulate`. `start`: `"approach"` (default: the orbit of the quasi-static
+    /// approach, the one the paper and `continue` report), `"transient"` (the attractor of
+    /// transients from the free orbit), or a state near the orbit: a previous `Orbit` (at a
+    /// nearby Z, as along a branch: the fast warm start) or the state `[q_1, q_1', ...]` (nm,
+    /// nm/us). Runs without the GIL.
+    #[pyo3(signature = (z=None, *, amplitude_ratio=None, start=None))]
+    fn orbit(
+        &self,
+        py: Python<'_>,
+        z: Option<f64>,
+        amplitude_ratio: Option<f64>,
+        start: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<crate::orbit::Orbit> {
+        let default = pyo3::types::PyString::new(py, "approach");
+        let start = start.unwrap_or(default.as_any());
+        crate::orbit::compute_orbit(py, self, z, amplitude_ratio, start)
+    }
+
+    /// The bifurcation diagram in Z (the paper's Fig. 2), as `drumroll continue`: the
+    /// periodic orbits continued from above first contact down to `floor` (nm, in
+    /// [-A0, Z_G1); default 0.05 A0) or until A/A0 < `min_amplitude_ratio` (default 0.3; 0
+    /// disables), arclength steps of at most `max_step` (nm; default A0/250), special points
+    /// located to |dZ| < 1e-9 nm; with `retract=True` also back up from the lowest point.
+    /// Runs without the GIL; Ctrl-C interrupts it between branch points.
+    #[pyo3(signature = (*, floor=None, min_amplitude_ratio=0.3, max_step=None, retract=false))]
+    fn diagram(
+        &self,
+        py: Python<'_>,
+        floor: Option<f64>,
+        min_amplitude_ratio: f64,
+        max_step: Option<f64>,
+        retract: bool,
+    ) -> PyResult<crate::diagram::Diagram> {
+        crate::diagram::compute_diagram(py, self, floor, min_amplitude_ratio, max_step, retract)
+    }
+
+    /// A time-domain approach sweep as in the lab, as `drumroll approach`: Z falls from
+    /// `from_nm` (default 0.2 nm above first contact) to `to_nm` (nm, default 0) at
+    /// `rate_nm_per_s` (nm/s, default the paper's 1), read by a lock-in over blocks of
+    /// `lockin_cycles` drive cycles, every `every`-th reading kept, after `settle_cycles`
+    /// cycles at the start; `retract=True` sweeps back up; `tolerance` is the contact
+    /// integration's. Returns a pandas DataFrame (dict of numpy arrays without pandas), one
+    /// row per reading: `cycle`, `z_nm`, `amplitude_ratio`, `phase_deg` (deg),
+    /// `impacts_per_period`, `peak_force_nn` (nN), `direction`; `attrs["inputs"]` holds the
+    /// inputs. Runs without the GIL; Ctrl-C stops it and raises KeyboardInterrupt.
+    #[pyo3(signature = (*, from_nm=None, to_nm=0.0, rate_nm_per_s=1.0, retract=false, lockin_cycles=1, every=1, settle_cycles=20, tolerance=afm::sweep::DEFAULT_TOLERANCE))]
+    #[allow(clippy::too_many_arguments)]
+    fn approach<'py>(
+        &self,
+        py: Python<'py>,
+        from_nm: Option<f64>,
+        to_nm: f64,
+        rate_nm_per_s: f64,
+        retract: bool,
+        lockin_cycles: usize,
+        every: usize,
+        settle_cycles: usize,
+        tolerance: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let options = crate::approach::ApproachOptions {
+            from_nm,
+            to_nm,
+            rate_nm_per_s,
+            retract,
+            lockin_cycles,
+            every,
+            settle_cycles,
+            tolerance,
+        };
+        crate::approach::compute_approach(py, self, &options)
+    }
+
+    /// The case as a dict in the case files' format, the cantilever and the sample inline
+    /// (`Case.from_dict` builds it back).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.resolved.case_json())
+    }
+
+    /// The case of a dict as `to_dict` returns it.
+    #[classmethod]
+    fn from_dict(_cls: &Bound<'_, pyo3::types::PyType>, data: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let value = py_to_json(data)?;
+        let resolved = Resolved::from_case_json(&value, "the case dict").map_err(to_py_err)?;
+        Ok(Self {
+            resolved: Arc::new(resolved),
+        })
+    }
+
+    /// Pickling: the case travels as its dict (so it reaches Dask workers).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let rebuild = py.get_type::<Self>().getattr("from_dict")?;
+        let state = slf.get().to_dict(py)?;
+        PyTuple::new(py, [rebuild, PyTuple::new(py, [state])?.into_any()])
+    }
+
+    fn __repr__(&self) -> String {
+        let model = &self.resolved.model;
+        format!(
+            "<drumroll.Case '{}': A0 = {} nm, drive {:.4} kHz, first contact Z_G1 = {:.6} nm>",
+            self.resolved.case.name,
+            model.free_amplitude_nm(),
+            model.drive_frequency_khz(),
+            model.grazing_separation_nm()
+        )
+    }
+}

@@ -1,0 +1,119 @@
+//! JSON values to Python objects, and tables of JSON records to columns: numpy arrays, in a
+//! pandas DataFrame when pandas can be imported.
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use pyo3::IntoPyObjectExt;
+use serde_json::Value;
+
+/// The Python object of a JSON value: `None`, `bool`, `int`, `float`, `str`, `list`, `dict`
+/// (what `json.loads` gives for the same text).
+pub fn json_to_py<'py>(py: Python<'py>, value: &Value) -> PyResult<Bound<'py, PyAny>> {
+    match value {
+        Value::Null => Ok(py.None().into_bound(py)),
+        Value::Bool(b) => b.into_bound_py_any(py),
+        Value::Number(n) => {
+            if let Some(i) = n.as_i64() {
+                i.into_bound_py_any(py)
+            } else if let Some(u) = n.as_u64() {
+                u.into_bound_py_any(py)
+            } else {
+                n.as_f64().unwrap_or(f64::NAN).into_bound_py_any(py)
+            }
+        }
+        Value::String(s) => s.into_bound_py_any(py),
+        Value::Array(items) => {
+            let list = PyList::empty(py);
+            for item in items {
+                list.append(json_to_py(py, item)?)?;
+            }
+            Ok(list.into_any())
+        }
+        Value::Object(map) => {
+            let dict = PyDict::new(py);
+            for (key, item) in map {
+                dict.set_item(key, json_to_py(py, item)?)?;
+            }
+            Ok(dict.into_any())
+        }
+    }
+}
+
+/// The JSON value of a Python object that `json.dumps` accepts (a dict of a cantilever or a
+/// sample file, say).
+pub fn py_to_json(object: &Bound<'_, PyAny>) -> PyResult<Value> {
+    let text: String = object
+        .py()
+        .import("json")?
+        .call_method1("dumps", (object,))?
+        .extract()?;
+    serde_json::from_str(&text)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("not JSON data: {e}")))
+}
+
+/// The numpy array of `(0..n).map(value)`: `int64` when every value is an integer, `float64`
+/// when every value is a number or `null` (`null` as NaN), `bool` when every value is a
+/// boolean, else an array of Python objects (strings, lists, dicts).
+fn column<'py>(
+    py: Python<'py>,
+    numpy: &Bound<'py, PyModule>,
+    values: &[&Value],
+) -> PyResult<Bound<'py, PyAny>> {
+    let all = |test: fn(&Value) -> bool| values.iter().all(|v| test(v));
+    if !values.is_empty() && all(|v| v.is_i64() || v.is_u64()) {
+        let items: Vec<i64> = values.iter().filter_map(|v| v.as_i64()).collect();
+        return numpy.call_method1("array", (items, "int64"));
+    }
+    if !values.is_empty() && all(|v| v.is_number() || v.is_null()) {
+        let items: Vec<f64> = values
+            .iter()
+            .map(|v| v.as_f64().unwrap_or(f64::NAN))
+            .collect();
+        return numpy.call_method1("array", (items, "float64"));
+    }
+    if !values.is_empty() && all(Value::is_boolean) {
+        let items: Vec<bool> = values.iter().filter_map(|v| v.as_bool()).collect();
+        return numpy.call_method1("array", (items, "bool"));
+    }
+    let array = numpy.call_method1("empty", (values.len(), "object"))?;
+    for (i, value) in values.iter().enumerate() {
+        array.set_item(i, json_to_py(py, value)?)?;
+    }
+    Ok(array)
+}
+
+/// The records (JSON objects with the same keys) as columns: a pandas DataFrame if pandas can
+/// be imported, else a dict of numpy arrays; one column per key, the keys of `order` first in
+/// that order, then the others alphabetically.
+pub fn records_to_table<'py>(
+    py: Python<'py>,
+    records: &[Value],
+    order: &[&str],
+) -> PyResult<Bound<'py, PyAny>> {
+    let numpy = py.import("numpy")?;
+    let mut keys: Vec<String> = order.iter().map(|k| k.to_string()).collect();
+    if let Some(Value::Object(first)) = records.first() {
+        let mut rest: Vec<String> = first
+            .keys()
+            .filter(|k| !order.contains(&k.as_str()))
+            .cloned()
+            .collect();
+        rest.sort();
+        keys.extend(rest);
+    }
+    let columns = PyDict::new(py);
+    for key in &keys {
+        let values: Vec<&Value> = records.iter().map(|r| &r[key.as_str()]).collect();
+        columns.set_item(key, column(py, &numpy, &values)?)?;
+    }
+    match py.import("pandas") {
+        Ok(pandas) => pandas.call_method1("DataFrame", (columns,)),
+        Err(_) => Ok(columns.into_any()),
+    }
+}
+
+/// A numpy `float64` array of `values`.
+pub fn float_array<'py>(py: Python<'py>, values: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
+    py.import("numpy")?
+        .call_method1("array", (values, "float64"))
+}

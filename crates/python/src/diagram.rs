@@ -1,0 +1,162 @@
+//! `drumroll.Diagram`: the bifurcation diagram in Z (the paper's Fig. 2; MODEL.md section 5)
+//! as `drumroll continue --json` gives it, with the branch points as a table.
+
+use drumroll::continue_diagram::{compute_diagrams, continue_json, diagram_settings, CSV_COLUMNS};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use serde_json::Value;
+
+use crate::case::Case;
+use crate::convert::{json_to_py, py_to_json, records_to_table};
+use crate::errors::to_py_err;
+use crate::interrupt::without_gil;
+
+/// A bifurcation diagram: the branch of periodic orbits continued in the separation Z from
+/// above first contact down to a floor, every special point (grazing G_n, fold, ...) located
+/// to |dZ| < 1e-9 nm, and optionally the retract branch back up.
+///
+/// `points`: one row per branch point, the columns the keys of a `continue --json` point
+/// (`z_nm` in nm, `amplitude_ratio`, `phase_deg` in degrees, `impacts_per_period`,
+/// `peak_force_nn` in nN, `stable`, ..., docs/output-schema.md); a pandas DataFrame, or a dict
+/// of numpy arrays without pandas (a `null` `min_gap_nm` is NaN there).
+/// `special_points`: a list of dicts (`label`, `z_nm`, `amplitude_ratio`, `phase_deg`,
+/// `impacts_before`, `impacts_after`, `bracket_nm`, `precision_nm`, `converged`, `state`).
+/// `to_dict()`: the whole `continue --json` object.
+#[pyclass(module = "drumroll", frozen)]
+pub struct Diagram {
+    json: Value,
+}
+
+fn branch_table<'py>(py: Python<'py>, branch: &Value) -> PyResult<Bound<'py, PyAny>> {
+    let points = branch["points"]
+        .as_array()
+        .map(Vec::as_slice)
+        .unwrap_or(&[]);
+    records_to_table(py, points, &CSV_COLUMNS)
+}
+
+#[pymethods]
+impl Diagram {
+    /// The approach's branch points, one row each (see the class docstring).
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        branch_table(py, &self.json)
+    }
+
+    /// The approach's special points: a list of dicts with the keys of `continue --json`.
+    #[getter]
+    fn special_points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.json["special_points"])
+    }
+
+    /// Why the approach stopped, in words.
+    #[getter]
+    fn stop(&self) -> String {
+        self.json["stop"].as_str().unwrap_or_default().to_string()
+    }
+
+    /// The error that ended the approach early, if any.
+    #[getter]
+    fn error(&self) -> Option<String> {
+        self.json["error"].as_str().map(String::from)
+    }
+
+    /// The retract's branch points (Z increasing from the approach's lowest point), or None
+    /// when the diagram was computed without `retract=True`.
+    #[getter]
+    fn retract_points<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        match self.json.get("retract") {
+            Some(retract) => Ok(Some(branch_table(py, retract)?)),
+            None => Ok(None),
+        }
+    }
+
+    /// The retract's special points (a list of dicts), or None without a retract.
+    #[getter]
+    fn retract_special_points<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        match self.json.get("retract") {
+            Some(retract) => Ok(Some(json_to_py(py, &retract["special_points"])?)),
+            None => Ok(None),
+        }
+    }
+
+    /// With a retract: the `[Z_low, Z_high]` ranges (nm) where two stable orbits coexist (the
+    /// hysteresis of approach and retract); None without a retract.
+    #[getter]
+    fn bistable_ranges_nm<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        match self.json.get("bistable_ranges_nm") {
+            Some(ranges) => Ok(Some(json_to_py(py, ranges)?)),
+            None => Ok(None),
+        }
+    }
+
+    /// The whole `drumroll continue --json` object as a dict.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &self.json)
+    }
+
+    /// A diagram from its `to_dict()` (or a saved `drumroll continue --json` file's content).
+    #[classmethod]
+    fn from_dict(_cls: &Bound<'_, pyo3::types::PyType>, data: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let json = py_to_json(data)?;
+        if !json["points"].is_array() || !json["special_points"].is_array() {
+            return Err(PyValueError::new_err(
+                "a diagram's dict has `points` and `special_points` arrays (the output of `drumroll continue --json`)",
+            ));
+        }
+        Ok(Self { json })
+    }
+
+    /// Pickling: the diagram travels as its dict.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let rebuild = py.get_type::<Self>().getattr("from_dict")?;
+        let state = slf.get().to_dict(py)?;
+        PyTuple::new(py, [rebuild, PyTuple::new(py, [state])?.into_any()])
+    }
+
+    fn __repr__(&self) -> String {
+        let labels: Vec<&str> = self.json["special_points"]
+            .as_array()
+            .map(|s| s.iter().filter_map(|p| p["label"].as_str()).collect())
+            .unwrap_or_default();
+        format!(
+            "<drumroll.Diagram '{}': {} points, special points [{}]>",
+            self.json["case"].as_str().unwrap_or_default(),
+            self.json["points"].as_array().map_or(0, Vec::len),
+            labels.join(", ")
+        )
+    }
+}
+
+/// The diagram of `case` (options as `drumroll continue`'s), computed without the GIL and
+/// interruptible by Ctrl-C between branch points.
+pub fn compute_diagram(
+    py: Python<'_>,
+    case: &Case,
+    floor: Option<f64>,
+    min_amplitude_ratio: f64,
+    max_step: Option<f64>,
+    retract: bool,
+) -> PyResult<Diagram> {
+    let resolved = case.resolved.clone();
+    let json = without_gil(py, |interrupted| -> anyhow::Result<Value> {
+        let settings = diagram_settings(&resolved.model, floor, min_amplitude_ratio, max_step)?;
+        let run = compute_diagrams(
+            &resolved.case,
+            &resolved.model,
+            &settings,
+            retract,
+            interrupted,
+        )?;
+        Ok(continue_json(
+            &resolved.case,
+            &resolved.model,
+            &settings,
+            &run,
+        ))
+    })?
+    .map_err(to_py_err)?;
+    Ok(Diagram { json })
+}
