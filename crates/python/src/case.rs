@@ -47,7 +47,6 @@ impl Resolved {
 
     /// The case of [`Resolved::case_json`]'s object (`source` names it in errors).
     pub fn from_case_json(value: &Value, source: &str) -> anyhow::Result<Self> {
-        let text = |key: &str| value[key].to_string();
         let number = |key: &str| value[key].as_f64();
         let Some(free_amplitude_nm) = number("free_amplitude_nm") else {
             anyhow::bail!("{source}: `free_amplitude_nm` must be a number of nm");
@@ -55,16 +54,25 @@ impl Resolved {
         let case = AfmCase {
             name: value["name"].as_str().unwrap_or("python").to_string(),
             description: value["description"].as_str().unwrap_or("").to_string(),
-            cantilever: fixtures::parse_cantilever(
-                &format!("{source}: cantilever"),
-                &text("cantilever"),
-            )?,
-            sample: fixtures::parse_sample(&format!("{source}: sample"), &text("sample"))?,
+            cantilever: from_value(&value["cantilever"], &format!("{source}: cantilever"))?,
+            sample: from_value(&value["sample"], &format!("{source}: sample"))?,
             free_amplitude_nm,
             drive_frequency_khz: number("drive_frequency_khz"),
         };
         Self::new(case)
     }
+}
+
+/// A cantilever or sample of its file's JSON object, numbers taken exactly (checked when the
+/// case is resolved; `file` names it in errors).
+fn from_value<T: serde::de::DeserializeOwned>(
+    value: &Value,
+    file: &str,
+) -> Result<T, afm::AfmError> {
+    T::deserialize(value).map_err(|source| afm::AfmError::Json {
+        file: file.to_string(),
+        source,
+    })
 }
 
 /// A cantilever or sample given from Python: a built-in name, a file path, or a dict in the
@@ -92,10 +100,9 @@ fn resolve_cantilever(reference: &Reference<'_>) -> PyResult<afm::Cantilever> {
             fixtures::load_cantilever(Path::new(name))
         }
         Reference::Name(name) => fixtures::builtin_cantilever(name),
-        Reference::Dict(dict) => fixtures::parse_cantilever(
-            "cantilever (a Python dict)",
-            &py_to_json(dict.as_any())?.to_string(),
-        ),
+        Reference::Dict(dict) => {
+            from_value(&py_to_json(dict.as_any())?, "cantilever (a Python dict)")
+        }
     };
     result.map_err(crate::errors::afm_to_py_err)
 }
@@ -104,10 +111,7 @@ fn resolve_sample(reference: &Reference<'_>) -> PyResult<afm::Sample> {
     let result = match reference {
         Reference::Name(name) if is_file_reference(name) => fixtures::load_sample(Path::new(name)),
         Reference::Name(name) => fixtures::builtin_sample(name),
-        Reference::Dict(dict) => fixtures::parse_sample(
-            "sample (a Python dict)",
-            &py_to_json(dict.as_any())?.to_string(),
-        ),
+        Reference::Dict(dict) => from_value(&py_to_json(dict.as_any())?, "sample (a Python dict)"),
     };
     result.map_err(crate::errors::afm_to_py_err)
 }

@@ -39,16 +39,53 @@ pub fn json_to_py<'py>(py: Python<'py>, value: &Value) -> PyResult<Bound<'py, Py
     }
 }
 
-/// The JSON value of a Python object that `json.dumps` accepts (a dict of a cantilever or a
-/// sample file, say).
+/// The JSON value of a Python object made of `None`, `bool`, `int`, `float`, `str`, lists,
+/// tuples and dicts with string keys (a dict of a cantilever file, say); floats are kept
+/// exactly (no trip through text). Anything else is a `TypeError` naming its type.
 pub fn py_to_json(object: &Bound<'_, PyAny>) -> PyResult<Value> {
-    let text: String = object
-        .py()
-        .import("json")?
-        .call_method1("dumps", (object,))?
-        .extract()?;
-    serde_json::from_str(&text)
-        .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("not JSON data: {e}")))
+    if object.is_none() {
+        return Ok(Value::Null);
+    }
+    if let Ok(b) = object.downcast::<pyo3::types::PyBool>() {
+        return Ok(Value::Bool(b.is_true()));
+    }
+    if object.is_instance_of::<pyo3::types::PyInt>() {
+        if let Ok(i) = object.extract::<i64>() {
+            return Ok(Value::from(i));
+        }
+        return Ok(Value::from(object.extract::<u64>()?));
+    }
+    if let Ok(f) = object.downcast::<pyo3::types::PyFloat>() {
+        return Ok(serde_json::Number::from_f64(f.value()).map_or(Value::Null, Value::Number));
+    }
+    if let Ok(s) = object.downcast::<pyo3::types::PyString>() {
+        return Ok(Value::String(s.to_cow()?.into_owned()));
+    }
+    if let Ok(dict) = object.downcast::<PyDict>() {
+        let mut map = serde_json::Map::new();
+        for (key, item) in dict.iter() {
+            let key: String = key
+                .extract()
+                .map_err(|_| pyo3::exceptions::PyTypeError::new_err("dict keys must be strings"))?;
+            map.insert(key, py_to_json(&item)?);
+        }
+        return Ok(Value::Object(map));
+    }
+    if object.is_instance_of::<PyList>() || object.is_instance_of::<pyo3::types::PyTuple>() {
+        let items: Vec<Value> = object
+            .try_iter()?
+            .map(|item| py_to_json(&item?))
+            .collect::<PyResult<_>>()?;
+        return Ok(Value::Array(items));
+    }
+    if let Ok(f) = object.extract::<f64>() {
+        // numpy scalars and other numbers.
+        return Ok(serde_json::Number::from_f64(f).map_or(Value::Null, Value::Number));
+    }
+    Err(pyo3::exceptions::PyTypeError::new_err(format!(
+        "cannot use a {} as JSON data (allowed: None, bool, int, float, str, list, tuple, dict)",
+        object.get_type().name()?
+    )))
 }
 
 /// The numpy array of `(0..n).map(value)`: `int64` when every value is an integer, `float64`

@@ -1,0 +1,209 @@
+"""drumroll: non-smooth dynamics of AFM cantilevers tapping a sample (Melcher, Xu, Raman,
+Appl. Phys. Lett. 93, 093111 (2008)).
+
+Units everywhere: lengths nm, forces nN, time us (or drive periods, `_periods`), frequencies
+kHz, phases degrees (a lag). Every result's keys and numbers are those of the `drumroll`
+command's JSON (docs/output-schema.md); `to_dict()` gives that JSON object.
+"""
+
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+__version__: str
+
+# A pandas DataFrame when pandas is installed, else a dict of numpy arrays (one per column).
+Table = Any
+
+class Case:
+    """A cantilever tapping a sample at free amplitude `a0` (nm) and a drive frequency (kHz),
+    resolved into the model of MODEL.md (Eq. 1 with Hertz contact).
+
+    `Case("biolever-mica")`: a built-in case or a case file path.
+    `Case(cantilever="biolever", sample="soft", a0=10.0)`: a cantilever and a sample (built-in
+    names, file paths, or dicts in the files' format). `a0` and `drive_frequency_khz` override
+    a named case's values; `Case()` is `biolever-mica`. Bad input raises ValueError (unknown
+    name, out-of-range value: the message names the field and its allowed range) or
+    TypeError; a file that cannot be read raises OSError. Pickles (travels to Dask workers).
+    """
+
+    def __init__(
+        self,
+        name_or_path: Optional[str] = None,
+        *,
+        cantilever: Union[str, Dict[str, Any], None] = None,
+        sample: Union[str, Dict[str, Any], None] = None,
+        a0: Optional[float] = None,
+        drive_frequency_khz: Optional[float] = None,
+    ) -> None: ...
+    @property
+    def name(self) -> str:
+        """The case's name, e.g. `biolever-mica`."""
+    @property
+    def a0(self) -> float:
+        """The free amplitude A0 of the photodiode signal u, nm."""
+    @property
+    def drive_frequency_khz(self) -> float:
+        """The drive frequency, kHz (the case's, else the fundamental f_1)."""
+    @property
+    def period_us(self) -> float:
+        """The drive period T = 1/f, us."""
+    @property
+    def first_contact_z_nm(self) -> float:
+        """First contact Z_G1: where the free orbit's lowest gap is zero, nm."""
+    @property
+    def free_phase_deg(self) -> float:
+        """The free orbit's phase, degrees."""
+    def orbit(
+        self,
+        z: Optional[float] = None,
+        *,
+        amplitude_ratio: Optional[float] = None,
+        start: Union[str, "Orbit", Sequence[float], None] = None,
+    ) -> "Orbit":
+        """The steady orbit at separation `z` (nm), or where the approach reaches
+        `amplitude_ratio` (A/A0), as `drumroll simulate`. `start`: "approach" (default),
+        "transient", or a state near the orbit (a previous Orbit at a nearby Z: the fast warm
+        start; or [q_1 nm, q_1' nm/us, q_2, q_2', ...]). Releases the GIL."""
+    def diagram(
+        self,
+        *,
+        floor: Optional[float] = None,
+        min_amplitude_ratio: float = 0.3,
+        max_step: Optional[float] = None,
+        retract: bool = False,
+    ) -> "Diagram":
+        """The bifurcation diagram in Z (the paper's Fig. 2), as `drumroll continue`: from
+        above first contact down to `floor` (nm, default 0.05 A0) or A/A0 <
+        `min_amplitude_ratio`; arclength steps up to `max_step` nm (default A0/250); with
+        `retract=True` back up too. Releases the GIL; Ctrl-C interrupts it."""
+    def approach(
+        self,
+        *,
+        from_nm: Optional[float] = None,
+        to_nm: float = 0.0,
+        rate_nm_per_s: float = 1.0,
+        retract: bool = False,
+        lockin_cycles: int = 1,
+        every: int = 1,
+        settle_cycles: int = 20,
+        tolerance: float = 1e-8,
+    ) -> Table:
+        """A time-domain approach sweep, as `drumroll approach`: Z from `from_nm` (default
+        Z_G1 + 0.2 nm) to `to_nm` (nm) at `rate_nm_per_s` (nm/s), read by a lock-in over
+        `lockin_cycles` drive cycles, every `every`-th reading kept. One row per reading:
+        cycle, z_nm, amplitude_ratio, phase_deg, impacts_per_period, peak_force_nn (nN),
+        direction; a DataFrame's attrs["inputs"] holds the inputs. Releases the GIL; Ctrl-C
+        stops it."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The case in the case files' format, cantilever and sample inline."""
+    @classmethod
+    def from_dict(cls, data: Dict[str, Any]) -> "Case":
+        """The case of a dict as `to_dict` returns it."""
+
+class Orbit:
+    """One steady periodic orbit at a separation Z (MODEL.md section 4); every key of
+    `drumroll simulate --json` is an attribute. `to_dict()` is the whole object (for an orbit
+    found by `z=` the other start's coexisting orbit is looked for then, as the CLI does)."""
+
+    z_nm: float
+    """Separation Z between the cantilever base and the sample, nm."""
+    amplitude_ratio: float
+    """A/A0 of the photodiode signal's first harmonic."""
+    phase_deg: float
+    """Phase of u's first harmonic, degrees (a lag)."""
+    free_phase_deg: float
+    """The free orbit's phase, degrees."""
+    first_contact_z_nm: float
+    """First contact Z_G1, nm."""
+    free_amplitude_nm: float
+    """A0, nm."""
+    drive_frequency_khz: float
+    """Drive frequency, kHz."""
+    period_us: float
+    """Drive period, us."""
+    multiplicity: int
+    """The orbit's period in drive periods."""
+    impacts_per_period: float
+    """Impacts over the orbit divided by its multiplicity."""
+    impacts_per_orbit: int
+    """Impacts over the whole orbit."""
+    peak_force_nn: float
+    """Largest tip-sample force, nN."""
+    mean_force_nn: float
+    """Mean tip-sample force per drive period, nN."""
+    impulse_nn_us: float
+    """Tip-sample impulse per drive period, nN us."""
+    contact_time_periods: float
+    """Time in contact per drive period, in drive periods."""
+    min_gap_nm: Optional[float]
+    """Lowest gap d over the orbit, nm."""
+    gap_minima: List[Dict[str, Any]]
+    """Every local minimum of the gap: t_periods, gap_nm, kind."""
+    impacts: List[Dict[str, Any]]
+    """Every impact: start_periods, end_periods, velocity_nm_per_us, peak_force_nn."""
+    periods: List[Dict[str, Any]]
+    """Per drive period of the orbit: amplitude_ratio, phase_deg, impacts, ..."""
+    converged: bool
+    newton_iterations: int
+    residual: float
+    stable: bool
+    floquet_multipliers: List[List[float]]
+    """[re, im] pairs by decreasing modulus."""
+    spectral_radius: float
+    state: List[float]
+    """[q_1 nm, q_1' nm/us, q_2, q_2', ...] at t = 0."""
+    start: str
+    """"approach", "transient" or "near"."""
+    case: str
+    coexisting_orbit: Optional[Dict[str, Any]]
+    """The other start's orbit at this Z when it is a different one (as the CLI's JSON)."""
+    inputs: Dict[str, Any]
+    """What the orbit was computed from (docs/output-schema.md)."""
+
+    def time_series(
+        self, samples: int = 1000, periods: Optional[int] = None
+    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(t us, u nm, F_ts nN) at `samples` points per drive period over `periods` drive
+        periods (default: one whole orbit), both ends included."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The `drumroll simulate --json` object."""
+
+class Diagram:
+    """A bifurcation diagram in Z, as `drumroll continue --json`. Pickles."""
+
+    @property
+    def points(self) -> Table:
+        """The approach's branch points: columns z_nm (nm), amplitude_ratio, phase_deg (deg),
+        multiplicity, impacts_per_period, impacts_per_orbit, min_gap_nm (nm), peak_force_nn
+        (nN), mean_force_nn (nN), impulse_nn_us (nN us), contact_time_periods,
+        spectral_radius, stable, iterations, residual, floquet_multipliers, gap_minima,
+        state."""
+    @property
+    def special_points(self) -> List[Dict[str, Any]]:
+        """label, z_nm, amplitude_ratio, phase_deg, impacts_before, impacts_after,
+        bracket_nm, precision_nm, converged, state."""
+    @property
+    def stop(self) -> str:
+        """Why the approach stopped."""
+    @property
+    def error(self) -> Optional[str]:
+        """The error that ended the branch early, if any."""
+    @property
+    def retract_points(self) -> Optional[Table]:
+        """The retract's branch points (with retract=True)."""
+    @property
+    def retract_special_points(self) -> Optional[List[Dict[str, Any]]]:
+        """The retract's special points (with retract=True)."""
+    @property
+    def bistable_ranges_nm(self) -> Optional[List[List[float]]]:
+        """[Z_low, Z_high] ranges (nm) with two stable orbits (with retract=True)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The `drumroll continue --json` object."""
+    @classmethod
+    def from_dict(cls, data: Dict[str, Any]) -> "Diagram":
+        """A diagram from its dict (or a saved `continue --json` file's content)."""
+
+def cases() -> Dict[str, Dict[str, Dict[str, Any]]]:
+    """The built-in fixtures: {"cases": {...}, "cantilevers": {...}, "samples": {...}}, each
+    entry in its file's format."""

@@ -1,0 +1,115 @@
+"""Every Python result equals the CLI's JSON for the same inputs: same keys, same numbers
+(both sides are exact binary64: Python's json parses the CLI's shortest round-trip digits)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import drumroll
+from conftest import cli_json, run_cli
+
+
+@pytest.mark.parametrize("z", [12.0, 8.5, 5.0, 2.7])
+def test_orbit_at_z_equals_simulate_json(z):
+    case = drumroll.Case("biolever-mica")
+    orbit = case.orbit(z=z)
+    expected = cli_json("simulate", "--case", "biolever-mica", "--z", str(z), "--json")
+    assert orbit.to_dict() == expected
+    for key in ("amplitude_ratio", "phase_deg", "impacts_per_period", "peak_force_nn", "state"):
+        assert getattr(orbit, key) == expected[key]
+
+
+def test_orbit_at_amplitude_ratio_and_transient_start_equal_simulate_json():
+    case = drumroll.Case("maclever-mica")
+    assert case.orbit(amplitude_ratio=0.9).to_dict() == cli_json(
+        "simulate", "--case", "maclever-mica", "--amplitude-ratio", "0.9", "--json"
+    )
+    assert case.orbit(z=19.997, start="transient").to_dict() == cli_json(
+        "simulate", "--case", "maclever-mica", "--z", "19.997", "--start", "transient", "--json"
+    )
+
+
+def test_cantilever_sample_a0_and_drive_equal_the_cli_options():
+    case = drumroll.Case(cantilever="biolever", sample="soft", a0=12.5, drive_frequency_khz=9.0)
+    expected = cli_json(
+        "simulate", "--cantilever", "biolever", "--sample", "soft", "--a0", "12.5",
+        "--drive-frequency", "9", "--z", "9", "--json",
+    )
+    assert case.orbit(z=9.0).to_dict() == expected
+
+
+def test_a_case_of_dicts_gives_the_named_case_numbers():
+    fixtures = drumroll.cases()
+    named = drumroll.Case(cantilever="maclever", sample="soft", a0=20.0)
+    from_dicts = drumroll.Case(
+        cantilever=fixtures["cantilevers"]["maclever"],
+        sample=fixtures["samples"]["soft"],
+        a0=20.0,
+    )
+    assert from_dicts.orbit(z=10.0).to_dict() == named.orbit(z=10.0).to_dict()
+
+
+def test_diagram_equals_continue_json():
+    case = drumroll.Case("biolever-mica")
+    diagram = case.diagram()
+    expected = cli_json("continue", "--case", "biolever-mica", "--json")
+    assert diagram.to_dict() == expected
+    assert diagram.special_points == expected["special_points"]
+    assert [p["label"] for p in diagram.special_points] == ["G1", "G2", "G3"]
+    points = diagram.points
+    assert list(points.columns)[:3] == ["z_nm", "amplitude_ratio", "phase_deg"]
+    assert set(points.columns) == set(expected["points"][0])
+    assert len(points) == len(expected["points"])
+    for column in points.columns:
+        values = [p[column] for p in expected["points"]]
+        if column == "min_gap_nm":
+            values = [math.nan if v is None else v for v in values]
+            np.testing.assert_array_equal(points[column].to_numpy(), np.array(values))
+        else:
+            assert list(points[column]) == values, column
+
+
+def test_diagram_options_and_retract_equal_continue_json():
+    case = drumroll.Case("maclever-mica")
+    diagram = case.diagram(floor=15.0, min_amplitude_ratio=0.0, max_step=0.1, retract=True)
+    expected = cli_json(
+        "continue", "--case", "maclever-mica", "--floor", "15", "--min-amplitude-ratio", "0",
+        "--max-step", "0.1", "--retract", "--json",
+    )
+    assert diagram.to_dict() == expected
+    assert diagram.retract_special_points == expected["retract"]["special_points"]
+    assert diagram.bistable_ranges_nm == expected["bistable_ranges_nm"]
+    assert len(diagram.retract_points) == len(expected["retract"]["points"])
+
+
+def test_approach_rows_equal_the_jsonl_records():
+    case = drumroll.Case("biolever-mica")
+    table = case.approach(from_nm=8.8, to_nm=8.7, rate_nm_per_s=1.0, every=50, retract=True)
+    lines = run_cli(
+        "approach", "--case", "biolever-mica", "--from", "8.8", "--to", "8.7", "--rate", "1",
+        "--every", "50", "--retract", "--jsonl",
+    ).stdout.splitlines()
+    inputs = json.loads(lines[0])["inputs"]
+    records = [json.loads(line) for line in lines[1:]]
+    assert table.to_dict(orient="records") == records
+    assert list(table.columns) == [
+        "cycle", "z_nm", "amplitude_ratio", "phase_deg", "impacts_per_period",
+        "peak_force_nn", "direction",
+    ]
+    assert table.attrs["inputs"] == inputs
+    assert set(table["direction"]) == {"approach", "retract"}
+
+
+def test_cases_lists_the_built_in_fixtures():
+    fixtures = drumroll.cases()
+    assert "biolever-mica" in fixtures["cases"]
+    assert set(fixtures["cantilevers"]) >= {"biolever", "maclever"}
+    assert set(fixtures["samples"]) >= {"mica", "soft", "purple-membrane"}
+    for name, case_dict in fixtures["cases"].items():
+        assert drumroll.Case(name).to_dict() == case_dict
+    inputs = cli_json("simulate", "--case", "maclever-soft", "--z", "15", "--json")["inputs"]
+    case_dict = fixtures["cases"]["maclever-soft"]
+    assert case_dict["cantilever"] == inputs["cantilever"]
+    assert case_dict["sample"] == inputs["sample"]
