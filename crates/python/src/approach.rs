@@ -7,10 +7,11 @@ use drumroll::model_args::ModelArgs;
 use pyo3::prelude::*;
 use serde_json::{json, Value};
 
-use crate::case::Case;
 use crate::convert::{json_to_py, records_to_table};
 use crate::errors::to_py_err;
 use crate::interrupt::without_gil;
+use crate::resolved::Resolved;
+use std::sync::Arc;
 
 /// The options of `Case.approach`, named as in Python (units in the names).
 pub struct ApproachOptions {
@@ -32,15 +33,14 @@ pub struct ApproachOptions {
     pub tolerance: f64,
 }
 
-/// The sweep of `case` with `options`: a table (DataFrame, or dict of numpy arrays) with one
+/// The sweep of the case `resolved` with `options`: a table (DataFrame, or dict of numpy arrays) with one
 /// row per record and the columns of `drumroll approach`'s CSV; a DataFrame's
 /// `attrs["inputs"]` holds the `inputs` object of `--jsonl`'s first line.
 pub fn compute_approach<'py>(
     py: Python<'py>,
-    case: &Case,
+    resolved: &Arc<Resolved>,
     options: &ApproachOptions,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let resolved = case.resolved.clone();
     let args = ApproachArgs {
         model: ModelArgs {
             case: None,

@@ -1,79 +1,16 @@
 //! `drumroll.Case`: a cantilever tapping a sample at a free amplitude and drive frequency
 //! (MODEL.md section 3), resolved into the tapping model, and the computations on it.
 
-use afm::{fixtures, Case as AfmCase, TappingModel};
-use anyhow::Context;
+use afm::{fixtures, Case as AfmCase};
 use drumroll::model_args::ModelArgs;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use serde_json::{json, Value};
 use std::path::Path;
 use std::sync::Arc;
 
 use crate::convert::{json_to_py, py_to_json};
 use crate::errors::to_py_err;
-
-/// A case resolved into its model, shared by the results computed on it.
-#[derive(Debug)]
-pub struct Resolved {
-    /// The case as given.
-    pub case: AfmCase,
-    /// Its tapping model (Eq. 1 with Hertz contact), at first contact `Z = Z_G1`.
-    pub model: TappingModel,
-}
-
-impl Resolved {
-    /// Validate `case` and build its model (errors as the CLI words them).
-    pub fn new(case: AfmCase) -> anyhow::Result<Self> {
-        case.validate("the Python arguments")
-            .context("invalid model parameters")?;
-        let model = TappingModel::from_case(&case)
-            .with_context(|| format!("cannot build the model of case `{}`", case.name))?;
-        Ok(Self { case, model })
-    }
-
-    /// The case in the case files' format with the cantilever and sample inline: what
-    /// `Case.to_dict()` returns and pickling stores.
-    pub fn case_json(&self) -> Value {
-        json!({
-            "name": self.case.name,
-            "description": self.case.description,
-            "cantilever": self.case.cantilever,
-            "sample": self.case.sample,
-            "free_amplitude_nm": self.case.free_amplitude_nm,
-            "drive_frequency_khz": self.case.drive_frequency_khz,
-        })
-    }
-
-    /// The case of [`Resolved::case_json`]'s object (`source` names it in errors).
-    pub fn from_case_json(value: &Value, source: &str) -> anyhow::Result<Self> {
-        let number = |key: &str| value[key].as_f64();
-        let Some(free_amplitude_nm) = number("free_amplitude_nm") else {
-            anyhow::bail!("{source}: `free_amplitude_nm` must be a number of nm");
-        };
-        let case = AfmCase {
-            name: value["name"].as_str().unwrap_or("python").to_string(),
-            description: value["description"].as_str().unwrap_or("").to_string(),
-            cantilever: from_value(&value["cantilever"], &format!("{source}: cantilever"))?,
-            sample: from_value(&value["sample"], &format!("{source}: sample"))?,
-            free_amplitude_nm,
-            drive_frequency_khz: number("drive_frequency_khz"),
-        };
-        Self::new(case)
-    }
-}
-
-/// A cantilever or sample of its file's JSON object, numbers taken exactly (checked when the
-/// case is resolved; `file` names it in errors).
-fn from_value<T: serde::de::DeserializeOwned>(
-    value: &Value,
-    file: &str,
-) -> Result<T, afm::AfmError> {
-    T::deserialize(value).map_err(|source| afm::AfmError::Json {
-        file: file.to_string(),
-        source,
-    })
-}
+use crate::resolved::{from_value, Resolved};
 
 /// A cantilever or sample given from Python: a built-in name, a file path, or a dict in the
 /// files' format.
@@ -241,7 +178,7 @@ impl Case {
     ) -> PyResult<crate::orbit::Orbit> {
         let default = pyo3::types::PyString::new(py, "approach");
         let start = start.unwrap_or(default.as_any());
-        crate::orbit::compute_orbit(py, self, z, amplitude_ratio, start)
+        crate::orbit::compute_orbit(py, &self.resolved, z, amplitude_ratio, start)
     }
 
     /// The bifurcation diagram in Z (the paper's Fig. 2), as `drumroll continue`: the
@@ -259,7 +196,14 @@ impl Case {
         max_step: Option<f64>,
         retract: bool,
     ) -> PyResult<crate::diagram::Diagram> {
-        crate::diagram::compute_diagram(py, self, floor, min_amplitude_ratio, max_step, retract)
+        crate::diagram::compute_diagram(
+            py,
+            &self.resolved,
+            floor,
+            min_amplitude_ratio,
+            max_step,
+            retract,
+        )
     }
 
     /// A time-domain approach sweep as in the lab, as `drumroll approach`: Z falls from
@@ -295,7 +239,7 @@ impl Case {
             settle_cycles,
             tolerance,
         };
-        crate::approach::compute_approach(py, self, &options)
+        crate::approach::compute_approach(py, &self.resolved, &options)
     }
 
     /// The case as a dict in the case files' format, the cantilever and the sample inline

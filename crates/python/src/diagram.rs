@@ -7,10 +7,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use serde_json::Value;
 
-use crate::case::Case;
 use crate::convert::{json_to_py, py_to_json, records_to_table};
 use crate::errors::to_py_err;
 use crate::interrupt::without_gil;
+use crate::resolved::Resolved;
+use std::sync::Arc;
 
 /// A bifurcation diagram: the branch of periodic orbits continued in the separation Z from
 /// above first contact down to a floor, every special point (grazing G_n, fold, ...) located
@@ -130,17 +131,16 @@ impl Diagram {
     }
 }
 
-/// The diagram of `case` (options as `drumroll continue`'s), computed without the GIL and
+/// The diagram of the case `resolved` (options as `drumroll continue`'s), computed without the GIL and
 /// interruptible by Ctrl-C between branch points.
 pub fn compute_diagram(
     py: Python<'_>,
-    case: &Case,
+    resolved: &Arc<Resolved>,
     floor: Option<f64>,
     min_amplitude_ratio: f64,
     max_step: Option<f64>,
     retract: bool,
 ) -> PyResult<Diagram> {
-    let resolved = case.resolved.clone();
     let json = without_gil(py, |interrupted| -> anyhow::Result<Value> {
         let settings = diagram_settings(&resolved.model, floor, min_amplitude_ratio, max_step)?;
         let run = compute_diagrams(

@@ -12,6 +12,7 @@ pub mod diagram;
 pub mod errors;
 pub mod interrupt;
 pub mod orbit;
+pub mod resolved;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

@@ -9,9 +9,9 @@ use pyo3::types::PyTuple;
 use serde_json::{json, Value};
 use std::sync::{Arc, OnceLock};
 
-use crate::case::{Case, Resolved};
 use crate::convert::{float_array, json_to_py, py_to_json};
 use crate::errors::{afm_to_py_err, to_py_err};
+use crate::resolved::Resolved;
 
 /// How an orbit was found: the CLI's starts, or Newton from a given state near the orbit.
 #[derive(Debug, Clone)]
@@ -242,14 +242,9 @@ impl Orbit {
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();
         let orbit = slf.get();
-        let case = Bound::new(
-            py,
-            Case {
-                resolved: orbit.resolved.clone(),
-            },
-        )?;
+        let case = json_to_py(py, &orbit.resolved.case_json())?;
         let rebuild = py.import("drumroll")?.getattr("_restore_orbit")?;
-        let args = PyTuple::new(py, [case.into_any(), orbit.to_dict(py)?])?;
+        let args = PyTuple::new(py, [case, orbit.to_dict(py)?])?;
         PyTuple::new(py, [rebuild, args.into_any()])
     }
 
@@ -262,9 +257,12 @@ impl Orbit {
     }
 }
 
-/// Rebuild a pickled orbit: its case and its `simulate --json` object.
+/// Rebuild a pickled orbit: its case's dict (`Case.to_dict()`) and its `simulate --json`
+/// object.
 #[pyfunction]
-pub fn _restore_orbit(case: &Case, data: &Bound<'_, PyAny>) -> PyResult<Orbit> {
+pub fn _restore_orbit(case: &Bound<'_, PyAny>, data: &Bound<'_, PyAny>) -> PyResult<Orbit> {
+    let resolved =
+        Resolved::from_case_json(&py_to_json(case)?, "the orbit's case").map_err(to_py_err)?;
     let value = py_to_json(data)?;
     if !value.is_object() {
         return Err(PyValueError::new_err("an orbit's data must be a dict"));
@@ -274,24 +272,24 @@ pub fn _restore_orbit(case: &Case, data: &Bound<'_, PyAny>) -> PyResult<Orbit> {
     let full = OnceLock::new();
     let _ = full.set(value);
     Ok(Orbit {
-        resolved: case.resolved.clone(),
+        resolved: Arc::new(resolved),
         computed: None,
         core,
         full,
     })
 }
 
-/// The steady orbit of `case` at `z` (or where the approach reaches `amplitude_ratio`), from
+/// The steady orbit of the case `resolved` at `z` (or where the approach reaches `amplitude_ratio`), from
 /// `start`: `"approach"`, `"transient"`, or a state (an `Orbit`, or a sequence of floats)
 /// near the orbit.
 pub fn compute_orbit(
     py: Python<'_>,
-    case: &Case,
+    resolved: &Arc<Resolved>,
     z: Option<f64>,
     amplitude_ratio: Option<f64>,
     start: &Bound<'_, PyAny>,
 ) -> PyResult<Orbit> {
-    let resolved = case.resolved.clone();
+    let resolved = resolved.clone();
     let settings = SteadyOrbitSettings::default();
     if let Ok(name) = start.extract::<String>() {
         let start = match name.as_str() {
