@@ -286,6 +286,11 @@ pub enum OrbitStart<'a> {
     /// orbit's state; callgrind). A worse prediction costs a map, never accuracy:
     /// convergence is decided by measured residuals only.
     Predicted(&'a [f64]),
+    /// `transient_periods` periods integrated from this state before Newton, as [`Self::Cold`]
+    /// does from the free state: the attractor whose basin holds the state rather than the
+    /// orbit nearest to it, as a quasi-static sweep of `Z` follows it (a neighbouring cell's
+    /// orbit, [`crate::quasi_static`]).
+    AfterTransients(&'a [f64]),
 }
 
 impl<'a> OrbitStart<'a> {
@@ -343,31 +348,35 @@ pub fn steady_orbit_in(
     let mut model = model.clone();
     model.set_separation(Separation::Constant(z_nm))?;
 
-    let (initial, predicted) = match start {
-        OrbitStart::Near(x) => (x.to_vec(), false),
-        OrbitStart::Predicted(x) => (x.to_vec(), true),
-        OrbitStart::Cold => (
-            iterate(
-                &model,
-                &model.free_state(),
-                settings.transient_periods,
-                &settings.integration,
-                workspace,
-            )?,
-            false,
-        ),
+    let free_state = model.free_state();
+    let (given, transients, predicted) = match start {
+        OrbitStart::Near(x) => (x, false, false),
+        OrbitStart::Predicted(x) => (x, false, true),
+        OrbitStart::AfterTransients(x) => (x, true, false),
+        OrbitStart::Cold => (free_state.as_slice(), true, false),
     };
-    if initial.len() != model.dim() || initial.iter().any(|v| !v.is_finite()) {
+    if given.len() != model.dim() || given.iter().any(|v| !v.is_finite()) {
         return Err(AfmError::InvalidField {
             file: String::from("steady orbit"),
             field: String::from("start"),
-            value: format!("{initial:?}"),
+            value: format!("{given:?}"),
             allowed: format!(
                 "a finite state of the model's dimension {} ([q_1, q_1', ..., q_N, q_N'])",
                 model.dim()
             ),
         });
     }
+    let initial = if transients {
+        iterate(
+            &model,
+            given,
+            settings.transient_periods,
+            &settings.integration,
+            workspace,
+        )?
+    } else {
+        given.to_vec()
+    };
 
     let first = shoot_observed(
         &model,
