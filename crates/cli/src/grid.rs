@@ -145,7 +145,7 @@ struct Grid {
 #[derive(Serialize)]
 struct RowRecord<'a> {
     row: usize,
-    parameter: f64,
+    parameter_value: f64,
     first_contact_z_nm: f64,
     cells: Vec<CellRecord<'a>>,
 }
@@ -226,10 +226,21 @@ fn resolve(args: &GridRunArgs) -> Result<Grid> {
     if args.threads == Some(0) {
         bail!("--threads 0: allowed 1 or more");
     }
+    axis.value(&case)
+        .with_context(|| format!("--vary {vary}"))?;
     let parameters = evenly_spaced(from, to, steps);
     for (row, &p) in parameters.iter().enumerate() {
-        let source = format!("--vary {axis} = {p} {} (row {row})", axis.unit());
-        let model = axis.model(&case, p, &source)?;
+        let option = match row {
+            0 => "--from",
+            _ if row == steps - 1 => "--to",
+            _ => "--from/--to",
+        };
+        let model = axis.model(&case, p, option).with_context(|| {
+            format!(
+                "{option}: no valid model at {axis} = {p} {} (row {row})",
+                axis.unit()
+            )
+        })?;
         let lowest = -model.free_amplitude_nm();
         if z_to < lowest {
             bail!(
@@ -268,6 +279,8 @@ fn header_line(args: &GridRunArgs, grid: &Grid) -> Result<String> {
         "parameter": {
             "name": grid.axis.name(),
             "unit": grid.axis.unit(),
+            "from": args.from,
+            "to": args.to,
             "values": grid.parameters,
         },
         "z_nm": grid.separations,
@@ -292,7 +305,7 @@ fn row_line(grid: &Grid, row: usize) -> Result<String> {
         .collect();
     let record = RowRecord {
         row,
-        parameter: p,
+        parameter_value: p,
         first_contact_z_nm: model.grazing_separation_nm(),
         cells,
     };
