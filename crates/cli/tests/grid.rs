@@ -225,6 +225,10 @@ fn merge_refuses_other_grids_and_names_missing_rows() {
     );
 }
 
+/// A bad-input case: options replaced in [`SMALL`] (option, new value), options added, and
+/// the texts the error must contain.
+type BadCase<'a> = (&'a [(&'a str, &'a str)], &'a [&'a str], &'a [&'a str]);
+
 #[test]
 fn bad_options_are_refused_by_name() {
     let directory = tempfile::tempdir().expect("temporary directory");
@@ -244,7 +248,7 @@ fn bad_options_are_refused_by_name() {
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
         failure(&refs)
     };
-    let cases: [(&[(&str, &str)], &[&str], &[&str]); 10] = [
+    let cases: [BadCase; 10] = [
         (
             &[("--vary", "amplitude")],
             &[],
