@@ -14,10 +14,10 @@ use crate::validation::invalid;
 use crate::{AfmError, TappingModel};
 
 /// Two cells hold the same attractor when their `A / A0` differ by at most this (and their
-/// period and impact count agree). Newton converges each orbit to 1e-10 nm in state, which
-/// moves `A / A0` by about 1e-10 / A0; two distinct stable orbits at one `Z` (the MAClever on
-/// mica's bistable range) differ by 1e-4 or more, except within a vanishing distance of the
-/// fold where they meet.
+/// impacts per period agree). Newton converges each orbit to 1e-10 nm in state, which moves
+/// `A / A0` by about 1e-10 / A0; two distinct stable orbits at one `Z` (the MAClever on mica's
+/// bistable range) differ by 1e-4 or more, except within a vanishing distance of the fold
+/// where they meet.
 pub const SAME_ATTRACTOR_AMPLITUDE_RATIO: f64 = 1e-7;
 
 /// The steady orbit one quasi-static sweep settles on at one separation.
@@ -40,11 +40,13 @@ pub struct QuasiStaticCell {
 }
 
 impl QuasiStaticCell {
-    /// Whether `self` and `other` are the same attractor: equal period and impact count and
-    /// `A / A0` within [`SAME_ATTRACTOR_AMPLITUDE_RATIO`].
+    /// Whether `self` and `other` are the same attractor: equal impacts per period and
+    /// `A / A0` within [`SAME_ATTRACTOR_AMPLITUDE_RATIO`]. The period `k` is not compared: the
+    /// recurrence search of [`crate::steady_orbit`] can report a period-1 orbit as a period-2
+    /// one (found on the second iterate of the map: 1e-4 nm below the MAClever on mica's fold),
+    /// the same orbit under another `k`.
     pub fn same_attractor(&self, other: &Self) -> bool {
-        self.multiplicity == other.multiplicity
-            && self.impacts_per_orbit == other.impacts_per_orbit
+        self.impacts_per_period == other.impacts_per_period
             && (self.amplitude_ratio - other.amplitude_ratio).abs()
                 <= SAME_ATTRACTOR_AMPLITUDE_RATIO
     }

@@ -387,3 +387,67 @@ fn the_impact_count_changes_within_one_cell_of_continue_s_grazing_points() {
         );
     }
 }
+
+#[test]
+fn bistable_cells_lie_in_continue_s_bistable_range() {
+    // The MAClever on mica at its own A0 = 20 nm: the fold pair just below first contact,
+    // Z from 20 down to 19.99 nm in 2.5e-4 nm cells.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let output = directory.path().join("map.jsonl");
+    let result = drumroll()
+        .args([
+            "grid",
+            "--case",
+            "maclever-mica",
+            "--vary",
+            "a0",
+            "--from",
+            "20",
+            "--to",
+            "20",
+            "--steps",
+            "1",
+            "--z-from",
+            "20",
+            "--z-to",
+            "19.99",
+            "--z-steps",
+            "41",
+            "--retract",
+            "--output",
+        ])
+        .arg(&output)
+        .output()
+        .expect("runs");
+    assert!(
+        result.status.success(),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    let text = std::fs::read_to_string(&output).expect("map");
+    let row: Value = serde_json::from_str(text.lines().nth(1).expect("row")).expect("JSON");
+    let diagram = json_of(&["continue", "--case", "maclever-mica", "--retract"]);
+    let ranges = diagram["bistable_ranges_nm"].as_array().expect("ranges");
+    assert_eq!(ranges.len(), 1, "{ranges:?}");
+    let bound = |i: usize| ranges[0][i].as_f64().expect("a number");
+    let [low, high] = [bound(0), bound(1)];
+    let cell = 2.5e-4;
+    let mut bistable = 0;
+    for c in row["cells"].as_array().expect("cells") {
+        let z = number(c, "z_nm");
+        let flagged = c["bistable"] == true;
+        if flagged {
+            bistable += 1;
+            assert!(
+                low - cell <= z && z <= high + cell,
+                "bistable at {z}, outside [{low}, {high}]"
+            );
+        } else {
+            assert!(
+                !(low + cell <= z && z <= high - cell),
+                "not bistable at {z}, inside [{low}, {high}]"
+            );
+        }
+    }
+    assert!(bistable >= 5, "{bistable} bistable cells");
+}
