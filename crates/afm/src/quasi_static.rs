@@ -42,7 +42,7 @@ pub struct QuasiStaticCell {
 impl QuasiStaticCell {
     /// Whether `self` and `other` are the same attractor: equal impacts per period and
     /// `A / A0` within [`SAME_ATTRACTOR_AMPLITUDE_RATIO`]. The period `k` is not compared: the
-    /// recurrence search of [`crate::steady_orbit`] can report a period-1 orbit as a period-2
+    /// recurrence search of [`crate::steady_orbit()`] can report a period-1 orbit as a period-2
     /// one (found on the second iterate of the map: 1e-4 nm below the MAClever on mica's fold),
     /// the same orbit under another `k`.
     pub fn same_attractor(&self, other: &Self) -> bool {
