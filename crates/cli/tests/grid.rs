@@ -451,3 +451,85 @@ fn bistable_cells_lie_in_continue_s_bistable_range() {
     }
     assert!(bistable >= 5, "{bistable} bistable cells");
 }
+
+#[test]
+fn a_run_killed_mid_row_resumes_into_the_same_map() {
+    // 12 rows of 200 cells (about 70 ms each on one thread), killed (SIGKILL) once 3 rows
+    // are in its work file, then run again to the end.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let at = |name: &str| directory.path().join(name);
+    let options = [
+        "grid",
+        "--case",
+        "biolever-mica",
+        "--vary",
+        "tip-radius",
+        "--from",
+        "10",
+        "--to",
+        "40",
+        "--steps",
+        "12",
+        "--z-from",
+        "12",
+        "--z-to",
+        "1",
+        "--z-steps",
+        "200",
+        "--threads",
+        "1",
+        "--output",
+    ];
+    let killed = at("killed.jsonl");
+    let work = at("killed.jsonl.part");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_drumroll"))
+        .args(options)
+        .arg(&killed)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("starts");
+    let start = std::time::Instant::now();
+    while std::fs::read(&work).map_or(0, |b| b.iter().filter(|&&c| c == b'\n').count()) < 4 {
+        assert!(start.elapsed().as_secs() < 60, "no rows written");
+        assert!(
+            child.try_wait().expect("status").is_none(),
+            "finished before the kill"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().expect("kill");
+    child.wait().expect("reaped");
+    assert!(!killed.exists(), "no map file from a killed run");
+    let rows_done = String::from_utf8(read(&work))
+        .expect("utf-8")
+        .matches('\n')
+        .count()
+        - 1;
+    assert!((3..12).contains(&rows_done), "{rows_done} rows at the kill");
+
+    let rerun = drumroll()
+        .args(options)
+        .arg(&killed)
+        .output()
+        .expect("runs");
+    assert!(
+        rerun.status.success(),
+        "{}",
+        String::from_utf8_lossy(&rerun.stderr)
+    );
+    assert!(
+        !work.exists(),
+        "the work file is removed once the map is written"
+    );
+    let fresh = drumroll()
+        .args(options)
+        .arg(at("fresh.jsonl"))
+        .output()
+        .expect("runs");
+    assert!(fresh.status.success());
+    assert_eq!(
+        read(&killed),
+        read(&at("fresh.jsonl")),
+        "resumed != uninterrupted"
+    );
+}
