@@ -53,8 +53,8 @@ fi
 (cd "$repo" && cargo build --release -p drumroll)
 export DRUMROLL="${CARGO_TARGET_DIR:-$repo/target}/release/drumroll"
 
-# MUNGE: a key of this test's own, and a daemon on a socket of its own (munged runs as user
-# munge, which must reach its directory).
+# MUNGE: a key of this test's own, and a daemon on a socket of its own, run as user munge
+# (setpriv execs it: the PID started is the daemon's own).
 chmod 755 "$work"
 # The key's directory is private, the socket's open to every user.
 mkdir -p "$work/munge" "$work/munge-socket"
@@ -64,7 +64,8 @@ chmod 700 "$work/munge"
 chmod 755 "$work/munge-socket"
 chmod 400 "$work/munge/munge.key"
 socket="$work/munge-socket/munge.socket"
-runuser -u munge -- munged --foreground --key-file="$work/munge/munge.key" \
+setpriv --reuid=munge --regid=munge --init-groups \
+    munged --foreground --key-file="$work/munge/munge.key" \
     --socket="$socket" --pid-file="$work/munge/munged.pid" \
     --log-file="$work/munge/munged.log" --seed-file="$work/munge/munged.seed" \
     >"$work/munged.stderr.log" 2>&1 &
