@@ -77,7 +77,8 @@ pub struct GridRunArgs {
     /// one row needs --from = --to.
     #[arg(long, required = true)]
     pub steps: Option<usize>,
-    /// The highest separation, where each row's approach starts, nm.
+    /// The highest separation, where each row's approach starts from the free orbit, nm
+    /// (above every row's first contact Z_G1 for an approach from free oscillation).
     #[arg(long, required = true, allow_negative_numbers = true)]
     pub z_from: Option<f64>,
     /// The lowest separation, where the approach ends, nm (at least -A0 of every row).
