@@ -37,7 +37,9 @@ mod modal_constants;
 pub mod model;
 pub mod observables;
 pub mod orbit_prediction;
+pub mod parameter_axis;
 pub mod phase;
+pub mod quasi_static;
 pub mod sample;
 pub mod separation;
 pub mod steady_orbit;
@@ -71,6 +73,8 @@ pub use observables::{
     GapMinimumKind, Harmonic, Impact, OrbitObservables, PeriodObserver, NEAR_IMPACT_FRACTION,
 };
 pub use orbit_prediction::{hermite_state, tangent_state};
+pub use parameter_axis::{ParameterAxis, PARAMETER_NAMES};
+pub use quasi_static::{quasi_static_row, QuasiStaticCell, QuasiStaticRow};
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{

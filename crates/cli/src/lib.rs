@@ -6,6 +6,8 @@ pub mod approach;
 pub mod cantilever;
 pub mod continue_diagram;
 pub mod digits;
+pub mod grid;
+pub mod grid_file;
 pub mod inputs;
 pub mod model_args;
 pub mod output;

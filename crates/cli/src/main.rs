@@ -26,6 +26,10 @@ enum Command {
     /// The paper's approximate theory (Eqs. 3-4, lambda_1..3, the ring-down criterion) beside
     /// the same quantities measured on the simulated steady orbit at one Z or A/A0.
     Theory(drumroll::theory::TheoryArgs),
+    /// The brute-force regime map: for each value of a parameter (a row), a quasi-static
+    /// approach (and retract) in Z by transients, each cell's impacts per period, period, A/A0
+    /// and phase; shardable (`--shard I/N`, then `grid merge`) and resumable.
+    Grid(drumroll::grid::GridArgs),
     /// The Euler-Bernoulli modal table of a cantilever with a point tip mass, and a cantilever
     /// file built from measured k_1, frequencies and quality factors.
     Cantilever(drumroll::cantilever::CantileverArgs),
@@ -38,6 +42,7 @@ fn main() -> ExitCode {
         Command::Continue(args) => drumroll::continue_diagram::run(args),
         Command::Approach(args) => drumroll::approach::run(args),
         Command::Theory(args) => drumroll::theory::run(args),
+        Command::Grid(args) => drumroll::grid::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),
     };
     match result {
