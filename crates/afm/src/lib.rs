@@ -78,7 +78,7 @@ pub use steady_orbit::{
 };
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
 pub use theory::{
-    compare_theory, measure_impacts, ImpactImpulse, ImpactMeasurement, ImpactPrediction,
-    ImpactTheory, Ringing, TheoryComparison,
+    compare_theory, measure_impacts, AssumptionFailure, ImpactImpulse, ImpactMeasurement,
+    ImpactPrediction, ImpactTheory, Ringing, TheoryComparison,
 };
 pub use trajectory::{sample_trajectory, TrajectorySample};

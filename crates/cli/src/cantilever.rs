@@ -397,8 +397,10 @@ fn build(
     Ok((cantilever, sources))
 }
 
-/// The JSON of `drumroll cantilever --json`: `{"modes": [...]}` with every table ratio, plus
-/// the built values per mode and the whole cantilever when one is built.
+/// The JSON of `drumroll cantilever --json` (docs/output-schema.md): `{"modes": [...]}` with
+/// every table ratio (the optical sensitivity `chi_n` under the cantilever file's name,
+/// `optical_sensitivity`), plus the built values per mode and the whole cantilever when one is
+/// built, and the `inputs` it was computed from.
 fn table_json(
     args: &CantileverArgs,
     table: &[ModalProperties],
@@ -414,7 +416,7 @@ fn table_json(
                 "eigenvalue": mode.eigenvalue,
                 "frequency_ratio": mode.frequency_ratio,
                 "stiffness_ratio": mode.stiffness_ratio,
-                "chi": mode.chi,
+                "optical_sensitivity": mode.chi,
                 "force_ratio_distributed": mode.force_ratio_distributed,
                 "force_ratio_tip": mode.force_ratio_tip,
             });
@@ -427,16 +429,27 @@ fn table_json(
                 map.insert("frequency_khz".into(), eigenmode.frequency_khz.into());
                 map.insert("frequency_source".into(), sources[index].name().into());
                 map.insert("quality_factor".into(), eigenmode.quality_factor.into());
-                map.insert(
-                    "optical_sensitivity".into(),
-                    eigenmode.optical_sensitivity.into(),
-                );
                 map.insert("force_ratio".into(), eigenmode.force_ratio.into());
             }
             entry
         })
         .collect();
     let mut value = json!({
+        "inputs": {
+            "drumroll_version": env!("CARGO_PKG_VERSION"),
+            "command": "cantilever",
+            "options": {
+                "tip_mass_ratio": args.tip_mass_ratio,
+                "modes": args.modes,
+                "drive": args.drive.name(),
+                "k1_n_per_m": args.k1,
+                "frequencies_khz": args.frequency_inputs().ok(),
+                "quality_factors": args.quality_inputs().ok(),
+                "radius_nm": args.radius,
+                "name": args.name,
+                "out": out.map(|path| path.display().to_string()),
+            },
+        },
         "tip_mass_ratio": args.tip_mass_ratio,
         "drive": args.drive.name(),
         "frequency_ratios": "in vacuum (liquid loading changes them)",
