@@ -44,7 +44,7 @@ pub mod sweep;
 pub mod theory;
 pub mod trajectory;
 pub mod trigonometric;
-mod validation;
+pub mod validation;
 
 pub use amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
 pub use bifurcation_diagram::{

@@ -208,7 +208,7 @@ fn other_range_violations() {
     );
     let message = afm::load_case(&path).expect_err("A0 < 0").to_string();
     assert!(
-        message.contains("free_amplitude_nm") && message.contains("(0, 100000] nm"),
+        message.contains("free_amplitude_nm") && message.contains("[0.001, 100000] nm"),
         "{message}"
     );
     let path = write(

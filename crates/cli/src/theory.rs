@@ -24,10 +24,11 @@ pub struct TheoryArgs {
     /// The cantilever, sample and drive.
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Compare at this separation Z between the cantilever base and the sample, nm.
+    /// Compare at this separation Z between the cantilever base and the sample, nm, in
+    /// [-A0, 100000] nm (at Z <= 0 the theory gives no prediction: the tip rests in the sample).
     #[arg(long, allow_hyphen_values = true, conflicts_with = "amplitude_ratio")]
     pub z: Option<f64>,
-    /// Compare at the Z where the approach from first contact reaches this A/A0 (0 < R < 1);
+    /// Compare at the Z where the approach from first contact reaches this A/A0, in (0, 1);
     /// default 0.95 (the paper's single-impact example, Fig. 1(a)) when --z is not given.
     #[arg(long, allow_negative_numbers = true)]
     pub amplitude_ratio: Option<f64>,
@@ -38,6 +39,7 @@ pub struct TheoryArgs {
 
 /// Run `drumroll theory`.
 pub fn run(args: &TheoryArgs) -> Result<()> {
+    crate::simulate::check_orbit_options(args.z, args.amplitude_ratio)?;
     let (case, model) = args.model.model()?;
     let settings = SteadyOrbitSettings::default();
     let orbit = orbit(args, &model, &settings)?;
@@ -75,9 +77,7 @@ fn orbit(
 ) -> Result<SteadyOrbit> {
     match (args.z, args.amplitude_ratio) {
         (Some(z), None) => {
-            if !z.is_finite() {
-                bail!("--z {z}: the separation must be a finite number of nm");
-            }
+            crate::option_ranges::separation_for(model.free_amplitude_nm()).check(z)?;
             steady_orbit(model, z, OrbitStart::Cold, settings)
                 .with_context(|| format!("no steady orbit at Z = {z} nm"))
         }

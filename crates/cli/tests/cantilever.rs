@@ -197,7 +197,7 @@ fn bad_input_is_refused_with_a_message_naming_it() {
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             [&base[..], &["--q1", "1.6"]].concat(),
-            "missing quality factor(s) --q2",
+            "to build a cantilever, missing: --q2 (",
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "4", "--q3", "5"]].concat(),
@@ -205,7 +205,7 @@ fn bad_input_is_refused_with_a_message_naming_it() {
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "-4"]].concat(),
-            "--q2 -4: must be in (0, 1000000]",
+            "--q2 -4: allowed [0.001, 1000000]",
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "4", "--f2", "3"]].concat(),
@@ -217,19 +217,19 @@ fn bad_input_is_refused_with_a_message_naming_it() {
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "0", "--k1", "-1"],
-            "--k1 -1: must be in (0, 1000000] N/m",
+            "--k1 -1: allowed [1e-6, 1000000] N/m",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "0", "--radius", "30"],
-            "to build a cantilever give --k1",
+            "to build a cantilever, missing: --k1 (N/m), --f1 (kHz), --q1, --q2 (",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "-0.1"],
-            "tip_mass_ratio",
+            "--tip-mass-ratio -0.1: allowed [0, 1000]",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "0", "--modes", "51"],
-            "must be in 1..=50",
+            "--modes 51: allowed [1, 50]",
         ),
     ];
     for (args, message) in cases {

@@ -153,11 +153,11 @@ fn bad_input_is_refused_with_a_message_naming_it() {
                 "--amplitude-ratio",
                 "1.5",
             ],
-            "0 < R < 1",
+            "--amplitude-ratio 1.5: allowed (0, 1)",
         ),
         (
             &["theory", "--case", "biolever-mica", "--z", "NaN"],
-            "finite",
+            "--z NaN: allowed [-100000, 100000] nm",
         ),
         (
             &[
