@@ -139,18 +139,19 @@ impl Interval {
                 let typed = format_number(value);
                 format!(
                     "{typed} looks like a value in {name}: {typed} {name} = {} {}",
-                    format_number(value_scaled(value, *factor)),
+                    format_number(value * factor),
                     self.unit
                 )
             })
     }
 }
 
-/// A number as a user would type it: plain decimals from 1e-4 to 1e7 (`0.001`, `3500`),
+/// A number as a user would type it: plain decimals from 1e-4 to 1e9 (`0.001`, `3500`),
 /// exponent notation beyond (`1e-8`, `2e-14`), the shortest form that reads back exactly.
 pub fn format_number(value: f64) -> String {
+    let value = round_to_significant(value);
     let magnitude = value.abs();
-    if value == 0.0 || !value.is_finite() || (1e-4..1e7).contains(&magnitude) {
+    if value == 0.0 || !value.is_finite() || (1e-4..1e9).contains(&magnitude) {
         value.to_string()
     } else {
         format!("{value:e}")
@@ -280,12 +281,11 @@ pub(crate) fn invalid(file: &str, field: &str, value: f64, allowed: String) -> A
     }
 }
 
-/// `value * factor`, rounded to 12 significant digits so that a unit conversion reads cleanly
-/// (`2e-8 * 1e9` prints as `20`, not `20.000000000000004`).
-fn value_scaled(value: f64, factor: f64) -> f64 {
-    let scaled = value * factor;
-    if scaled == 0.0 || !scaled.is_finite() {
-        return scaled;
+/// `value` rounded to 12 significant digits, so that a product reads cleanly (`2e-8 * 1e9`
+/// prints as `20`, not `20.000000000000004`; `0.01 * 9.3` as `0.093`).
+fn round_to_significant(value: f64) -> f64 {
+    if value == 0.0 || !value.is_finite() {
+        return value;
     }
-    format!("{scaled:.11e}").parse().unwrap_or(scaled)
+    format!("{value:.11e}").parse().unwrap_or(value)
 }

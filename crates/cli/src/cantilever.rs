@@ -63,7 +63,7 @@ pub struct CantileverArgs {
     #[arg(long, default_value_t = 2, allow_negative_numbers = true)]
     pub modes: i64,
     /// Measured stiffness of the first mode k_1, N/m (e.g. by Sader's method), in
-    /// [0.000001, 1000000] N/m (typical 0.001 to 1000 N/m).
+    /// [1e-6, 1000000] N/m (typical 0.001 to 1000 N/m).
     #[arg(long, allow_negative_numbers = true)]
     pub k1: Option<f64>,
     /// Measured natural frequency of mode 1 (in liquid), kHz. Every frequency is in

@@ -43,7 +43,8 @@ impl ModelArgs {
             option_ranges::A0.check(a0)?;
         }
         if let Some(frequency) = self.drive_frequency {
-            option_ranges::DRIVE_FREQUENCY.check(frequency)?;
+            // The warning, if any, comes with the cantilever's range below.
+            option_ranges::DRIVE_FREQUENCY.warning(frequency)?;
         }
         let mut case = match (&self.case, &self.cantilever, &self.sample) {
             (Some(name), None, None) => {
@@ -83,7 +84,7 @@ impl ModelArgs {
             case.free_amplitude_nm = a0;
         }
         if let Some(frequency) = self.drive_frequency {
-            option_ranges::drive_frequency_for(&case.cantilever).warning(frequency)?;
+            option_ranges::drive_frequency_for(&case.cantilever).check(frequency)?;
             case.drive_frequency_khz = Some(frequency);
             if let Some(warning) = case.drive_warning() {
                 eprintln!("drumroll: warning: --drive-frequency {warning}");
