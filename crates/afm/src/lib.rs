@@ -32,6 +32,7 @@ pub mod free_response;
 pub mod gauss_legendre;
 pub mod hertz;
 pub mod impact_numbers;
+mod json_path;
 pub mod lockin;
 pub mod model;
 pub mod observables;

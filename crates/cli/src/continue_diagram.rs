@@ -60,8 +60,9 @@ pub struct ContinueArgs {
 
 /// Run `drumroll continue`.
 pub fn run(args: &ContinueArgs) -> Result<()> {
+    // The options that need no model, checked before the output paths and the model.
     option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
-    let max_points = option_ranges::MAX_POINTS.count(args.max_points)?;
+    option_ranges::MAX_POINTS.count(args.max_points)?;
     let csv_path = args
         .csv
         .as_ref()
@@ -73,22 +74,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
     let (case, model) = args.model.model()?;
-    let mut settings = DiagramSettings::approach(&model);
-    let a0 = model.free_amplitude_nm();
-    if let Some(floor) = args.floor {
-        OptionRange::new(
-            "--floor",
-            Interval::right_open(-a0, model.grazing_separation_nm(), "nm"),
-        )
-        .check(floor)?;
-        settings.z_limit_nm = floor;
-    }
-    settings.min_amplitude_ratio = args.min_amplitude_ratio;
-    if let Some(step) = args.max_step {
-        OptionRange::new("--max-step", Interval::positive(a0, "nm")).check(step)?;
-        settings.max_step = step;
-    }
-    settings.max_points = max_points;
+    let settings = diagram_settings(args, &model)?;
     let approach = approach_diagram(&model, &settings)
         .with_context(|| format!("continuation of case `{}` failed", case.name))?;
     let retract = if args.retract {
@@ -210,6 +196,29 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         return Err(Incomplete(format!("{}{hint}", unfinished.join("; "))).into());
     }
     Ok(())
+}
+
+/// The approach's settings for `model` from `args`, every option checked against
+/// [`crate::option_ranges`] (`--floor` in `[-A0, Z_G1)`, `--max-step` in `(0, A0]`).
+pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<DiagramSettings> {
+    option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
+    let mut settings = DiagramSettings::approach(model);
+    let a0 = model.free_amplitude_nm();
+    if let Some(floor) = args.floor {
+        OptionRange::new(
+            "--floor",
+            Interval::right_open(-a0, model.grazing_separation_nm(), "nm"),
+        )
+        .check(floor)?;
+        settings.z_limit_nm = floor;
+    }
+    settings.min_amplitude_ratio = args.min_amplitude_ratio;
+    if let Some(step) = args.max_step {
+        OptionRange::new("--max-step", Interval::positive(a0, "nm")).check(step)?;
+        settings.max_step = step;
+    }
+    settings.max_points = option_ranges::MAX_POINTS.count(args.max_points)?;
+    Ok(settings)
 }
 
 /// The readable table of special points of one diagram.

@@ -130,7 +130,7 @@ pub fn output_path(path: &Path, extension: &str, option: &str) -> Result<PathBuf
             Ok(path.to_path_buf())
         }
         _ => bail!(
-            "{option} {}: the file name must end in .{extension}",
+            "{option} {}: allowed: a file name ending in .{extension}",
             path.display()
         ),
     }

@@ -213,7 +213,7 @@ fn bad_input_is_refused_with_a_message_naming_it() {
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "4", "--out", &text_out]].concat(),
-            "must end in .json",
+            "allowed: a file name ending in .json",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "0", "--k1", "-1"],
