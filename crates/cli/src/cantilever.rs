@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use crate::model_args::output_path;
 use crate::option_ranges::{self, check_option};
-use crate::output::write_atomically;
+use crate::output::{print_stdout, write_atomically};
 
 /// Modes whose frequency and quality factor have their own option (`--f1 .. --f4`,
 /// `--q1 .. --q4`); more modes take the `--frequencies` and `--quality-factors` lists.
@@ -237,17 +237,10 @@ pub fn run(args: &CantileverArgs) -> Result<()> {
         })?;
     }
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&table_json(
-                args,
-                &table,
-                built.as_ref(),
-                out.as_deref()
-            ))?
-        );
+        let json = table_json(args, &table, built.as_ref(), out.as_deref());
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(&json)?))?;
     } else {
-        print!("{}", summary(args, &table, built.as_ref(), out.as_deref()));
+        print_stdout(&summary(args, &table, built.as_ref(), out.as_deref()))?;
     }
     Ok(())
 }
@@ -286,23 +279,7 @@ fn build(
             )?;
         }
     }
-    let mut missing: Vec<String> = Vec::new();
-    if args.k1.is_none() {
-        missing.push(String::from("--k1 (N/m)"));
-    }
-    if frequencies.first().copied().flatten().is_none() {
-        missing.push(String::from("--f1 (kHz)"));
-    }
-    if args.radius.is_none() {
-        missing.push(String::from("--radius (nm)"));
-    }
-    missing.extend(
-        qualities
-            .iter()
-            .enumerate()
-            .filter(|(_, q)| q.is_none())
-            .map(|(index, _)| format!("--q{}", index + 1)),
-    );
+    let missing = missing_options(args, &frequencies, &qualities);
     let (Some(k1), Some(Some(f1)), Some(radius), true) = (
         args.k1,
         frequencies.first(),
@@ -391,6 +368,33 @@ fn build(
         .validate("the built cantilever")
         .context("the built cantilever is not valid")?;
     Ok((cantilever, sources))
+}
+
+/// The options a build needs that are not given: `--k1`, `--f1`, `--radius` and a quality
+/// factor for every mode.
+fn missing_options(
+    args: &CantileverArgs,
+    frequencies: &[Option<f64>],
+    qualities: &[Option<f64>],
+) -> Vec<String> {
+    let mut missing: Vec<String> = Vec::new();
+    if args.k1.is_none() {
+        missing.push(String::from("--k1 (N/m)"));
+    }
+    if frequencies.first().copied().flatten().is_none() {
+        missing.push(String::from("--f1 (kHz)"));
+    }
+    if args.radius.is_none() {
+        missing.push(String::from("--radius (nm)"));
+    }
+    missing.extend(
+        qualities
+            .iter()
+            .enumerate()
+            .filter(|(_, q)| q.is_none())
+            .map(|(index, _)| format!("--q{}", index + 1)),
+    );
+    missing
 }
 
 /// The JSON of `drumroll cantilever --json` (docs/output-schema.md): `{"modes": [...]}` with

@@ -16,7 +16,7 @@ use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
 use crate::option_ranges::{self, OptionRange};
-use crate::output::write_atomically;
+use crate::output::{print_stdout, write_atomically};
 use crate::plot::{render_svg, Marker, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 
 /// Options of `drumroll continue`.
@@ -131,20 +131,20 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             });
             object["bistable_ranges_nm"] = json!(bistable);
         }
-        println!("{}", serde_json::to_string(&object)?);
+        print_stdout(&format!("{}\n", serde_json::to_string(&object)?))?;
     } else {
-        print!("{}", table(&case.name, &model, "approach", &approach));
+        print_stdout(&table(&case.name, &model, "approach", &approach))?;
         if let Some(retract) = &retract {
-            print!("{}", table(&case.name, &model, "retract", retract));
+            print_stdout(&table(&case.name, &model, "retract", retract))?;
             match bistable.as_deref() {
-                Some([]) | None => {
-                    println!("no bistable range: approach and retract follow one stable orbit")
-                }
+                Some([]) | None => print_stdout(
+                    "no bistable range: approach and retract follow one stable orbit\n",
+                )?,
                 Some(ranges) => {
                     for [low, high] in ranges {
-                        println!(
-                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)"
-                        );
+                        print_stdout(&format!(
+                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)\n"
+                        ))?;
                     }
                 }
             }
@@ -170,8 +170,18 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         )?;
         write_atomically(&path, svg.as_bytes())?;
     }
-    let unfinished: Vec<String> = std::iter::once(("approach", &approach))
-        .chain(retract.as_ref().map(|retract| ("retract", retract)))
+    reached_end(&approach, retract.as_ref(), settings.max_points)
+}
+
+/// `Ok` when every branch reached its requested end, else the [`Incomplete`] error that says
+/// which did not and why (`main` exits with status 3).
+fn reached_end(
+    approach: &BifurcationDiagram,
+    retract: Option<&BifurcationDiagram>,
+    max_points: usize,
+) -> Result<()> {
+    let unfinished: Vec<String> = std::iter::once(("approach", approach))
+        .chain(retract.map(|retract| ("retract", retract)))
         .filter(|(_, diagram)| !diagram.completed)
         .map(|(direction, diagram)| {
             let error = diagram
@@ -186,10 +196,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             .iter()
             .any(|u| u.contains("maximum number of points"))
         {
-            format!(
-                "; raise --max-points (now {}) or --max-step",
-                settings.max_points
-            )
+            format!("; raise --max-points (now {}) or --max-step", max_points)
         } else {
             String::new()
         };

@@ -41,6 +41,21 @@ pub fn check_writable(path: &Path, option: &str) -> Result<()> {
     Ok(())
 }
 
+/// Print `text` on standard output; a reader that closed the pipe (`drumroll ... | head`)
+/// ends the output quietly instead of a panic.
+pub fn print_stdout(text: &str) -> Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Err(error) if error.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(error).context("cannot write to standard output")
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Write `content` to `path` atomically: into `path` + a temporary suffix in the same
 /// directory, flushed and synced, then renamed to `path`. On any error the temporary file is
 /// removed and the target is left as it was.

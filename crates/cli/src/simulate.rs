@@ -14,7 +14,7 @@ use crate::digits;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
 use crate::option_ranges;
-use crate::output::write_atomically;
+use crate::output::{print_stdout, write_atomically};
 use crate::plot::render_svg;
 use crate::trajectory_plot::trajectory_panels;
 
@@ -72,16 +72,16 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         let mut object = orbit_json(&case.name, &model, &orbit);
         let options = json!({ "z_nm": args.z, "amplitude_ratio": args.amplitude_ratio });
         object["inputs"] = orbit_inputs_json("simulate", options, &case, &model, &settings);
-        println!("{}", serde_json::to_string_pretty(&object)?);
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;
     } else {
-        print!("{}", summary(&case.name, &model, &orbit));
+        print_stdout(&summary(&case.name, &model, &orbit))?;
     }
     if let Some(path) = plot_path {
         let panels = trajectory_panels(&model, &orbit, 2)?;
         let svg = render_svg(&panels, 2, 1, (800, 320))?;
         write_atomically(&path, svg.as_bytes())?;
         if !args.json {
-            println!("figure: {}", path.display());
+            print_stdout(&format!("figure: {}\n", path.display()))?;
         }
     }
     Ok(())

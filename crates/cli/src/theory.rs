@@ -13,6 +13,7 @@ use std::fmt::Write as _;
 
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::ModelArgs;
+use crate::output::print_stdout;
 
 /// The amplitude ratio used when neither `--z` nor `--amplitude-ratio` is given: the paper's
 /// single-impact example (its Fig. 1(a)).
@@ -63,9 +64,9 @@ pub fn run(args: &TheoryArgs) -> Result<()> {
         let mut object = comparison_json(&case.name, &model, &comparison);
         let options = json!({ "z_nm": args.z, "amplitude_ratio": args.amplitude_ratio });
         object["inputs"] = orbit_inputs_json("theory", options, &case, &model, &settings);
-        println!("{}", serde_json::to_string_pretty(&object)?);
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;
     } else {
-        print!("{}", summary(&case.name, &model, &comparison));
+        print_stdout(&summary(&case.name, &model, &comparison))?;
     }
     Ok(())
 }
@@ -177,10 +178,60 @@ fn optional(value: Option<f64>, format: &dyn Fn(f64) -> String) -> String {
     value.map_or_else(|| String::from("-"), format)
 }
 
+/// The four rows theory / simulated / relative error of the table (`-` where a value is
+/// withheld or undefined).
+fn comparison_rows(s: &mut String, comparison: &TheoryComparison) {
+    let (p, m) = (comparison.prediction, &comparison.measurement);
+    let ringing = m.ringing;
+    let six = |v: f64| format!("{v:.6}");
+    let four_e = |v: f64| format!("{v:.4e}");
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16.6}{:>12}",
+        "impulse per period (Eq. 3), nN us",
+        optional(p.map(|p| p.impulse_nn_us), &six),
+        m.impulse_nn_us,
+        relative(comparison.impulse_relative_error)
+    );
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16}{:>12}",
+        "q_2 initial amplitude (Eq. 4), nm",
+        optional(p.map(|p| p.q2_initial_amplitude_nm), &six),
+        optional(ringing.map(|r| r.initial_amplitude_nm), &six),
+        relative(comparison.q2_initial_amplitude_relative_error)
+    );
+    let decay_time = ringing.and_then(|r| r.effective_decay_time_us);
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16}{:>12}",
+        "q_2 decay time tau (Eq. 4), us",
+        optional(p.map(|p| p.q2_decay_time_us), &six),
+        optional(decay_time, &six),
+        relative(
+            p.zip(decay_time)
+                .map(|(p, measured)| p.q2_decay_time_us / measured - 1.0)
+        )
+    );
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16}{:>12}",
+        "q_2 decay over one period (Eq. 4)",
+        optional(p.map(|p| p.q2_decay_over_period), &four_e),
+        optional(ringing.map(|r| r.decay_over_period), &four_e),
+        relative(comparison.q2_decay_over_period_relative_error)
+    );
+    if p.is_none() {
+        let _ = writeln!(
+            s,
+            "(-: no prediction, the theory's assumptions fail on this orbit; see the warnings)"
+        );
+    }
+}
+
 /// The readable table of `drumroll theory`.
 pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) -> String {
     let theory = &comparison.theory;
-    let p = comparison.prediction;
     let m = &comparison.measurement;
     let mut s = String::new();
     let _ = writeln!(
@@ -240,51 +291,8 @@ pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) 
         "{:<34}{:>16}{:>16}{:>12}",
         "quantity", "theory", "simulated", "error"
     );
+    comparison_rows(&mut s, comparison);
     let ringing = m.ringing;
-    let six = |v: f64| format!("{v:.6}");
-    let four_e = |v: f64| format!("{v:.4e}");
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16}{:>16.6}{:>12}",
-        "impulse per period (Eq. 3), nN us",
-        optional(p.map(|p| p.impulse_nn_us), &six),
-        m.impulse_nn_us,
-        relative(comparison.impulse_relative_error)
-    );
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16}{:>16}{:>12}",
-        "q_2 initial amplitude (Eq. 4), nm",
-        optional(p.map(|p| p.q2_initial_amplitude_nm), &six),
-        optional(ringing.map(|r| r.initial_amplitude_nm), &six),
-        relative(comparison.q2_initial_amplitude_relative_error)
-    );
-    let decay_time = ringing.and_then(|r| r.effective_decay_time_us);
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16}{:>16}{:>12}",
-        "q_2 decay time tau (Eq. 4), us",
-        optional(p.map(|p| p.q2_decay_time_us), &six),
-        optional(decay_time, &six),
-        relative(
-            p.zip(decay_time)
-                .map(|(p, measured)| p.q2_decay_time_us / measured - 1.0)
-        )
-    );
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16}{:>16}{:>12}",
-        "q_2 decay over one period (Eq. 4)",
-        optional(p.map(|p| p.q2_decay_over_period), &four_e),
-        optional(ringing.map(|r| r.decay_over_period), &four_e),
-        relative(comparison.q2_decay_over_period_relative_error)
-    );
-    if p.is_none() {
-        let _ = writeln!(
-            s,
-            "(-: no prediction, the theory's assumptions fail on this orbit; see the warnings)"
-        );
-    }
     if let Some(from_u) = comparison.prediction_from_u_phase {
         let _ = writeln!(
             s,

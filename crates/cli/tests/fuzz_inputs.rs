@@ -358,16 +358,19 @@ fn chain(error: &anyhow::Error) -> String {
 }
 
 /// A rejection must name where (an option, or a file or built-in name), what (a field or an
-/// option) and what is allowed (a range, the expected type or fields, or the known names).
+/// option; for a JSON syntax error, its line and column) and what is allowed (a range, the
+/// expected type or fields, or the known names).
 fn check_rejection(message: &str, sources: &[&str]) -> Result<(), TestCaseError> {
     let names_option = message.contains("--");
     let names_source = names_option || sources.iter().any(|source| message.contains(source));
+    // A syntax error is in no field: its line and column locate it.
+    let syntax = message.contains(" at line ") && message.contains(" column ");
     let names_field = names_option
+        || syntax
         || message.contains("field `")
         || message.contains("unknown ")
         || message.contains("cannot read")
         || message.contains("cannot write there");
-    let syntax = message.contains(" at line ") && message.contains(" column ");
     let names_range = message.contains("allowed")
         || message.contains("expected")
         || message.contains("built-in")
@@ -412,6 +415,44 @@ fn capped_orbit_settings() -> SteadyOrbitSettings {
     settings
 }
 
+/// The words of `drumroll simulate` for `input` (files at `lever`, `surface`, `case`, plot
+/// at `plot`), and the model's options alone (for `continue`).
+fn command_words(
+    input: &Input,
+    lever: &str,
+    surface: &str,
+    case: &str,
+    plot: &str,
+) -> (Vec<String>, Vec<String>) {
+    let mut words: Vec<String> = vec![String::from("simulate")];
+    let push = |words: &mut Vec<String>, option: &str, value: &Option<String>| {
+        if let Some(value) = value {
+            words.push(format!("--{option}={value}"));
+        }
+    };
+    match input.model_choice {
+        0 => push(&mut words, "case", &Some(case.to_string())),
+        1 => {
+            push(&mut words, "cantilever", &Some(lever.to_string()));
+            push(&mut words, "sample", &Some(surface.to_string()));
+            let a0 = input.a0.clone().unwrap_or_else(|| "10".into());
+            push(&mut words, "a0", &Some(a0));
+        }
+        _ => push(&mut words, "case", &Some(String::from("biolever-mica"))),
+    }
+    if input.model_choice != 1 {
+        push(&mut words, "a0", &input.a0);
+    }
+    push(&mut words, "drive-frequency", &input.drive_frequency);
+    let model_words = words[1..].to_vec();
+    match &input.amplitude_ratio {
+        Some(ratio) => push(&mut words, "amplitude-ratio", &Some(ratio.clone())),
+        None => push(&mut words, "z", &Some(input.z.clone())),
+    }
+    push(&mut words, "plot", &Some(plot.to_string()));
+    (words, model_words)
+}
+
 /// Push one input through parsing, checks, model, a short orbit and diagram, and an output.
 fn run_one(input: &Input, dir: &Path, tally: &mut Tally) -> Result<(), TestCaseError> {
     let started = Instant::now();
@@ -435,32 +476,7 @@ fn run_one(input: &Input, dir: &Path, tally: &mut Tally) -> Result<(), TestCaseE
     .display()
     .to_string();
 
-    let mut words: Vec<String> = vec![String::from("simulate")];
-    let push = |words: &mut Vec<String>, option: &str, value: &Option<String>| {
-        if let Some(value) = value {
-            words.push(format!("--{option}={value}"));
-        }
-    };
-    match input.model_choice {
-        0 => push(&mut words, "case", &Some(case.clone())),
-        1 => {
-            push(&mut words, "cantilever", &Some(lever.clone()));
-            push(&mut words, "sample", &Some(surface.clone()));
-            let a0 = input.a0.clone().unwrap_or_else(|| "10".into());
-            push(&mut words, "a0", &Some(a0));
-        }
-        _ => push(&mut words, "case", &Some(String::from("biolever-mica"))),
-    }
-    if input.model_choice != 1 {
-        push(&mut words, "a0", &input.a0);
-    }
-    push(&mut words, "drive-frequency", &input.drive_frequency);
-    let model_words = words[1..].to_vec();
-    match &input.amplitude_ratio {
-        Some(ratio) => push(&mut words, "amplitude-ratio", &Some(ratio.clone())),
-        None => push(&mut words, "z", &Some(input.z.clone())),
-    }
-    push(&mut words, "plot", &Some(plot.clone()));
+    let (words, model_words) = command_words(input, &lever, &surface, &case, &plot);
     let sources = [
         lever.as_str(),
         surface.as_str(),

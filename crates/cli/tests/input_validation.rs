@@ -309,3 +309,27 @@ fn help_states_every_range_and_the_exit_statuses() {
         }
     }
 }
+
+/// `drumroll theory --json | head -1` closes the pipe before the output is written: the
+/// command ends quietly, never with a panic about a broken pipe.
+#[test]
+fn a_closed_pipe_ends_the_output_without_a_panic() {
+    for args in [
+        &["theory", "--z", "9.5", "--json"][..],
+        &["simulate", "--z", "9.5"][..],
+        &["continue", "--floor", "9.9", "--json"][..],
+    ] {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("drumroll"))
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("starts");
+        // The reader goes away before the orbit is computed and printed.
+        drop(child.stdout.take());
+        let output = child.wait_with_output().expect("ends");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(output.status.code(), Some(0), "{args:?}: {stderr}");
+    }
+}
