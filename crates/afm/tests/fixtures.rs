@@ -123,7 +123,7 @@ fn negative_stiffness_names_file_field_and_range() {
     assert!(message.contains(&file), "{message}");
     assert!(message.contains("modes[0].stiffness_n_per_m"), "{message}");
     assert!(message.contains("-0.05"), "{message}");
-    assert!(message.contains("[0.000001, 1000000] N/m"), "{message}");
+    assert!(message.contains("[1e-6, 1000000] N/m"), "{message}");
 }
 
 #[test]
