@@ -147,6 +147,30 @@ fn an_implausible_value_is_warned_about_with_its_likely_unit() {
             && stderr.contains("0.01 um = 10 nm"),
         "{stderr}"
     );
+    // The same for a file's field: a sample of 500 Pa is allowed, softer than AFM samples are.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sample = write(
+        dir.path(),
+        "gel.json",
+        r#"{"name": "gel", "youngs_modulus_gpa": 5e-7}"#,
+    );
+    let (code, _, stderr) = run(&[
+        "simulate",
+        "--cantilever",
+        "biolever",
+        "--sample",
+        &sample,
+        "--a0",
+        "10",
+        "--z",
+        "9.5",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("gel.json: field `youngs_modulus_gpa` = 5e-7 is unusual for AFM")
+            && stderr.contains("typical 1e-6 to 1500 GPa"),
+        "{stderr}"
+    );
 }
 
 #[test]
