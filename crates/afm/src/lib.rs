@@ -32,6 +32,7 @@ pub mod free_response;
 pub mod gauss_legendre;
 pub mod hertz;
 pub mod impact_numbers;
+mod json_path;
 pub mod lockin;
 mod modal_constants;
 pub mod model;
@@ -47,7 +48,7 @@ pub mod sweep;
 pub mod theory;
 pub mod trajectory;
 pub mod trigonometric;
-mod validation;
+pub mod validation;
 
 pub use amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
 pub use bifurcation_diagram::{
@@ -83,7 +84,7 @@ pub use steady_orbit::{
 };
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
 pub use theory::{
-    compare_theory, measure_impacts, ImpactImpulse, ImpactMeasurement, ImpactPrediction,
-    ImpactTheory, Ringing, TheoryComparison,
+    compare_theory, measure_impacts, AssumptionFailure, ImpactImpulse, ImpactMeasurement,
+    ImpactPrediction, ImpactTheory, Ringing, TheoryComparison,
 };
 pub use trajectory::{sample_trajectory, TrajectorySample};
