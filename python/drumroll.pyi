@@ -71,12 +71,14 @@ class Case:
         floor: Optional[float] = None,
         min_amplitude_ratio: float = 0.3,
         max_step: Optional[float] = None,
+        max_points: int = 20000,
         retract: bool = False,
     ) -> "Diagram":
         """The bifurcation diagram in Z (the paper's Fig. 2), as `drumroll continue`: from
         above first contact down to `floor` (nm, default 0.05 A0) or A/A0 <
         `min_amplitude_ratio`; arclength steps up to `max_step` nm (default A0/250); with
-        `retract=True` back up too. Releases the GIL; Ctrl-C interrupts it."""
+        `retract=True` back up too; at most `max_points` points per branch (`completed` is
+        False on a branch cut short). Releases the GIL; Ctrl-C interrupts it."""
     def approach(
         self,
         *,
@@ -186,6 +188,10 @@ class Diagram:
     @property
     def stop(self) -> str:
         """Why the approach stopped."""
+    @property
+    def completed(self) -> bool:
+        """Whether the approach reached its requested end (the CLI exits with status 3 when
+        not)."""
     @property
     def error(self) -> Optional[str]:
         """The error that ended the branch early, if any."""

@@ -2,6 +2,7 @@
 //! periodic orbits from above first contact down to a floor, every special point labelled and
 //! located, and optionally the retract branch back up.
 
+use afm::validation::Interval;
 use afm::{
     approach_diagram_until, diagram_until, BifurcationDiagram, Case, DiagramPoint, DiagramSettings,
     TappingModel,
@@ -12,9 +13,11 @@ use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
-use crate::output::write_atomically;
+use crate::option_ranges::{self, OptionRange};
+use crate::output::{print_stdout, write_atomically};
 use crate::plot::{render_svg, Marker, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 
 /// Options of `drumroll continue`.
@@ -26,12 +29,19 @@ pub struct ContinueArgs {
     /// Lowest separation of the approach, nm, in [-A0, Z_G1) (default 0.05 A0).
     #[arg(long, allow_negative_numbers = true)]
     pub floor: Option<f64>,
-    /// The approach also stops when A/A0 falls below this ratio (default 0.3; 0 disables).
-    #[arg(long, default_value_t = 0.3)]
+    /// The approach also stops when A/A0 falls below this ratio, in [0, 1) (default 0.3; 0
+    /// disables).
+    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
     pub min_amplitude_ratio: f64,
-    /// Largest arclength step, in nm (default A0/250: several hundred points per diagram).
-    #[arg(long)]
+    /// Largest arclength step, in nm, in (0, A0] (default A0/250: several hundred points per
+    /// diagram).
+    #[arg(long, allow_negative_numbers = true)]
     pub max_step: Option<f64>,
+    /// Largest number of points per branch, in [2, 10000000]. A branch that reaches it before
+    /// its end stops there: the points so far are printed and written, stderr says so, and the
+    /// exit status is 3.
+    #[arg(long, default_value_t = 20_000, allow_negative_numbers = true)]
+    pub max_points: i64,
     /// After the approach, continue back up from its lowest point (Z increasing), so that
     /// hysteresis shows; the bistable range is reported.
     #[arg(long)]
@@ -51,7 +61,9 @@ pub struct ContinueArgs {
 
 /// Run `drumroll continue`.
 pub fn run(args: &ContinueArgs) -> Result<()> {
-    let (case, model) = args.model.model()?;
+    // The options that need no model, checked before the output paths and the model.
+    option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
+    option_ranges::MAX_POINTS.count(args.max_points)?;
     let csv_path = args
         .csv
         .as_ref()
@@ -62,7 +74,8 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .as_ref()
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
-    let settings = diagram_settings(&model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    let (case, model) = args.model.model()?;
+    let settings = diagram_settings(args, &model)?;
     let run = compute_diagrams(&case, &model, &settings, args.retract, &mut || false)?;
     let DiagramRun {
         approach,
@@ -70,23 +83,21 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         bistable,
     } = &run;
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string(&continue_json(&case, &model, &settings, &run))?
-        );
+        let object = continue_json(&case, &model, &settings, &run);
+        print_stdout(&format!("{}\n", serde_json::to_string(&object)?))?;
     } else {
-        print!("{}", table(&case.name, &model, "approach", approach));
+        print_stdout(&table(&case.name, &model, "approach", approach))?;
         if let Some(retract) = &retract {
-            print!("{}", table(&case.name, &model, "retract", retract));
+            print_stdout(&table(&case.name, &model, "retract", retract))?;
             match bistable.as_deref() {
-                Some([]) | None => {
-                    println!("no bistable range: approach and retract follow one stable orbit")
-                }
+                Some([]) | None => print_stdout(
+                    "no bistable range: approach and retract follow one stable orbit\n",
+                )?,
                 Some(ranges) => {
                     for [low, high] in ranges {
-                        println!(
-                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)"
-                        );
+                        print_stdout(&format!(
+                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)\n"
+                        ))?;
                     }
                 }
             }
@@ -112,42 +123,61 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         )?;
         write_atomically(&path, svg.as_bytes())?;
     }
+    reached_end(approach, retract.as_ref(), settings.max_points)
+}
+
+/// `Ok` when every branch reached its requested end, else the [`Incomplete`] error that says
+/// which did not and why (`main` exits with status 3).
+fn reached_end(
+    approach: &BifurcationDiagram,
+    retract: Option<&BifurcationDiagram>,
+    max_points: usize,
+) -> Result<()> {
+    let unfinished: Vec<String> = std::iter::once(("approach", approach))
+        .chain(retract.map(|retract| ("retract", retract)))
+        .filter(|(_, diagram)| !diagram.completed)
+        .map(|(direction, diagram)| {
+            let error = diagram
+                .error
+                .as_deref()
+                .map_or_else(String::new, |error| format!(" ({error})"));
+            format!("the {direction} ended because {}{error}", diagram.stop)
+        })
+        .collect();
+    if !unfinished.is_empty() {
+        let hint = if unfinished
+            .iter()
+            .any(|u| u.contains("maximum number of points"))
+        {
+            format!("; raise --max-points (now {}) or --max-step", max_points)
+        } else {
+            String::new()
+        };
+        return Err(Incomplete(format!("{}{hint}", unfinished.join("; "))).into());
+    }
     Ok(())
 }
 
-/// The diagram settings of `model` for the options of `continue`: `floor` (nm, in
-/// `[-A0, Z_G1)`, default 0.05 A0), `min_amplitude_ratio` (in `[0, 1)`) and `max_step` (nm, in
-/// `(0, A0]`, default A0/250); errors name the option and its allowed range.
-pub fn diagram_settings(
-    model: &TappingModel,
-    floor: Option<f64>,
-    min_amplitude_ratio: f64,
-    max_step: Option<f64>,
-) -> Result<DiagramSettings> {
+/// The approach's settings for `model` from `args`, every option checked against
+/// [`crate::option_ranges`] (`--floor` in `[-A0, Z_G1)`, `--max-step` in `(0, A0]`).
+pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<DiagramSettings> {
+    option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
     let mut settings = DiagramSettings::approach(model);
-    if let Some(floor) = floor {
-        let lowest = -model.free_amplitude_nm();
-        if !(floor >= lowest && floor < model.grazing_separation_nm()) {
-            bail!(
-                "--floor {floor}: allowed [{lowest}, {:.6}) nm, from -A0 up to just below first contact Z_G1",
-                model.grazing_separation_nm()
-            );
-        }
+    let a0 = model.free_amplitude_nm();
+    if let Some(floor) = args.floor {
+        OptionRange::new(
+            "--floor",
+            Interval::right_open(-a0, model.grazing_separation_nm(), "nm"),
+        )
+        .check(floor)?;
         settings.z_limit_nm = floor;
     }
-    if !(0.0..1.0).contains(&min_amplitude_ratio) {
-        bail!("--min-amplitude-ratio {min_amplitude_ratio}: allowed 0 <= R < 1");
-    }
-    settings.min_amplitude_ratio = min_amplitude_ratio;
-    if let Some(step) = max_step {
-        if !(step.is_finite() && step > 0.0 && step <= model.free_amplitude_nm()) {
-            bail!(
-                "--max-step {step}: allowed 0 < step <= A0 = {} nm",
-                model.free_amplitude_nm()
-            );
-        }
+    settings.min_amplitude_ratio = args.min_amplitude_ratio;
+    if let Some(step) = args.max_step {
+        OptionRange::new("--max-step", Interval::positive(a0, "nm")).check(step)?;
         settings.max_step = step;
     }
+    settings.max_points = option_ranges::MAX_POINTS.count(args.max_points)?;
     Ok(settings)
 }
 
@@ -185,6 +215,7 @@ pub fn compute_diagrams(
         };
         let retract_settings = DiagramSettings {
             max_step: settings.max_step,
+            max_points: settings.max_points,
             ..DiagramSettings::retract(model)
         };
         Some(
@@ -235,6 +266,7 @@ pub fn continue_json(
         "points": approach.points,
         "special_points": approach.special_points,
         "stop": approach.stop,
+        "completed": approach.completed,
         "error": approach.error,
     });
     if let Some(retract) = &run.retract {
@@ -242,6 +274,7 @@ pub fn continue_json(
             "points": retract.points,
             "special_points": retract.special_points,
             "stop": retract.stop,
+            "completed": retract.completed,
             "error": retract.error,
         });
         object["bistable_ranges_nm"] = json!(run.bistable);

@@ -7,7 +7,14 @@ use std::process::ExitCode;
 /// Non-smooth dynamics of AFM cantilevers tapping a sample: steady orbits, impacts, grazing
 /// bifurcations (Melcher, Xu, Raman, Appl. Phys. Lett. 93, 093111 (2008)).
 #[derive(Debug, Parser)]
-#[command(name = "drumroll", version, about)]
+#[command(
+    name = "drumroll",
+    version,
+    about,
+    after_help = "Exit status: 0 success; 1 error (bad input or a failed computation); 2 the \
+                  command line does not parse; 3 the run stopped before its requested end (the \
+                  output computed so far is written, and stderr says why)."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -26,6 +33,10 @@ enum Command {
     /// The paper's approximate theory (Eqs. 3-4, lambda_1..3, the ring-down criterion) beside
     /// the same quantities measured on the simulated steady orbit at one Z or A/A0.
     Theory(drumroll::theory::TheoryArgs),
+    /// The brute-force regime map: for each value of a parameter (a row), a quasi-static
+    /// approach (and retract) in Z by transients, each cell's impacts per period, period, A/A0
+    /// and phase; shardable (`--shard I/N`, then `grid merge`) and resumable.
+    Grid(drumroll::grid::GridArgs),
     /// The Euler-Bernoulli modal table of a cantilever with a point tip mass, and a cantilever
     /// file built from measured k_1, frequencies and quality factors.
     Cantilever(drumroll::cantilever::CantileverArgs),
@@ -38,16 +49,37 @@ fn main() -> ExitCode {
         Command::Continue(args) => drumroll::continue_diagram::run(args),
         Command::Approach(args) => drumroll::approach::run(args),
         Command::Theory(args) => drumroll::theory::run(args),
+        Command::Grid(args) => drumroll::grid::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
+            if let Some(incomplete) = error.downcast_ref::<drumroll::exit_status::Incomplete>() {
+                eprintln!("drumroll: {incomplete}");
+                return ExitCode::from(drumroll::exit_status::INCOMPLETE);
+            }
             eprintln!("drumroll: error: {error}");
-            for cause in error.chain().skip(1) {
+            for cause in distinct_causes(&error) {
                 eprintln!("  caused by: {cause}");
             }
             ExitCode::FAILURE
         }
     }
+}
+
+/// The causes of `error` below its top message, each once: a cause whose text the message
+/// above it already contains (an error that prints its source, e.g. `solver failure: ...`)
+/// is skipped.
+fn distinct_causes(error: &anyhow::Error) -> Vec<String> {
+    let mut above = error.to_string();
+    let mut causes = Vec::new();
+    for cause in error.chain().skip(1) {
+        let text = cause.to_string();
+        if !above.contains(&text) {
+            causes.push(text.clone());
+        }
+        above = text;
+    }
+    causes
 }

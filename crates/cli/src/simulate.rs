@@ -13,7 +13,8 @@ use std::path::PathBuf;
 use crate::digits;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
-use crate::output::write_atomically;
+use crate::option_ranges;
+use crate::output::{print_stdout, write_atomically};
 use crate::plot::render_svg;
 use crate::trajectory_plot::trajectory_panels;
 
@@ -23,7 +24,8 @@ pub struct SimulateArgs {
     /// The cantilever, sample and drive.
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Separation Z between the cantilever base and the sample, nm (Z > 0 above the sample).
+    /// Separation Z between the cantilever base and the sample, nm (Z > 0 above the sample), in
+    /// [-A0, 100000] nm.
     #[arg(
         long,
         allow_hyphen_values = true,
@@ -32,7 +34,7 @@ pub struct SimulateArgs {
     )]
     pub z: Option<f64>,
     /// Instead of --z: approach from above first contact (Z decreasing, each orbit started from
-    /// the previous one) and stop at the Z where A/A0 equals this ratio (0 < R < 1).
+    /// the previous one) and stop at the Z where A/A0 equals this ratio, in (0, 1).
     #[arg(long, allow_negative_numbers = true)]
     pub amplitude_ratio: Option<f64>,
     /// Which orbit --z reports where several coexist: `approach`, the orbit of the quasi-static
@@ -101,12 +103,13 @@ pub fn coexisting_orbit(
 
 /// Run `drumroll simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
-    let (case, model) = args.model.model()?;
+    check_orbit_options(args.z, args.amplitude_ratio)?;
     let plot_path = args
         .plot
         .as_ref()
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
+    let (case, model) = args.model.model()?;
     let settings = SteadyOrbitSettings::default();
     let (orbit, start) = orbit_at(&model, args.z, args.amplitude_ratio, args.start, &settings)?;
     let coexisting = match args.z {
@@ -131,11 +134,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             coexisting,
             options,
         );
-        println!("{}", serde_json::to_string_pretty(&object)?);
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;
     } else {
-        print!("{}", summary(&case.name, &model, &orbit));
+        print_stdout(&summary(&case.name, &model, &orbit))?;
         if let Some(other) = &coexisting {
-            print!("{}", coexisting_note(&model, start, other));
+            print_stdout(&coexisting_note(&model, start, other))?;
         }
     }
     if let Some(path) = plot_path {
@@ -143,7 +146,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         let svg = render_svg(&panels, 2, 1, (800, 320))?;
         write_atomically(&path, svg.as_bytes())?;
         if !args.json {
-            println!("figure: {}", path.display());
+            print_stdout(&format!("figure: {}\n", path.display()))?;
         }
     }
     Ok(())
@@ -151,7 +154,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
 
 /// The steady orbit `simulate` reports: at separation `z` from `start`, or (with
 /// `amplitude_ratio` instead) where the approach reaches that `A/A0`; exactly one of the two is
-/// given. Returns the orbit and the start that found it (`Approach` for an amplitude ratio).
+/// given, each checked against [`crate::option_ranges`]. Returns the orbit and the start that
+/// found it (`Approach` for an amplitude ratio).
 pub fn orbit_at(
     model: &TappingModel,
     z: Option<f64>,
@@ -159,11 +163,10 @@ pub fn orbit_at(
     start: Start,
     settings: &SteadyOrbitSettings,
 ) -> Result<(SteadyOrbit, Start)> {
+    check_orbit_options(z, amplitude_ratio)?;
     match (z, amplitude_ratio) {
         (Some(z), None) => {
-            if !z.is_finite() {
-                bail!("--z {z}: the separation must be a finite number of nm");
-            }
+            option_ranges::separation_for(model.free_amplitude_nm()).check(z)?;
             let orbit = steady_orbit(model, z, start.orbit_start(), settings)
                 .with_context(|| format!("no steady orbit at Z = {z} nm"))?;
             Ok((orbit, start))
@@ -201,6 +204,18 @@ pub fn simulate_json(
         });
     object["inputs"] = orbit_inputs_json("simulate", options, case, model, settings);
     object
+}
+
+/// Check `--z` and `--amplitude-ratio` of `simulate` and `theory` against the table of
+/// [`crate::option_ranges`] (`--z` again against the model's `-A0` once it is built).
+pub fn check_orbit_options(z: Option<f64>, amplitude_ratio: Option<f64>) -> Result<()> {
+    if let Some(z) = z {
+        option_ranges::Z.check(z)?;
+    }
+    if let Some(ratio) = amplitude_ratio {
+        option_ranges::AMPLITUDE_RATIO.check(ratio)?;
+    }
+    Ok(())
 }
 
 /// The JSON object of one steady orbit (units in the key names; docs/output-schema.md). Every

@@ -213,6 +213,76 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
         &[lines],
     ));
 
+    // grid, JSON Lines: the header line, then rows with approach, retract and bistable.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let map = directory.path().join("map.jsonl");
+    stdout_of(&[
+        "grid",
+        "--vary",
+        "a0",
+        "--from",
+        "9",
+        "--to",
+        "10",
+        "--steps",
+        "2",
+        "--z-from",
+        "9.5",
+        "--z-to",
+        "8.5",
+        "--z-steps",
+        "3",
+        "--retract",
+        "--output",
+        map.to_str().expect("utf-8 path"),
+    ]);
+    let lines: Vec<Value> = std::fs::read_to_string(&map)
+        .expect("map")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one object per line"))
+        .collect();
+    assert!(lines[0].get("inputs").is_some() && lines[0].get("row").is_none());
+    printed.extend(check(&schema, "`drumroll grid` (JSON Lines)", &[lines]));
+
+    // theory: the paper's example (every number), below the surface and without contact
+    // (predictions withheld: `null`).
+    let theory = [
+        one(&["theory", "--case", "biolever-mica", "--json"]),
+        one(&["theory", "--case", "biolever-mica", "--z", "-5", "--json"]),
+        one(&["theory", "--case", "biolever-mica", "--z", "11", "--json"]),
+    ];
+    printed.extend(check(&schema, "`drumroll theory --json`", &theory));
+
+    // cantilever: the table alone, and a cantilever built and written.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let out = directory.path().join("lever.json");
+    let cantilever = [
+        one(&["cantilever", "--tip-mass-ratio", "0", "--json"]),
+        one(&[
+            "cantilever",
+            "--tip-mass-ratio",
+            "0.16",
+            "--k1",
+            "0.1",
+            "--f1",
+            "3.5",
+            "--f2",
+            "28",
+            "--q1",
+            "1.6",
+            "--q2",
+            "4.3",
+            "--radius",
+            "50",
+            "--name",
+            "lever",
+            "--out",
+            out.to_str().expect("utf-8 path"),
+            "--json",
+        ]),
+    ];
+    printed.extend(check(&schema, "`drumroll cantilever --json`", &cantilever));
+
     // Every documented key of the inputs object is printed by some command.
     for path in schema["The `inputs` object"].keys() {
         assert!(

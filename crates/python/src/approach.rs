@@ -3,14 +3,13 @@
 
 use drumroll::approach::{ApproachArgs, CSV_HEADER};
 use drumroll::inputs::inputs_json;
-use drumroll::model_args::ModelArgs;
 use pyo3::prelude::*;
 use serde_json::{json, Value};
 
 use crate::convert::{json_to_py, records_to_table};
 use crate::errors::to_py_err;
 use crate::interrupt::without_gil;
-use crate::resolved::Resolved;
+use crate::resolved::{resolved_model_args, Resolved};
 use std::sync::Arc;
 
 /// The options of `Case.approach`, named as in Python (units in the names).
@@ -24,11 +23,11 @@ pub struct ApproachOptions {
     /// Retract back up after the approach.
     pub retract: bool,
     /// Drive cycles per lock-in reading.
-    pub lockin_cycles: usize,
+    pub lockin_cycles: i64,
     /// Keep every N-th reading.
-    pub every: usize,
+    pub every: i64,
     /// Cycles integrated at the start before the sweep.
-    pub settle_cycles: usize,
+    pub settle_cycles: i64,
     /// Contact integration tolerance.
     pub tolerance: f64,
 }
@@ -42,13 +41,7 @@ pub fn compute_approach<'py>(
     options: &ApproachOptions,
 ) -> PyResult<Bound<'py, PyAny>> {
     let args = ApproachArgs {
-        model: ModelArgs {
-            case: None,
-            cantilever: None,
-            sample: None,
-            a0: None,
-            drive_frequency: None,
-        },
+        model: resolved_model_args(),
         from: options.from_nm,
         to: options.to_nm,
         rate: options.rate_nm_per_s,

@@ -37,9 +37,11 @@ fn resolve_cantilever(reference: &Reference<'_>) -> PyResult<afm::Cantilever> {
             fixtures::load_cantilever(Path::new(name))
         }
         Reference::Name(name) => fixtures::builtin_cantilever(name),
-        Reference::Dict(dict) => {
-            from_value(&py_to_json(dict.as_any())?, "cantilever (a Python dict)")
-        }
+        Reference::Dict(dict) => from_value(
+            &py_to_json(dict.as_any())?,
+            "cantilever (a Python dict)",
+            fixtures::parse_cantilever,
+        ),
     };
     result.map_err(crate::errors::afm_to_py_err)
 }
@@ -48,7 +50,11 @@ fn resolve_sample(reference: &Reference<'_>) -> PyResult<afm::Sample> {
     let result = match reference {
         Reference::Name(name) if is_file_reference(name) => fixtures::load_sample(Path::new(name)),
         Reference::Name(name) => fixtures::builtin_sample(name),
-        Reference::Dict(dict) => from_value(&py_to_json(dict.as_any())?, "sample (a Python dict)"),
+        Reference::Dict(dict) => from_value(
+            &py_to_json(dict.as_any())?,
+            "sample (a Python dict)",
+            fixtures::parse_sample,
+        ),
     };
     result.map_err(crate::errors::afm_to_py_err)
 }
@@ -185,25 +191,28 @@ impl Case {
     /// periodic orbits continued from above first contact down to `floor` (nm, in
     /// [-A0, Z_G1); default 0.05 A0) or until A/A0 < `min_amplitude_ratio` (default 0.3; 0
     /// disables), arclength steps of at most `max_step` (nm; default A0/250), special points
-    /// located to |dZ| < 1e-9 nm; with `retract=True` also back up from the lowest point.
+    /// located to |dZ| < 1e-9 nm, at most `max_points` points per branch (a branch that
+    /// reaches it stops there: `completed` is then False); with `retract=True` also back up
+    /// from the lowest point.
     /// Runs without the GIL; Ctrl-C interrupts it between branch points.
-    #[pyo3(signature = (*, floor=None, min_amplitude_ratio=0.3, max_step=None, retract=false))]
+    #[pyo3(signature = (*, floor=None, min_amplitude_ratio=0.3, max_step=None, max_points=20000, retract=false))]
     fn diagram(
         &self,
         py: Python<'_>,
         floor: Option<f64>,
         min_amplitude_ratio: f64,
         max_step: Option<f64>,
+        max_points: i64,
         retract: bool,
     ) -> PyResult<crate::diagram::Diagram> {
-        crate::diagram::compute_diagram(
-            py,
-            &self.resolved,
+        let options = crate::diagram::DiagramOptions {
             floor,
             min_amplitude_ratio,
             max_step,
+            max_points,
             retract,
-        )
+        };
+        crate::diagram::compute_diagram(py, &self.resolved, &options)
     }
 
     /// A time-domain approach sweep as in the lab, as `drumroll approach`: Z falls from
@@ -224,9 +233,9 @@ impl Case {
         to_nm: f64,
         rate_nm_per_s: f64,
         retract: bool,
-        lockin_cycles: usize,
-        every: usize,
-        settle_cycles: usize,
+        lockin_cycles: i64,
+        every: i64,
+        settle_cycles: i64,
         tolerance: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
         let options = crate::approach::ApproachOptions {

@@ -1,7 +1,9 @@
 //! `drumroll.Diagram`: the bifurcation diagram in Z (the paper's Fig. 2; MODEL.md section 5)
 //! as `drumroll continue --json` gives it, with the branch points as a table.
 
-use drumroll::continue_diagram::{compute_diagrams, continue_json, diagram_settings, CSV_COLUMNS};
+use drumroll::continue_diagram::{
+    compute_diagrams, continue_json, diagram_settings, ContinueArgs, CSV_COLUMNS,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -10,7 +12,7 @@ use serde_json::Value;
 use crate::convert::{json_to_py, py_to_json, records_to_table};
 use crate::errors::to_py_err;
 use crate::interrupt::without_gil;
-use crate::resolved::Resolved;
+use crate::resolved::{resolved_model_args, Resolved};
 use std::sync::Arc;
 
 /// A bifurcation diagram: the branch of periodic orbits continued in the separation Z from
@@ -55,6 +57,13 @@ impl Diagram {
     #[getter]
     fn stop(&self) -> String {
         self.json["stop"].as_str().unwrap_or_default().to_string()
+    }
+
+    /// Whether the approach reached its requested end (False: it stopped at `max_points` or on
+    /// an error; the CLI exits with status 3 then).
+    #[getter]
+    fn completed(&self) -> bool {
+        self.json["completed"].as_bool().unwrap_or(false)
     }
 
     /// The error that ended the approach early, if any.
@@ -131,23 +140,45 @@ impl Diagram {
     }
 }
 
+/// The options of `Case.diagram`, as `drumroll continue`'s.
+pub struct DiagramOptions {
+    /// Lowest separation, nm.
+    pub floor: Option<f64>,
+    /// The approach stops below this A/A0.
+    pub min_amplitude_ratio: f64,
+    /// Largest arclength step, nm.
+    pub max_step: Option<f64>,
+    /// Largest number of points per branch.
+    pub max_points: i64,
+    /// Continue back up after the approach.
+    pub retract: bool,
+}
+
 /// The diagram of the case `resolved` (options as `drumroll continue`'s), computed without the GIL and
 /// interruptible by Ctrl-C between branch points.
 pub fn compute_diagram(
     py: Python<'_>,
     resolved: &Arc<Resolved>,
-    floor: Option<f64>,
-    min_amplitude_ratio: f64,
-    max_step: Option<f64>,
-    retract: bool,
+    options: &DiagramOptions,
 ) -> PyResult<Diagram> {
+    let args = ContinueArgs {
+        model: resolved_model_args(),
+        floor: options.floor,
+        min_amplitude_ratio: options.min_amplitude_ratio,
+        max_step: options.max_step,
+        max_points: options.max_points,
+        retract: options.retract,
+        json: true,
+        csv: None,
+        plot: None,
+    };
     let json = without_gil(py, |interrupted| -> anyhow::Result<Value> {
-        let settings = diagram_settings(&resolved.model, floor, min_amplitude_ratio, max_step)?;
+        let settings = diagram_settings(&args, &resolved.model)?;
         let run = compute_diagrams(
             &resolved.case,
             &resolved.model,
             &settings,
-            retract,
+            args.retract,
             interrupted,
         )?;
         Ok(continue_json(

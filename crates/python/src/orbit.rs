@@ -333,11 +333,11 @@ pub fn compute_orbit(
             state.len()
         )));
     }
-    if !z.is_finite() {
-        return Err(to_py_err(anyhow::anyhow!(
-            "--z {z}: the separation must be a finite number of nm"
-        )));
-    }
+    drumroll::simulate::check_orbit_options(Some(z), None)
+        .and_then(|()| {
+            drumroll::option_ranges::separation_for(resolved.model.free_amplitude_nm()).check(z)
+        })
+        .map_err(to_py_err)?;
     let orbit = py
         .allow_threads(|| {
             afm::steady_orbit(&resolved.model, z, afm::OrbitStart::Near(&state), &settings)

@@ -46,8 +46,16 @@ impl Resolved {
         let case = AfmCase {
             name: value["name"].as_str().unwrap_or("python").to_string(),
             description: value["description"].as_str().unwrap_or("").to_string(),
-            cantilever: from_value(&value["cantilever"], &format!("{source}: cantilever"))?,
-            sample: from_value(&value["sample"], &format!("{source}: sample"))?,
+            cantilever: from_value(
+                &value["cantilever"],
+                &format!("{source}: cantilever"),
+                afm::fixtures::parse_cantilever,
+            )?,
+            sample: from_value(
+                &value["sample"],
+                &format!("{source}: sample"),
+                afm::fixtures::parse_sample,
+            )?,
             free_amplitude_nm,
             drive_frequency_khz: number("drive_frequency_khz"),
         };
@@ -56,13 +64,35 @@ impl Resolved {
 }
 
 /// A cantilever or sample of its file's JSON object, numbers taken exactly (checked when the
-/// case is resolved; `file` names it in errors).
+/// case is resolved; `file` names it in errors). On a malformed object the error is the one
+/// `parse` (`afm::fixtures::parse_cantilever` or `parse_sample`) gives for the object's text,
+/// which names the field.
 pub fn from_value<T: serde::de::DeserializeOwned>(
     value: &Value,
     file: &str,
+    parse: fn(&str, &str) -> Result<T, afm::AfmError>,
 ) -> Result<T, afm::AfmError> {
-    T::deserialize(value).map_err(|source| afm::AfmError::Json {
-        file: file.to_string(),
-        source,
+    T::deserialize(value).or_else(|source| {
+        let text = serde_json::to_string_pretty(value).unwrap_or_default();
+        match parse(file, &text) {
+            Err(error) => Err(error),
+            Ok(_) => Err(afm::AfmError::Json {
+                file: file.to_string(),
+                field: String::new(),
+                source,
+            }),
+        }
     })
+}
+
+/// The CLI's model options left empty: for building a command's options (whose checks the
+/// Python API reuses) when the case is already resolved.
+pub fn resolved_model_args() -> drumroll::model_args::ModelArgs {
+    drumroll::model_args::ModelArgs {
+        case: None,
+        cantilever: None,
+        sample: None,
+        a0: None,
+        drive_frequency: None,
+    }
 }
