@@ -3,6 +3,7 @@
 
 use afm::{fixtures, Case as AfmCase};
 use drumroll::model_args::ModelArgs;
+use drumroll::option_ranges;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::path::Path;
@@ -99,7 +100,14 @@ impl Case {
                     "--cantilever and --sample need --a0 (the free amplitude, nm)"
                 )));
             };
+            // The command line's checks of --a0 and --drive-frequency, with its messages.
+            option_ranges::A0.check(a0).map_err(to_py_err)?;
             let cantilever = resolve_cantilever(cantilever)?;
+            if let Some(frequency) = drive_frequency_khz {
+                option_ranges::drive_frequency_for(&cantilever)
+                    .check(frequency)
+                    .map_err(to_py_err)?;
+            }
             let sample = resolve_sample(sample)?;
             AfmCase {
                 name: format!("{}-{}", cantilever.name, sample.name),
