@@ -72,15 +72,15 @@ pub fn from_value<T: serde::de::DeserializeOwned>(
     file: &str,
     parse: fn(&str, &str) -> Result<T, afm::AfmError>,
 ) -> Result<T, afm::AfmError> {
-    T::deserialize(value).or_else(|source| {
+    T::deserialize(value).map_err(|source| {
         let text = serde_json::to_string_pretty(value).unwrap_or_default();
         match parse(file, &text) {
-            Err(error) => Err(error),
-            Ok(_) => Err(afm::AfmError::Json {
+            Err(error) => error,
+            Ok(_) => afm::AfmError::Json {
                 file: file.to_string(),
                 field: String::new(),
                 source,
-            }),
+            },
         }
     })
 }
