@@ -20,12 +20,14 @@
 
 use std::cell::{Cell, RefCell};
 
-use hybrid::{FlowMap, Sensitivity};
+use hybrid::{FlowMap, HybridSystem, Sensitivity};
+
+use crate::hybrid_problem::Parametrised;
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::ContinuationError;
 use crate::problem::OrbitStructure;
-use crate::two_parameter::{TwoParameterProblem, TwoParametrised};
+use crate::two_parameter::{SystemFamily, TwoParameterProblem};
 
 /// Which codimension-one point a curve follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -60,8 +62,8 @@ pub(crate) struct Evaluation {
 
 /// A defining system bound to its problem, with its section time and (fold, period doubling)
 /// its bordering vectors.
-pub(crate) struct Defining<'a, S: TwoParametrised> {
-    pub problem: &'a TwoParameterProblem<S>,
+pub(crate) struct Defining<'a, F: SystemFamily> {
+    pub problem: &'a TwoParameterProblem<F>,
     pub kind: CodimOneKind,
     /// Section time `t0` (absolute system time).
     pub section: Cell<f64>,
@@ -69,7 +71,7 @@ pub(crate) struct Defining<'a, S: TwoParametrised> {
     pub borders: RefCell<(DVector<f64>, DVector<f64>)>,
 }
 
-impl<'a, S: TwoParametrised> Defining<'a, S> {
+impl<'a, F: SystemFamily> Defining<'a, F> {
     /// Dimension `n` of the orbit state.
     pub fn n(&self) -> usize {
         self.problem.dim()

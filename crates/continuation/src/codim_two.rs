@@ -24,7 +24,7 @@ use crate::curve_corrector::{correct, tangent};
 use crate::curve_settings::CurveSettings;
 use crate::error::ContinuationError;
 use crate::floquet::floquet_multipliers;
-use crate::two_parameter::TwoParametrised;
+use crate::two_parameter::SystemFamily;
 
 /// What meets what at a codimension-two point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -90,7 +90,7 @@ fn shifted_determinant(monodromy: &DMatrix<f64>, mu: f64) -> f64 {
 }
 
 /// The test functions of a curve at a point.
-fn tests<S: TwoParametrised>(defining: &Defining<'_, S>, c: &Current) -> Vec<Test> {
+fn tests<F: SystemFamily>(defining: &Defining<'_, F>, c: &Current) -> Vec<Test> {
     let evaluation = &c.solved.evaluation;
     let impacts = evaluation.structure.impacts as f64;
     match defining.kind {
@@ -125,8 +125,8 @@ fn changed(a: f64, b: f64, count: bool) -> bool {
 }
 
 /// Detect and locate every codimension-two point between `a` and `b`.
-pub(crate) fn detect<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+pub(crate) fn detect<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     a: &Current,
     b: &Current,
     settings: &CurveSettings,
@@ -142,8 +142,8 @@ pub(crate) fn detect<S: TwoParametrised>(
 }
 
 /// Bisection of test `index` between `a` and `b` along their secant.
-fn locate<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn locate<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     a: &Current,
     b: &Current,
     index: usize,

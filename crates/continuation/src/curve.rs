@@ -18,7 +18,7 @@ use crate::curve_settings::CurveSettings;
 use crate::error::ContinuationError;
 use crate::floquet::{floquet_multipliers, is_stable};
 use crate::problem::OrbitStructure;
-use crate::two_parameter::{TwoParameterProblem, TwoParametrised};
+use crate::two_parameter::{SystemFamily, TwoParameterProblem};
 use hybrid::Sensitivity;
 
 /// Where a curve starts: an orbit at (or near) the codimension-one point at `(p, q)`.
@@ -125,8 +125,8 @@ fn unit(m: usize, j: usize) -> DVector<f64> {
 /// # Errors
 /// Invalid settings, a start outside the range, a start that does not converge at fixed `q`
 /// ([`ContinuationError::StartNotConverged`]), or a singular start.
-pub fn continue_curve<S: TwoParametrised>(
-    problem: &TwoParameterProblem<S>,
+pub fn continue_curve<F: SystemFamily>(
+    problem: &TwoParameterProblem<F>,
     kind: CodimOneKind,
     start: &CurveStart,
     settings: &CurveSettings,
@@ -198,8 +198,8 @@ pub fn continue_curve<S: TwoParametrised>(
 
 /// The unknowns at the start: for a grazing, the section moved half a period map away from
 /// the gap minimum nearest zero, and that minimum's time.
-fn initial_unknowns<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn initial_unknowns<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     start: &CurveStart,
 ) -> Result<DVector<f64>, ContinuationError> {
     let problem = defining.problem;
@@ -248,8 +248,8 @@ fn initial_unknowns<S: TwoParametrised>(
 }
 
 /// A curve point from a solved point.
-pub(crate) fn point_of<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+pub(crate) fn point_of<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     solved: &Solved,
     at_fixed_second: bool,
 ) -> CurvePoint {
@@ -282,8 +282,8 @@ fn crossed(values: &[f64], from: f64, to: f64) -> Option<f64> {
 
 /// Trace one half of a curve from `current`; returns its points (without the start), its
 /// codimension-two points and its end.
-fn half_curve<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn half_curve<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     mut current: Current,
     settings: &CurveSettings,
 ) -> (Vec<CurvePoint>, Vec<Codim2Point>, CurveEnd) {
@@ -400,8 +400,8 @@ fn half_curve<S: TwoParametrised>(
 
 /// Check a corrected point's tangent turn and place it on a crossed target. `Ok(None)`: cut
 /// the step. The flag says whether the point is on an end of the range.
-fn finish_step<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn finish_step<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     current: &Current,
     solved: Solved,
     targets: &[f64],
@@ -432,8 +432,8 @@ fn finish_step<S: TwoParametrised>(
 
 /// The point between `current` and `next` with unknown `j` fixed at `value` (from the linear
 /// interpolation), with its tangent; `Ok(None)` if it does not converge.
-fn fixed_parameter<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn fixed_parameter<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     current: &Current,
     next: &Current,
     j: usize,
@@ -466,8 +466,8 @@ fn fixed_parameter<S: TwoParametrised>(
 /// Grazing curves: move the section half a period map away from the grazing time once the
 /// latter drifts into the outer twentieths of the period map (state flowed to the new section
 /// and corrected there at fixed `q`; if that fails, the section stays).
-fn recentre<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn recentre<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     current: Current,
     corrector: &crate::shooting::NewtonSettings,
 ) -> Result<Current, ContinuationError> {

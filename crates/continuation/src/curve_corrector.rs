@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::codim_one::{Defining, Evaluation};
 use crate::error::ContinuationError;
 use crate::shooting::NewtonSettings;
-use crate::two_parameter::TwoParametrised;
+use crate::two_parameter::SystemFamily;
 
 /// A converged point of the defining system.
 #[derive(Debug, Clone)]
@@ -40,8 +40,8 @@ pub(crate) fn recoverable(error: &ContinuationError) -> bool {
 }
 
 /// Evaluate, mapping recoverable failures (and non-finite values) to `None`.
-fn try_evaluate<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn try_evaluate<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     u: &DVector<f64>,
 ) -> Result<Option<Evaluation>, ContinuationError> {
     if !u.iter().all(|v| v.is_finite()) {
@@ -75,8 +75,8 @@ fn closed(jacobian: &DMatrix<f64>, row: &DVector<f64>) -> DMatrix<f64> {
 
 /// Newton on `[F(u); row . u - target] = 0` from `guess`. `Ok(None)` when it does not
 /// converge (the caller cuts its step); errors only for a misconfigured problem.
-pub(crate) fn correct<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+pub(crate) fn correct<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     guess: DVector<f64>,
     row: &DVector<f64>,
     target: f64,
@@ -136,8 +136,8 @@ pub(crate) fn correct<S: TwoParametrised>(
 /// `h_target = min(h / 2, c h^2)` (`h > 0` its current value, `c = 1, 10^2, 10^4, ...`)
 /// instead of zero, so that the quadratic error of the step stays on the free side and the
 /// iteration keeps converging quadratically; last, plain halving of the full step.
-fn safe_side_step<S: TwoParametrised>(
-    defining: &Defining<'_, S>,
+fn safe_side_step<F: SystemFamily>(
+    defining: &Defining<'_, F>,
     u: &DVector<f64>,
     evaluation: &Evaluation,
     a: &DMatrix<f64>,

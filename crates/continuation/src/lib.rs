@@ -86,4 +86,4 @@ pub use settings::{ContinuationSettings, ParameterDirection};
 pub use shooting::{newton_update, shoot, NewtonSettings, ShootingResult};
 pub use special_point::{SpecialPoint, SpecialPointKind};
 pub use test_function::{neimark_sacker_test, period_doubling_test, TestValues};
-pub use two_parameter::{TwoParameterProblem, TwoParametrised};
+pub use two_parameter::{SystemFamily, TwoParameterProblem, TwoParametrised};

@@ -41,7 +41,7 @@ fn grazing_curve_matches_the_closed_form_through_resonance() {
         .expect("G1 on the one-parameter branch");
     let mut system = oscillator(w0);
     system.amplitude = g1.parameter;
-    let problem = TwoParameterProblem::new(system, 1, Settings::default()).expect("problem");
+    let problem = TwoParameterProblem::new(system, w0, 1, Settings::default()).expect("problem");
     let settings = CurveSettings {
         second_range: (0.5, 1.6),
         targets: vec![1.0],
