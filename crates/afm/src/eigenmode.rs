@@ -9,9 +9,9 @@ use crate::AfmError;
 /// (the Biolever's 0.036 N/m is among them). Far below it the contact is so stiff against the
 /// lever that steps underflow (measured on the Biolever on mica: `k_1` = 1e-12 N/m still
 /// converges, 1e-20 N/m does not).
-const MIN_STIFFNESS: f64 = 1e-6;
+pub(crate) const MIN_STIFFNESS: f64 = 1e-6;
 /// Largest accepted modal stiffness, N/m.
-const MAX_STIFFNESS: f64 = 1e6;
+pub(crate) const MAX_STIFFNESS: f64 = 1e6;
 /// Smallest accepted natural frequency, kHz (10 Hz, far below any cantilever's: the paper's are
 /// 3.5 to 72 kHz). A drive period of a slower one takes millions of steps at the contact's time
 /// scale (measured: `f_1` = 1 Hz converges in 0.8 s, 0.1 Hz exhausts the step limit).
@@ -20,9 +20,9 @@ pub(crate) const MIN_FREQUENCY: f64 = 1e-2;
 pub(crate) const MAX_FREQUENCY: f64 = 1e6;
 /// Smallest accepted quality factor: a mode damped a thousand times past critical (measured:
 /// `Q_2` = 1e-6 still converges, in 2 s; 1e-9 exhausts the step limit).
-const MIN_QUALITY: f64 = 1e-3;
+pub(crate) const MIN_QUALITY: f64 = 1e-3;
 /// Largest accepted quality factor.
-const MAX_QUALITY: f64 = 1e6;
+pub(crate) const MAX_QUALITY: f64 = 1e6;
 /// Largest accepted magnitude of an optical sensitivity or forcing ratio.
 const MAX_RATIO: f64 = 1e3;
 

@@ -36,7 +36,9 @@ pub mod lockin;
 pub mod model;
 pub mod observables;
 pub mod orbit_prediction;
+pub mod parameter_axis;
 pub mod phase;
+pub mod regime_map;
 pub mod sample;
 pub mod separation;
 pub mod steady_orbit;
@@ -70,6 +72,10 @@ pub use observables::{
     GapMinimumKind, Harmonic, Impact, OrbitObservables, PeriodObserver, NEAR_IMPACT_FRACTION,
 };
 pub use orbit_prediction::{hermite_state, tangent_state};
+pub use parameter_axis::{CaseFamily, ParameterAxis, PARAMETER_NAMES};
+pub use regime_map::{
+    regime_map, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap, RegimeMapSettings,
+};
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{

@@ -53,7 +53,8 @@ pub(crate) struct Evaluation {
     pub jacobian: DMatrix<f64>,
     /// The monodromy of the period map from `t0`.
     pub monodromy: DMatrix<f64>,
-    /// Structure of the contact gap over the period map.
+    /// Structure of the contact gap over the period map (for a grazing, its impacts exclude a
+    /// touch of the grazing minimum itself).
     pub structure: OrbitStructure,
     /// Whether the grazing minimum itself touches the surface (grazing curves only): such an
     /// iterate lies on the non-smooth side and is not accepted by the corrector.
@@ -235,12 +236,18 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
         let k = self
             .problem
             .with_system(p, q, |system| system.contact_surface())?;
-        let touching = a
+        let own = |e: &&hybrid::Event| e.surface == k && (e.t - s).abs() < window;
+        let touching = a.events.iter().chain(&b.events).any(|e| own(&e));
+        let own_impacts = a
             .events
             .iter()
             .chain(&b.events)
-            .any(|e| e.surface == k && (e.t - s).abs() < window);
-        let structure = self.problem.structure(&[&a, &b], t0, d, x, p, q)?;
+            .filter(|e| own(e) && e.direction == hybrid::Direction::Down)
+            .count();
+        let mut structure = self.problem.structure(&[&a, &b], t0, d, x, p, q)?;
+        // The impacts of the orbit on its free side: a touch of the grazing minimum itself
+        // (numerically either side of zero at the root) is not counted.
+        structure.impacts = structure.impacts.saturating_sub(own_impacts);
         Ok(Evaluation {
             residual,
             jacobian,
