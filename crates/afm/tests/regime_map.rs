@@ -3,8 +3,8 @@
 //! points as the map's curves hold there.
 
 use afm::{
-    approach_diagram, builtin_case, regime_map, DiagramSettings, ParameterAxis,
-    RegimeMapSettings, TappingModel,
+    approach_diagram, builtin_case, regime_map, DiagramSettings, ParameterAxis, RegimeMapSettings,
+    TappingModel,
 };
 
 /// Biolever on mica over `A0 = 8 .. 12 nm`: at six `at` values and at the case's own
@@ -33,13 +33,10 @@ fn map_points_match_independent_diagrams() {
             .apply(&case, a0)
             .expect("in range");
         let model = TappingModel::from_case(&rebuilt).expect("model");
-        let diagram = approach_diagram(&model, &DiagramSettings::approach(&model)).expect("diagram");
+        let diagram =
+            approach_diagram(&model, &DiagramSettings::approach(&model)).expect("diagram");
         for curve in &map.curves {
-            let on_curve: Vec<_> = curve
-                .points
-                .iter()
-                .filter(|p| p.parameter == a0)
-                .collect();
+            let on_curve: Vec<_> = curve.points.iter().filter(|p| p.parameter == a0).collect();
             assert_eq!(on_curve.len(), 1, "{} at A0 = {a0}", curve.label);
             let point = on_curve[0];
             assert!(point.at_fixed_parameter);

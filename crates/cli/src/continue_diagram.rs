@@ -61,33 +61,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .as_ref()
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
-    let mut settings = DiagramSettings::approach(&model);
-    if let Some(floor) = args.floor {
-        let lowest = -model.free_amplitude_nm();
-        if !(floor >= lowest && floor < model.grazing_separation_nm()) {
-            bail!(
-                "--floor {floor}: allowed [{lowest}, {:.6}) nm, from -A0 up to just below first contact Z_G1",
-                model.grazing_separation_nm()
-            );
-        }
-        settings.z_limit_nm = floor;
-    }
-    if !(0.0..1.0).contains(&args.min_amplitude_ratio) {
-        bail!(
-            "--min-amplitude-ratio {}: allowed 0 <= R < 1",
-            args.min_amplitude_ratio
-        );
-    }
-    settings.min_amplitude_ratio = args.min_amplitude_ratio;
-    if let Some(step) = args.max_step {
-        if !(step.is_finite() && step > 0.0 && step <= model.free_amplitude_nm()) {
-            bail!(
-                "--max-step {step}: allowed 0 < step <= A0 = {} nm",
-                model.free_amplitude_nm()
-            );
-        }
-        settings.max_step = step;
-    }
+    let settings = approach_settings(&model, args.floor, args.min_amplitude_ratio, args.max_step)?;
     let approach = approach_diagram(&model, &settings)
         .with_context(|| format!("continuation of case `{}` failed", case.name))?;
     let retract = if args.retract {
@@ -181,6 +155,44 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         write_atomically(&path, svg.as_bytes())?;
     }
     Ok(())
+}
+
+/// The approach diagram's settings of `model` with `continue`'s options `--floor`,
+/// `--min-amplitude-ratio` and `--max-step` applied (errors name the option and its range).
+pub fn approach_settings(
+    model: &TappingModel,
+    floor: Option<f64>,
+    min_amplitude_ratio: f64,
+    max_step: Option<f64>,
+) -> Result<DiagramSettings> {
+    let mut settings = DiagramSettings::approach(model);
+    if let Some(floor) = floor {
+        let lowest = -model.free_amplitude_nm();
+        if !(floor >= lowest && floor < model.grazing_separation_nm()) {
+            bail!(
+                "--floor {floor}: allowed [{lowest}, {:.6}) nm, from -A0 up to just below first contact Z_G1",
+                model.grazing_separation_nm()
+            );
+        }
+        settings.z_limit_nm = floor;
+    }
+    if !(0.0..1.0).contains(&min_amplitude_ratio) {
+        bail!(
+            "--min-amplitude-ratio {}: allowed 0 <= R < 1",
+            min_amplitude_ratio
+        );
+    }
+    settings.min_amplitude_ratio = min_amplitude_ratio;
+    if let Some(step) = max_step {
+        if !(step.is_finite() && step > 0.0 && step <= model.free_amplitude_nm()) {
+            bail!(
+                "--max-step {step}: allowed 0 < step <= A0 = {} nm",
+                model.free_amplitude_nm()
+            );
+        }
+        settings.max_step = step;
+    }
+    Ok(settings)
 }
 
 /// The readable table of special points of one diagram.
@@ -367,6 +379,8 @@ fn panels(
                 .collect(),
             markers: phase_markers,
             y_period: Some(PHASE_PERIOD_DEG),
+            regions: Vec::new(),
+            shaded: Vec::new(),
         },
         Panel {
             title: String::from("A/A0 vs Z"),
@@ -378,6 +392,8 @@ fn panels(
                 .collect(),
             markers: z_markers,
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
         },
         Panel {
             title: String::from("impacts per period vs Z"),
@@ -389,6 +405,8 @@ fn panels(
                 .collect(),
             markers: Vec::new(),
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
         },
     ]
 }

@@ -7,6 +7,8 @@ pub mod cantilever;
 pub mod continue_diagram;
 pub mod digits;
 pub mod inputs;
+pub mod map;
+pub mod map_plot;
 pub mod model_args;
 pub mod output;
 pub mod plot;

@@ -49,6 +49,8 @@ pub fn trajectory_panels(
             series: vec![series("", |s| s.u_nm)],
             markers: Vec::new(),
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
         },
         Panel {
             title: String::from("tip-sample force (Hertz)"),
@@ -57,6 +59,8 @@ pub fn trajectory_panels(
             series: vec![series("", |s| s.force_nn)],
             markers: Vec::new(),
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
         },
     ])
 }
