@@ -103,8 +103,9 @@ pub struct MapPoint {
 /// One end of a map curve.
 #[derive(Debug, Clone, Serialize)]
 pub struct MapEnd {
-    /// Why the curve stopped there: `range-end`, `separation-limit`, `max-points`,
-    /// `corrector-failed` or `error`.
+    /// Why the curve stopped there: `range-end`, `separation-limit`, `closed` (the curve is
+    /// a closed loop inside the range: both ends say so), `max-points`, `corrector-failed` or
+    /// `error`.
     pub reason: String,
     /// The parameter value of the last point.
     pub parameter: f64,
@@ -247,8 +248,7 @@ pub fn regime_map(
     let seed = approach_diagram(&model, &settings.diagram)?;
     let integration = settings.diagram.orbit.integration.clone();
     let problem = TwoParameterProblem::new(family.clone(), q0, 1, integration.clone())?;
-    let mut targets = settings.at.clone();
-    targets.push(q0);
+    let targets = settings.at.clone();
     let curve_settings = CurveSettings {
         initial_step: 1e-3 * model.free_amplitude_nm(),
         max_step: model.free_amplitude_nm(),
@@ -361,6 +361,7 @@ fn end_words(end: &CurveEnd) -> &'static str {
         CurveStop::RangeEnd => "range-end",
         CurveStop::ParameterBound => "separation-limit",
         CurveStop::MaxPoints => "max-points",
+        CurveStop::Closed => "closed",
         CurveStop::StepTooSmall => "corrector-failed",
         CurveStop::Error => "error",
     }

@@ -70,6 +70,8 @@ pub enum CurveStop {
     ParameterBound,
     /// `max_points` points in this direction.
     MaxPoints,
+    /// The curve came back to its start: it is closed (an isola), and both ends say so.
+    Closed,
     /// The corrector failed at the minimum step (the defining system degenerates, e.g. the
     /// grazing minimum merges with a maximum, or the orbit ceases to exist).
     StepTooSmall,
@@ -166,6 +168,14 @@ pub fn continue_curve<F: SystemFamily>(
     let mut halves = Vec::new();
     let borders = defining.borders.borrow().clone();
     for sign in [-1.0, 1.0] {
+        if halves
+            .first()
+            .is_some_and(|(_, _, end): &(_, _, CurveEnd)| end.reason == CurveStop::Closed)
+        {
+            let closed = halves[0].2.clone();
+            halves.push((Vec::new(), Vec::new(), closed));
+            continue;
+        }
         *defining.borders.borrow_mut() = borders.clone();
         let t = tangent(&first.evaluation, &(sign * unit(m, m - 1)), first.u[m - 2])?;
         let current = Current {
@@ -290,7 +300,9 @@ fn half_curve<F: SystemFamily>(
     defining.section.set(current.section);
     let m = defining.unknowns();
     let (iq, ip) = (m - 1, m - 2);
+    let (p_start, q_start) = (current.solved.u[ip], current.solved.u[iq]);
     let mut targets = settings.targets.clone();
+    targets.push(q_start);
     targets.push(settings.second_range.0);
     targets.push(settings.second_range.1);
     let (p_low, p_high) = settings.parameter_range;
@@ -394,6 +406,16 @@ fn half_curve<F: SystemFamily>(
         }
         if range_end {
             return (points, codim2, end(CurveStop::RangeEnd, &current, None));
+        }
+        let (p_now, q_now) = (current.solved.u[ip], current.solved.u[iq]);
+        let scale = 1.0 + p_start.abs() + q_start.abs();
+        if points.len() > 2
+            && current.at_fixed_second
+            && (q_now - q_start).abs() <= 1e-12 * scale
+            && (p_now - p_start).abs() <= 1e-7 * scale
+        {
+            points.pop();
+            return (points, codim2, end(CurveStop::Closed, &current, None));
         }
     }
 }
