@@ -130,6 +130,15 @@ impl ParameterAxis {
         value.is_finite() && low_ok && value <= high
     }
 
+    /// The physical range in words, e.g. `(0, 100000] nm` or `[0.001, 1000000]`.
+    pub fn describe_range(&self, case: &Case) -> String {
+        let (low, high) = self.physical_range(case);
+        let open = if low == 0.0 { '(' } else { '[' };
+        format!("{open}{low}, {high}] {}", self.unit())
+            .trim_end()
+            .to_string()
+    }
+
     /// The case's own value of the parameter.
     pub fn value(&self, case: &Case) -> f64 {
         match self {

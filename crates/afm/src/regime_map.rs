@@ -188,11 +188,7 @@ fn check_range(case: &Case, axis: ParameterAxis, s: &RegimeMapSettings) -> Resul
     };
     for (field, value) in [("--from", s.from), ("--to", s.to)] {
         if !axis.allows(case, value) {
-            return Err(bad(
-                field,
-                value,
-                format!("{} within {allowed}", axis.name()),
-            ));
+            return Err(bad(field, value, format!("{} in {allowed}", axis.name())));
         }
     }
     if s.from >= s.to {
