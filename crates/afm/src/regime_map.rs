@@ -176,10 +176,7 @@ fn kind_of(label: &str) -> Option<CodimOneKind> {
 
 /// Check the range and the `at` values against the axis (errors name the option).
 fn check_range(case: &Case, axis: ParameterAxis, s: &RegimeMapSettings) -> Result<(), AfmError> {
-    let (low, high) = axis.physical_range(case);
-    let allowed = format!("{low} .. {high} {}", axis.unit())
-        .trim_end()
-        .to_string();
+    let allowed = axis.describe_range(case);
     let bad = |field: &str, value: f64, allowed: String| AfmError::InvalidField {
         file: "command line".into(),
         field: field.into(),
