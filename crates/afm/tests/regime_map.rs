@@ -59,3 +59,73 @@ fn map_points_match_independent_diagrams() {
         }
     }
 }
+
+/// The MAClever on mica has a pair of folds near first contact. Over `A0 = 5 .. 25 nm` its fold
+/// curve passes a cusp (both folds of the pair are one curve) near `A0 = 8.73 nm`: at four `at`
+/// values the curve's points at that `A0` are the two folds an independent approach diagram
+/// locates there (same tolerance as above), and just below the cusp's `A0` the diagram has no
+/// fold, just above it two (0.3 nm either side: closer above it the pair of folds is narrower than
+/// the diagram's step).
+#[test]
+fn fold_curve_and_cusp_match_independent_diagrams() {
+    let case = builtin_case("maclever-mica").expect("case");
+    let model = TappingModel::from_case(&case).expect("model");
+    let at = vec![12.0, 16.0, 22.0, 25.0];
+    let settings = RegimeMapSettings {
+        at: at.clone(),
+        labels: Some(vec!["fold".into()]),
+        points_per_range: 20,
+        ..RegimeMapSettings::new(&model, 5.0, 25.0)
+    };
+    let map = regime_map(&case, ParameterAxis::FreeAmplitude, &settings).expect("map");
+    assert_eq!(map.curves.len(), 1, "the two folds are one curve");
+    let fold = &map.curves[0];
+    let cusps: Vec<_> = map
+        .codim2_points
+        .iter()
+        .filter(|c| c.label == "cusp")
+        .collect();
+    assert_eq!(cusps.len(), 1, "{:?}", map.codim2_points);
+    let cusp = cusps[0].parameter;
+    let diagram_at = |a0: f64| {
+        let rebuilt = ParameterAxis::FreeAmplitude
+            .apply(&case, a0)
+            .expect("in range");
+        let model = TappingModel::from_case(&rebuilt).expect("model");
+        approach_diagram(&model, &DiagramSettings::approach(&model)).expect("diagram")
+    };
+    for a0 in at.iter().copied().chain([20.0]) {
+        let mut on_curve: Vec<f64> = fold
+            .points
+            .iter()
+            .filter(|p| p.parameter == a0)
+            .map(|p| p.z_nm)
+            .collect();
+        on_curve.sort_by(f64::total_cmp);
+        let diagram = diagram_at(a0);
+        let mut folds: Vec<(f64, f64)> = diagram
+            .special_points
+            .iter()
+            .filter(|s| s.label == "fold")
+            .map(|s| (s.z_nm, s.precision_nm))
+            .collect();
+        folds.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert_eq!(on_curve.len(), 2, "A0 = {a0}: {on_curve:?}");
+        assert_eq!(folds.len(), 2, "A0 = {a0}: {folds:?}");
+        for (z, (zd, precision)) in on_curve.iter().zip(&folds) {
+            assert!(
+                (z - zd).abs() <= 1e-9 + precision,
+                "A0 = {a0}: map fold Z = {z} vs diagram {zd}"
+            );
+        }
+    }
+    let count = |a0: f64| {
+        diagram_at(a0)
+            .special_points
+            .iter()
+            .filter(|s| s.label == "fold")
+            .count()
+    };
+    assert_eq!(count(cusp - 0.3), 0, "below the cusp at {cusp}");
+    assert_eq!(count(cusp + 0.3), 2, "above the cusp at {cusp}");
+}

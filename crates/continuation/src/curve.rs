@@ -314,6 +314,11 @@ fn half_curve<F: SystemFamily>(
         parameters: (current.solved.u[ip], current.solved.u[iq]),
         error,
     };
+    let (low, high) = settings.second_range;
+    let leaving = current.tangent[iq];
+    if (q_start >= high && leaving > 0.0) || (q_start <= low && leaving < 0.0) {
+        return (points, codim2, end(CurveStop::RangeEnd, &current, None));
+    }
     loop {
         if points.len() >= settings.max_points {
             return (points, codim2, end(CurveStop::MaxPoints, &current, None));
