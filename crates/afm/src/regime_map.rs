@@ -3,7 +3,7 @@
 //! the `(p, Z)` plane with `A/A0` and the phase along them (MODEL.md section 5; the
 //! continuation itself is [`continuation::continue_curve`]).
 //!
-//! ```no_run
+//! ```
 //! use afm::{builtin_case, regime_map, ParameterAxis, RegimeMapSettings, TappingModel};
 //!
 //! // The G2 boundary (onset of two impacts per period) of the Biolever on mica over A0.
@@ -11,13 +11,21 @@
 //! let model = TappingModel::from_case(&case)?;
 //! let settings = RegimeMapSettings {
 //!     labels: Some(vec!["G2".into()]),
-//!     ..RegimeMapSettings::new(&model, 5.0, 20.0)
+//!     at: vec![9.5, 10.5],
+//!     points_per_range: 10,
+//!     ..RegimeMapSettings::new(&model, 9.0, 11.0)
 //! };
 //! let map = regime_map(&case, ParameterAxis::FreeAmplitude, &settings)?;
-//! for point in &map.curves[0].points {
-//!     println!("A0 = {:.3} nm: G2 at Z = {:.6} nm, A/A0 = {:.4}", point.parameter, point.z_nm,
-//!         point.amplitude_ratio);
+//! let g2 = &map.curves[0];
+//! assert_eq!(g2.label, "G2");
+//! for point in g2.points.iter().filter(|p| p.at_fixed_parameter) {
+//!     println!("A0 = {:.3} nm: G2 at Z = {:.9} nm, A/A0 = {:.6}", point.parameter,
+//!         point.z_nm, point.amplitude_ratio);
 //! }
+//! // The boundary spans the range: both ends are range ends, every point is a grazing of the
+//! // second minimum (one impact above it, two below).
+//! assert!(g2.ends.iter().all(|e| e.reason == "range-end"));
+//! assert!(g2.points.iter().all(|p| (p.impacts_before, p.impacts_after) == (1, 2)));
 //! # Ok::<(), afm::AfmError>(())
 //! ```
 

@@ -166,10 +166,8 @@ impl continuation::TwoParametrised for CuspField {
 /// and back to `q = 3` on the other fold (`x = -1, p = 2`): every point on `p^2 = 4 (q/3)^3`
 /// to 1e-8 (the corrector's residual 1e-10 in `x` and in the test function, amplified by the
 /// curve's slope, at most 3 here, plus the integration error 1e-12 relative), both ends on
-/// `q = 3`, one cusp located at `(0, 0)`: the bisection stops at a bracket of 1e-9 in `p` and
-/// `q` around the sign change of `dq/ds`; 1e-6 is a loose bound on the bracket's end point
-/// (the corrector's residual 1e-10 moves `x` by at most 1e-10 / |3 x^2 - q| ... which is
-/// unbounded only at the cusp itself, where the test function, not the residual, fixes it).
+/// `q = 3`, and one cusp located at `(0, 0)` within 1e-6 (the bisection brackets the sign
+/// change of `dq/ds` to 1e-9 in `p` and `q`; the bound is loose).
 #[test]
 fn fold_curve_of_the_cusp_normal_form_is_exact_and_turns_at_the_cusp() {
     use continuation::Codim2Kind;
