@@ -270,7 +270,7 @@ pub fn regime_map(
             continue;
         };
         if let Some(labels) = &settings.labels {
-            if !labels.iter().any(|l| *l == special.label) {
+            if !labels.contains(&special.label) {
                 continue;
             }
         }

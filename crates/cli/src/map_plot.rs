@@ -7,6 +7,9 @@ use afm::{MapCurve, MapPoint, ParameterAxis, RegimeMap};
 
 use crate::plot::{Marker, Panel, Series, Stroke};
 
+/// The vertical coordinate of a panel, read from a curve point.
+type Ordinate = fn(&MapPoint) -> f64;
+
 /// The figure's two panels.
 pub fn map_panels(axis: ParameterAxis, map: &RegimeMap) -> Vec<Panel> {
     let unit = axis.unit();
@@ -15,7 +18,7 @@ pub fn map_panels(axis: ParameterAxis, map: &RegimeMap) -> Vec<Panel> {
     } else {
         format!("{} ({unit})", axis.name())
     };
-    let planes: [(&str, &str, fn(&MapPoint) -> f64); 2] = [
+    let planes: [(&str, &str, Ordinate); 2] = [
         ("Z (nm)", "regime map in (parameter, Z)", |p| p.z_nm),
         ("A/A0", "regime map in (parameter, A/A0)", |p| {
             p.amplitude_ratio

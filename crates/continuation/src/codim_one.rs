@@ -44,6 +44,18 @@ pub enum CodimOneKind {
 /// contact surface belongs to the grazing minimum itself.
 pub(crate) const GRAZING_WINDOW: f64 = 5e-3;
 
+/// The gap `h` and its rate `dh/dt` at a state, with their partial derivatives.
+struct GapAt {
+    /// `[h, dh/dt]`.
+    values: [f64; 2],
+    /// Their gradients in the state (`2 x n`).
+    gradients: DMatrix<f64>,
+    /// Their derivatives along the flow in time.
+    time: [f64; 2],
+    /// Their explicit derivatives in `p`.
+    parameter: [f64; 2],
+}
+
 /// One evaluation of a defining system at `u`.
 #[derive(Debug, Clone)]
 pub(crate) struct Evaluation {
@@ -109,13 +121,7 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
     }
 
     /// `h`, `dh/dt` at `(s, y)` and their derivatives in state, time and `p`.
-    fn gap_at(
-        &self,
-        s: f64,
-        y: &[f64],
-        p: f64,
-        q: f64,
-    ) -> Result<([f64; 2], DMatrix<f64>, [f64; 2], [f64; 2]), ContinuationError> {
+    fn gap_at(&self, s: f64, y: &[f64], p: f64, q: f64) -> Result<GapAt, ContinuationError> {
         let n = y.len();
         let (h, gradient, partials, rate, rate_gradient, rate_t, field) =
             self.problem.with_system(p, q, |system| {
@@ -167,7 +173,12 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
             dot(&gradient, &field) + partials.t,
             dot(&rate_gradient, &field) + rate_t,
         ];
-        Ok(([h, rate], gradients, time, [partials.p, rate_dp]))
+        Ok(GapAt {
+            values: [h, rate],
+            gradients,
+            time,
+            parameter: [partials.p, rate_dp],
+        })
     }
 
     /// The split flows `t0 -> s -> t0 + D` at `(x, p, q)`.
@@ -205,10 +216,15 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
         let monodromy = &b.transition * phi1;
         let yp = DVector::from_column_slice(&a.parameter_sensitivity);
         let pp = &b.transition * &yp + DVector::from_column_slice(&b.parameter_sensitivity);
-        let (values, gradients, time, partial_p) = self.gap_at(s, &a.state, p, q)?;
+        let GapAt {
+            values,
+            gradients,
+            time,
+            parameter: partial_p,
+        } = self.gap_at(s, &a.state, p, q)?;
         let dq = Self::q_step(q);
         let (aq, bq, _) = self.split_flows(x, s, p, q + dq, Sensitivity::None)?;
-        let (values_q, ..) = self.gap_at(s, &aq.state, p, q + dq)?;
+        let values_q = self.gap_at(s, &aq.state, p, q + dq)?.values;
         let m = n + 3;
         let mut residual = DVector::zeros(n + 2);
         let mut jacobian = DMatrix::zeros(n + 2, m);
