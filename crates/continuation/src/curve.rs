@@ -327,16 +327,8 @@ fn half_curve<F: SystemFamily>(
         if tq * step > settings.max_second_step {
             step = settings.max_second_step / tq;
         }
-        let u_pred = &current.solved.u + step * &current.tangent;
-        let target = current.tangent.dot(&u_pred);
-        let solved = match correct(
-            defining,
-            u_pred,
-            &current.tangent,
-            target,
-            &settings.corrector,
-        ) {
-            Ok(Some(solved)) => solved,
+        let (next, range_end) = match advance(defining, &current, step, &targets, settings) {
+            Ok(Some(found)) => found,
             Ok(None) => {
                 if step <= settings.min_step {
                     let error = ContinuationError::StepTooSmall {
@@ -344,36 +336,13 @@ fn half_curve<F: SystemFamily>(
                         step,
                         residual: f64::NAN,
                     };
-                    return (
-                        points,
-                        codim2,
-                        end(CurveStop::StepTooSmall, &current, Some(error)),
-                    );
+                    let stop = end(CurveStop::StepTooSmall, &current, Some(error));
+                    return (points, codim2, stop);
                 }
                 step = (step * settings.step_cut).max(settings.min_step);
                 continue;
             }
             Err(e) => return (points, codim2, end(CurveStop::Error, &current, Some(e))),
-        };
-        let outcome = match finish_step(defining, &current, solved, &targets, settings) {
-            Ok(outcome) => outcome,
-            Err(e) => return (points, codim2, end(CurveStop::Error, &current, Some(e))),
-        };
-        let Some((next, range_end)) = outcome else {
-            if step <= settings.min_step {
-                let error = ContinuationError::StepTooSmall {
-                    parameter: current.solved.u[ip],
-                    step,
-                    residual: f64::NAN,
-                };
-                return (
-                    points,
-                    codim2,
-                    end(CurveStop::StepTooSmall, &current, Some(error)),
-                );
-            }
-            step = (step * settings.step_cut).max(settings.min_step);
-            continue;
         };
         let p = next.solved.u[ip];
         let out_of_range = p < p_low || p > p_high;
@@ -422,6 +391,31 @@ fn half_curve<F: SystemFamily>(
             points.pop();
             return (points, codim2, end(CurveStop::Closed, &current, None));
         }
+    }
+}
+
+/// One predictor-corrector step of arclength `step` from `current`, its tangent turn checked
+/// and the point placed on a crossed target. `Ok(None)`: cut the step. The flag says whether
+/// the point is on an end of the range.
+fn advance<F: SystemFamily>(
+    defining: &Defining<'_, F>,
+    current: &Current,
+    step: f64,
+    targets: &[f64],
+    settings: &CurveSettings,
+) -> Result<Option<(Current, bool)>, ContinuationError> {
+    let u_pred = &current.solved.u + step * &current.tangent;
+    let target = current.tangent.dot(&u_pred);
+    let corrected = correct(
+        defining,
+        u_pred,
+        &current.tangent,
+        target,
+        &settings.corrector,
+    )?;
+    match corrected {
+        Some(solved) => finish_step(defining, current, solved, targets, settings),
+        None => Ok(None),
     }
 }
 
