@@ -347,6 +347,7 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             y_period: Some(PHASE_PERIOD_DEG),
             regions: Vec::new(),
             shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: format!("{case}: amplitude ratio vs separation"),
@@ -357,6 +358,7 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             y_period: None,
             regions: Vec::new(),
             shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ]
 }

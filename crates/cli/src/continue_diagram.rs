@@ -381,6 +381,7 @@ fn panels(
             y_period: Some(PHASE_PERIOD_DEG),
             regions: Vec::new(),
             shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: String::from("A/A0 vs Z"),
@@ -394,6 +395,7 @@ fn panels(
             y_period: None,
             regions: Vec::new(),
             shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: String::from("impacts per period vs Z"),
@@ -407,6 +409,7 @@ fn panels(
             y_period: None,
             regions: Vec::new(),
             shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ]
 }

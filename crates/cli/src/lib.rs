@@ -6,6 +6,7 @@ pub mod approach;
 pub mod cantilever;
 pub mod continue_diagram;
 pub mod digits;
+pub mod grid_overlay;
 pub mod inputs;
 pub mod map;
 pub mod map_plot;

@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::continue_diagram::approach_settings;
+use crate::grid_overlay::read_grid;
 use crate::inputs::orbit_inputs_json;
 use crate::map_plot::map_panels;
 use crate::model_args::{output_path, ModelArgs};
@@ -62,6 +63,10 @@ pub struct MapArgs {
     /// Draw the map in the (PARAM, Z) and (PARAM, A/A0) planes.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// With --plot: draw this `drumroll grid` result (JSON Lines, the same PARAM) as cells
+    /// under the curves, coloured by impacts per period (grey: bistable).
+    #[arg(long, value_name = "FILE.jsonl", requires = "plot")]
+    pub grid_file: Option<PathBuf>,
 }
 
 /// The labels `--labels` accepts: `G<n>` (n >= 1), `fold`, `period-doubling`.
@@ -87,6 +92,11 @@ pub fn run(args: &MapArgs) -> Result<()> {
         .map(|p| output_path(p, "svg", "--plot"))
         .transpose()?;
     let axis = ParameterAxis::parse(&args.vary, case.cantilever.modes.len())?;
+    let grid = args
+        .grid_file
+        .as_ref()
+        .map(|path| read_grid(path, &axis.name()))
+        .transpose()?;
     for label in &args.labels {
         if !valid_label(label) {
             bail!("--labels {label}: allowed G<n> (n >= 1), fold, period-doubling");
@@ -157,7 +167,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         write_atomically(&path, csv_text(&map.curves)?.as_bytes())?;
     }
     if let Some(path) = plot_path {
-        let svg = render_svg(&map_panels(axis, &map), 1, 2, (620, 480))?;
+        let svg = render_svg(&map_panels(axis, &map, grid.as_ref()), 1, 2, (620, 480))?;
         write_atomically(&path, svg.as_bytes())?;
     }
     Ok(())

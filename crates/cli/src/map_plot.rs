@@ -1,32 +1,44 @@
 //! The figure of `drumroll map`: the regime map in the `(p, Z)` and `(p, A/A0)` planes, curves
 //! labelled (stable parts solid, unstable dashed), the regions between consecutive grazing
 //! curves named by their impacts per period, the area inside the fold curves (two stable
-//! orbits: bistable) shaded, and codimension-two points marked.
+//! orbits: bistable) shaded, and codimension-two points marked; under them, optionally, the
+//! cells of a brute-force grid coloured by impacts per period (grey: bistable).
 
 use afm::{MapCurve, MapPoint, ParameterAxis, RegimeMap};
 
+use crate::grid_overlay::{grid_cells, Grid, GridCell};
 use crate::plot::{Marker, Panel, Series, Stroke};
 
 /// The vertical coordinate of a panel, read from a curve point.
 type Ordinate = fn(&MapPoint) -> f64;
+/// The same coordinate read from a grid cell.
+type GridOrdinate = fn(&GridCell) -> f64;
 
-/// The figure's two panels.
-pub fn map_panels(axis: ParameterAxis, map: &RegimeMap) -> Vec<Panel> {
+/// The figure's two panels, with the cells of a brute-force `grid` under the curves if given.
+pub fn map_panels(axis: ParameterAxis, map: &RegimeMap, grid: Option<&Grid>) -> Vec<Panel> {
     let unit = axis.unit();
     let x_label = if unit.is_empty() {
         axis.name()
     } else {
         format!("{} ({unit})", axis.name())
     };
-    let planes: [(&str, &str, Ordinate); 2] = [
-        ("Z (nm)", "regime map in (parameter, Z)", |p| p.z_nm),
-        ("A/A0", "regime map in (parameter, A/A0)", |p| {
-            p.amplitude_ratio
-        }),
+    let planes: [(&str, &str, Ordinate, GridOrdinate); 2] = [
+        (
+            "Z (nm)",
+            "regime map in (parameter, Z)",
+            |p| p.z_nm,
+            |c| c.z_nm,
+        ),
+        (
+            "A/A0",
+            "regime map in (parameter, A/A0)",
+            |p| p.amplitude_ratio,
+            |c| c.amplitude_ratio,
+        ),
     ];
     planes
         .iter()
-        .map(|(y_label, title, y)| Panel {
+        .map(|(y_label, title, y, grid_y)| Panel {
             title: format!("{title} (dashed: unstable; shaded: bistable)"),
             x_label: x_label.clone(),
             y_label: y_label.to_string(),
@@ -54,6 +66,7 @@ pub fn map_panels(axis: ParameterAxis, map: &RegimeMap) -> Vec<Panel> {
             y_period: None,
             regions: region_labels(&map.curves, *y),
             shaded: bistable_polygons(&map.curves, *y),
+            cells: grid.map_or_else(Vec::new, |g| grid_cells(g, *grid_y)),
         })
         .collect()
 }

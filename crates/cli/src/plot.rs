@@ -37,6 +37,18 @@ pub struct Marker {
     pub at: (f64, f64),
 }
 
+/// A filled rectangle in data coordinates (a cell of a brute-force grid), drawn under
+/// everything else in a light tint of a palette colour, or grey for `None`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    /// Horizontal extent `(low, high)`.
+    pub x: (f64, f64),
+    /// Vertical extent `(low, high)`.
+    pub y: (f64, f64),
+    /// Index into the palette, or `None` for grey.
+    pub colour: Option<usize>,
+}
+
 /// One x-y chart of a figure.
 #[derive(Debug, Clone, Default)]
 pub struct Panel {
@@ -59,6 +71,8 @@ pub struct Panel {
     /// Closed polygons in data coordinates filled in a light grey under the series (regions
     /// such as a bistable range).
     pub shaded: Vec<Vec<(f64, f64)>>,
+    /// Filled rectangles drawn first, under the shading and the series.
+    pub cells: Vec<Cell>,
 }
 
 /// The period of a phase axis in degrees (see [`Panel::y_period`]).
@@ -135,6 +149,12 @@ fn data_range(panel: &Panel) -> ((f64, f64), (f64, f64)) {
         .flat_map(|s| s.points.iter().copied())
         .chain(panel.markers.iter().map(|m| m.at))
         .chain(panel.shaded.iter().flatten().copied())
+        .chain(
+            panel
+                .cells
+                .iter()
+                .flat_map(|c| [(c.x.0, c.y.0), (c.x.1, c.y.1)]),
+        )
         .filter(|(x, y)| x.is_finite() && y.is_finite());
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
@@ -180,6 +200,24 @@ where
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(plot_error)?;
+    for cell in &panel.cells {
+        let finite = [cell.x.0, cell.x.1, cell.y.0, cell.y.1]
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite {
+            continue;
+        }
+        let fill = match cell.colour {
+            Some(i) => PALETTE[i % PALETTE.len()].mix(0.25).filled(),
+            None => RGBColor(150, 150, 150).mix(0.5).filled(),
+        };
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(cell.x.0, cell.y.0), (cell.x.1, cell.y.1)],
+                fill,
+            )))
+            .map_err(plot_error)?;
+    }
     for polygon in &panel.shaded {
         let finite: Vec<(f64, f64)> = polygon
             .iter()

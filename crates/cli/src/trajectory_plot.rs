@@ -51,6 +51,7 @@ pub fn trajectory_panels(
             y_period: None,
             regions: Vec::new(),
             shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: String::from("tip-sample force (Hertz)"),
@@ -61,6 +62,7 @@ pub fn trajectory_panels(
             y_period: None,
             regions: Vec::new(),
             shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ])
 }

@@ -176,3 +176,60 @@ fn bad_input_is_refused_with_a_message_naming_the_option() {
         assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
     }
 }
+
+/// A grid file in `drumroll grid`'s format (docs/output-schema.md) is drawn as cells under
+/// the curves: one rectangle per cell, in the tint of its impact count, grey where bistable;
+/// a grid over another parameter is refused naming `--grid-file`.
+#[test]
+fn grid_file_cells_are_drawn_under_the_curves() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let grid = directory.path().join("grid.jsonl");
+    let header = r#"{"case":"biolever-mica","parameter":{"name":"a0","unit":"nm","from":9.9,"to":10.1,"values":[9.9,10.1]},"z_nm":[10.5,8.0]}"#;
+    let row = |r: usize, p: f64| {
+        format!(
+            r#"{{"row":{r},"parameter_value":{p},"first_contact_z_nm":10.0,"cells":[{{"z_nm":10.5,"approach":{{"amplitude_ratio":1.0,"phase_deg":92.0,"multiplicity":1,"impacts_per_orbit":0,"impacts_per_period":0.0,"stable":true,"converged":true}}}},{{"z_nm":8.0,"approach":{{"amplitude_ratio":0.8,"phase_deg":84.0,"multiplicity":1,"impacts_per_orbit":2,"impacts_per_period":2.0,"stable":true,"converged":true}},"bistable":true}}]}}"#
+        )
+    };
+    std::fs::write(
+        &grid,
+        format!("{header}\n{}\n{}\n", row(0, 9.9), row(1, 10.1)),
+    )
+    .expect("grid");
+    let plot = directory.path().join("map.svg");
+    let args = [
+        "map", "--vary", "a0", "--from", "9.9", "--to", "10.1", "--points", "4", "--labels", "G2",
+    ];
+    let output = drumroll()
+        .args(args)
+        .args(["--plot", plot.to_str().expect("utf-8")])
+        .args(["--grid-file", grid.to_str().expect("utf-8")])
+        .output()
+        .expect("runs");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let svg = std::fs::read_to_string(&plot).expect("svg");
+    // Four cells in each of the two planes: two tinted by their impacts, two grey.
+    assert_eq!(svg.matches("opacity=\"0.25\"").count(), 4, "tinted cells");
+    assert_eq!(
+        svg.matches("fill=\"#969696\"").count(),
+        4,
+        "bistable cells in grey"
+    );
+    let other = directory.path().join("other.jsonl");
+    std::fs::write(&other, header.replace("\"a0\"", "\"tip-radius\"")).expect("grid");
+    let output = drumroll()
+        .args(args)
+        .args(["--plot", plot.to_str().expect("utf-8")])
+        .args(["--grid-file", other.to_str().expect("utf-8")])
+        .output()
+        .expect("runs");
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--grid-file") && stderr.contains("tip-radius"),
+        "{stderr}"
+    );
+}
