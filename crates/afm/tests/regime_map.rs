@@ -129,3 +129,59 @@ fn fold_curve_and_cusp_match_independent_diagrams() {
     assert_eq!(count(cusp - 0.3), 0, "below the cusp at {cusp}");
     assert_eq!(count(cusp + 0.3), 2, "above the cusp at {cusp}");
 }
+
+/// Driven at 20 kHz the Biolever on mica has four period doublings on its approach. Their four
+/// curves over `A0 = 9 .. 11 nm` hold, at both ends and at 9.5 and 10.5, the period doublings
+/// an independent approach diagram locates there (same tolerance as above).
+#[test]
+fn period_doubling_curves_match_independent_diagrams() {
+    let mut case = builtin_case("biolever-mica").expect("case");
+    case.drive_frequency_khz = Some(20.0);
+    let model = TappingModel::from_case(&case).expect("model");
+    let at = vec![9.5, 10.5];
+    let settings = RegimeMapSettings {
+        at: at.clone(),
+        labels: Some(vec!["period-doubling".into()]),
+        points_per_range: 4,
+        ..RegimeMapSettings::new(&model, 9.0, 11.0)
+    };
+    let map = regime_map(&case, ParameterAxis::FreeAmplitude, &settings).expect("map");
+    assert_eq!(map.curves.len(), 4);
+    for a0 in [9.0, 9.5, 10.5, 11.0] {
+        let mut on_curves: Vec<f64> = map
+            .curves
+            .iter()
+            .flat_map(|c| {
+                c.points
+                    .iter()
+                    .filter(|p| p.parameter == a0)
+                    .map(|p| p.z_nm)
+            })
+            .collect();
+        on_curves.sort_by(f64::total_cmp);
+        let rebuilt = ParameterAxis::FreeAmplitude
+            .apply(&case, a0)
+            .expect("in range");
+        let model = TappingModel::from_case(&rebuilt).expect("model");
+        let diagram =
+            approach_diagram(&model, &DiagramSettings::approach(&model)).expect("diagram");
+        let mut found: Vec<(f64, f64)> = diagram
+            .special_points
+            .iter()
+            .filter(|s| s.label == "period-doubling")
+            .map(|s| (s.z_nm, s.precision_nm))
+            .collect();
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert_eq!(
+            on_curves.len(),
+            found.len(),
+            "A0 = {a0}: {on_curves:?} vs {found:?}"
+        );
+        for (z, (zd, precision)) in on_curves.iter().zip(&found) {
+            assert!(
+                (z - zd).abs() <= 1e-9 + precision,
+                "A0 = {a0}: map Z = {z} vs diagram {zd}"
+            );
+        }
+    }
+}
