@@ -232,7 +232,9 @@ fn check_range(case: &Case, axis: ParameterAxis, s: &RegimeMapSettings) -> Resul
 /// The regime map of `case` along `axis` over `[settings.from, settings.to]`.
 ///
 /// # Errors
-/// Invalid settings (naming the option), a failed seed diagram, or a curve that cannot start.
+/// Invalid settings (naming the option), a failed seed diagram, or a failed evaluation of a
+/// point's observables. A curve that cannot start is returned without points, its ends saying
+/// why.
 pub fn regime_map(
     case: &Case,
     axis: ParameterAxis,
@@ -290,7 +292,24 @@ pub fn regime_map(
             parameter: z,
             second_parameter: q0,
         };
-        let curve = continue_curve(&problem, kind, &start, &curve_settings)?;
+        // A curve that cannot start is kept, empty, with the reason at both ends.
+        let curve = match continue_curve(&problem, kind, &start, &curve_settings) {
+            Ok(curve) => curve,
+            Err(error) => {
+                let end = CurveEnd {
+                    reason: CurveStop::Error,
+                    parameters: (z, q0),
+                    error: Some(error),
+                };
+                Curve {
+                    kind,
+                    points: Vec::new(),
+                    start_index: 0,
+                    codim2_points: Vec::new(),
+                    ends: [end.clone(), end],
+                }
+            }
+        };
         curves.push((kind, curve, special.label.clone()));
     }
     let mut map_curves = Vec::new();

@@ -189,7 +189,18 @@ fn table(case: &str, axis: ParameterAxis, at: &[f64], map: &RegimeMap) -> String
         let ends: Vec<String> = curve
             .ends
             .iter()
-            .map(|e| format!("{} at {} = {:.6}", e.reason, axis.name(), e.parameter))
+            .map(|e| {
+                let error = e
+                    .error
+                    .as_ref()
+                    .map_or(String::new(), |m| format!(" ({m})"));
+                format!(
+                    "{} at {} = {:.6}{error}",
+                    e.reason,
+                    axis.name(),
+                    e.parameter
+                )
+            })
             .collect();
         let _ = writeln!(
             s,

@@ -86,7 +86,7 @@ pub struct CurveEnd {
     pub reason: CurveStop,
     /// `(p, q)` of the last point.
     pub parameters: (f64, f64),
-    /// The error that stopped it, if any.
+    /// The error that stopped it ([`CurveStop::Error`] only).
     pub error: Option<ContinuationError>,
 }
 
@@ -331,12 +331,7 @@ fn half_curve<F: SystemFamily>(
             Ok(Some(found)) => found,
             Ok(None) => {
                 if step <= settings.min_step {
-                    let error = ContinuationError::StepTooSmall {
-                        parameter: current.solved.u[ip],
-                        step,
-                        residual: f64::NAN,
-                    };
-                    let stop = end(CurveStop::StepTooSmall, &current, Some(error));
+                    let stop = end(CurveStop::StepTooSmall, &current, None);
                     return (points, codim2, stop);
                 }
                 step = (step * settings.step_cut).max(settings.min_step);
