@@ -41,6 +41,7 @@ pub mod orbit_prediction;
 pub mod parameter_axis;
 pub mod phase;
 pub mod quasi_static;
+pub mod regime_map;
 pub mod sample;
 pub mod separation;
 pub mod steady_orbit;
@@ -74,8 +75,11 @@ pub use observables::{
     GapMinimumKind, Harmonic, Impact, OrbitObservables, PeriodObserver, NEAR_IMPACT_FRACTION,
 };
 pub use orbit_prediction::{hermite_state, tangent_state};
-pub use parameter_axis::{ParameterAxis, PARAMETER_NAMES};
+pub use parameter_axis::{CaseFamily, ParameterAxis, PARAMETER_NAMES};
 pub use quasi_static::{quasi_static_row, QuasiStaticCell, QuasiStaticRow};
+pub use regime_map::{
+    regime_map, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap, RegimeMapSettings,
+};
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{

@@ -6,7 +6,9 @@
 use std::fmt;
 use std::str::FromStr;
 
-use crate::validation::{check, Interval};
+use continuation::SystemFamily;
+
+use crate::validation::{check, ranges, Interval};
 use crate::{AfmError, Case, TappingModel};
 
 /// The quantity varied along a map's parameter axis. Each is a field of a [`Case`]; the model
@@ -64,17 +66,65 @@ impl ParameterAxis {
     }
 
     /// The physical range of the values: the range the case, cantilever and sample files
-    /// accept for the field (a drive frequency must besides lie within `[f_1 / 100, 100 f_N]`,
-    /// which depends on the cantilever and is checked by [`ParameterAxis::apply`]'s model).
+    /// accept for the field ([`crate::validation::ranges`]; a drive frequency must besides lie
+    /// within `[f_1 / 100, 100 f_N]`, which depends on the cantilever: see
+    /// [`ParameterAxis::physical_range`]).
     fn range(self) -> Interval {
         match self {
-            Self::FreeAmplitude => Interval::positive(1e5, "nm"),
-            Self::DriveFrequency => Interval::closed(1e-2, 1e6, "kHz"),
-            Self::SampleModulus => Interval::positive(1e4, "GPa"),
-            Self::TipRadius => Interval::positive(1e5, "nm"),
-            Self::QualityFactor(_) => Interval::closed(1e-3, 1e6, ""),
-            Self::Stiffness(_) => Interval::closed(1e-6, 1e6, "N/m"),
+            Self::FreeAmplitude => ranges::FREE_AMPLITUDE_NM,
+            Self::DriveFrequency => ranges::FREQUENCY_KHZ,
+            Self::SampleModulus => ranges::YOUNGS_MODULUS_GPA,
+            Self::TipRadius => ranges::TIP_RADIUS_NM,
+            Self::QualityFactor(_) => ranges::QUALITY_FACTOR,
+            Self::Stiffness(_) => ranges::STIFFNESS_N_PER_M,
         }
+    }
+
+    /// Parse a name of [`PARAMETER_NAMES`] given as the option `--vary` for a case whose
+    /// cantilever has `modes` modes.
+    ///
+    /// # Errors
+    /// [`AfmError::InvalidField`] naming `--vary` and the allowed names (with the modes the
+    /// cantilever has).
+    pub fn parse(name: &str, modes: usize) -> Result<Self, AfmError> {
+        let unknown = || AfmError::InvalidField {
+            file: String::from("command line"),
+            field: String::from("--vary"),
+            value: name.to_string(),
+            allowed: format!(
+                "one of {} (N: a mode number from 1 to {modes}, the cantilever's modes)",
+                PARAMETER_NAMES.join(", ")
+            ),
+        };
+        let axis: Self = name.parse().map_err(|_| unknown())?;
+        match axis {
+            Self::QualityFactor(mode) | Self::Stiffness(mode) if mode > modes => Err(unknown()),
+            _ => Ok(axis),
+        }
+    }
+
+    /// The physical range of the values for `case`: the file range of the field, and for the
+    /// drive frequency its intersection with the model's `[f_1 / 100, 100 f_N]`
+    /// ([`crate::Cantilever::drive_frequency_range_khz`]).
+    pub fn physical_range(self, case: &Case) -> Interval {
+        let range = self.range();
+        match self {
+            Self::DriveFrequency => {
+                let (low, high) = case.cantilever.drive_frequency_range_khz();
+                Interval::closed(low.max(range.min), high.min(range.max), range.unit)
+            }
+            _ => range,
+        }
+    }
+
+    /// Whether `value` lies in [`ParameterAxis::physical_range`] for `case`.
+    pub fn allows(self, case: &Case, value: f64) -> bool {
+        self.physical_range(case).contains(value)
+    }
+
+    /// [`ParameterAxis::physical_range`] in words, e.g. `[0.001, 100000] nm`.
+    pub fn describe_range(self, case: &Case) -> String {
+        self.physical_range(case).describe()
     }
 
     /// Check that `value` lies in the axis's physical range; the error names `source` (e.g. the
@@ -198,6 +248,33 @@ impl FromStr for ParameterAxis {
     }
 }
 
+/// The models of a case along a [`ParameterAxis`]: the [`SystemFamily`] a regime map's curves
+/// are continued over (the first parameter of each member is the separation `Z`, nm).
+#[derive(Debug, Clone)]
+pub struct CaseFamily {
+    /// The case at its own parameter value.
+    pub case: Case,
+    /// The varied input.
+    pub axis: ParameterAxis,
+}
+
+impl CaseFamily {
+    /// The model at parameter value `value` (separation at first contact).
+    ///
+    /// # Errors
+    /// As [`ParameterAxis::model`].
+    pub fn model_at(&self, value: f64) -> Result<TappingModel, AfmError> {
+        self.axis.model(&self.case, value, "regime map")
+    }
+}
+
+impl SystemFamily for CaseFamily {
+    type System = TappingModel;
+    fn system_at(&self, q: f64) -> Result<TappingModel, String> {
+        self.model_at(q).map_err(|e| e.to_string())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,7 +315,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            message.contains("--to") && message.contains("(0, 10000] GPa"),
+            message.contains("--to") && message.contains(&ranges::YOUNGS_MODULUS_GPA.describe()),
             "{message}"
         );
         let message = ParameterAxis::DriveFrequency

@@ -346,6 +346,9 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             series: both(|r| (r.amplitude_ratio, r.phase_deg)),
             markers: Vec::new(),
             y_period: Some(PHASE_PERIOD_DEG),
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: format!("{case}: amplitude ratio vs separation"),
@@ -354,6 +357,9 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             series: both(|r| (r.z_nm, r.amplitude_ratio)),
             markers: Vec::new(),
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ]
 }

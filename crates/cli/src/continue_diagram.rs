@@ -158,13 +158,29 @@ fn reached_end(
     Ok(())
 }
 
-/// The approach's settings for `model` from `args`, every option checked against
-/// [`crate::option_ranges`] (`--floor` in `[-A0, Z_G1)`, `--max-step` in `(0, A0]`).
+/// The approach's settings for `model` from `continue`'s options, every option checked
+/// against [`crate::option_ranges`] (see [`approach_settings`]; `--max-points` besides).
 pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<DiagramSettings> {
-    option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
+    let mut settings =
+        approach_settings(model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    settings.max_points = option_ranges::MAX_POINTS.count(args.max_points)?;
+    Ok(settings)
+}
+
+/// The approach diagram's settings of `model` with the options `--floor` (in `[-A0, Z_G1)`),
+/// `--min-amplitude-ratio` and `--max-step` (in `(0, A0]`) applied, each checked against
+/// [`crate::option_ranges`] (errors name the option and its range); shared by `continue` and
+/// `map`.
+pub fn approach_settings(
+    model: &TappingModel,
+    floor: Option<f64>,
+    min_amplitude_ratio: f64,
+    max_step: Option<f64>,
+) -> Result<DiagramSettings> {
+    option_ranges::MIN_AMPLITUDE_RATIO.check(min_amplitude_ratio)?;
     let mut settings = DiagramSettings::approach(model);
     let a0 = model.free_amplitude_nm();
-    if let Some(floor) = args.floor {
+    if let Some(floor) = floor {
         OptionRange::new(
             "--floor",
             Interval::right_open(-a0, model.grazing_separation_nm(), "nm"),
@@ -172,12 +188,11 @@ pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<Dia
         .check(floor)?;
         settings.z_limit_nm = floor;
     }
-    settings.min_amplitude_ratio = args.min_amplitude_ratio;
-    if let Some(step) = args.max_step {
+    settings.min_amplitude_ratio = min_amplitude_ratio;
+    if let Some(step) = max_step {
         OptionRange::new("--max-step", Interval::positive(a0, "nm")).check(step)?;
         settings.max_step = step;
     }
-    settings.max_points = option_ranges::MAX_POINTS.count(args.max_points)?;
     Ok(settings)
 }
 
@@ -466,6 +481,9 @@ fn panels(
                 .collect(),
             markers: phase_markers,
             y_period: Some(PHASE_PERIOD_DEG),
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: String::from("A/A0 vs Z"),
@@ -477,6 +495,9 @@ fn panels(
                 .collect(),
             markers: z_markers,
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: String::from("impacts per period vs Z"),
@@ -488,6 +509,9 @@ fn panels(
                 .collect(),
             markers: Vec::new(),
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ]
 }

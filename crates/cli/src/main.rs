@@ -27,6 +27,10 @@ enum Command {
     /// The bifurcation diagram in Z: periodic orbits continued from above first contact down
     /// to a floor, grazing points G1, G2, G3, ..., folds and period doubling located.
     Continue(drumroll::continue_diagram::ContinueArgs),
+    /// The impact-regime map over a second parameter (a0, drive-frequency, sample-modulus,
+    /// tip-radius, quality-factor-N, stiffness-N): the G_n, fold and period-doubling points of
+    /// the approach continued over a range, in the (PARAM, Z) and (PARAM, A/A0) planes.
+    Map(drumroll::map::MapArgs),
     /// A time-domain approach (and retract) sweep at a constant rate, read by a lock-in once
     /// per drive cycle (or block of cycles); the records stream out as CSV or JSON Lines.
     Approach(drumroll::approach::ApproachArgs),
@@ -47,6 +51,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => drumroll::simulate::run(args),
         Command::Continue(args) => drumroll::continue_diagram::run(args),
+        Command::Map(args) => drumroll::map::run(args),
         Command::Approach(args) => drumroll::approach::run(args),
         Command::Theory(args) => drumroll::theory::run(args),
         Command::Grid(args) => drumroll::grid::run(args),

@@ -37,6 +37,18 @@ pub struct Marker {
     pub at: (f64, f64),
 }
 
+/// A filled rectangle in data coordinates (a cell of a brute-force grid), drawn under
+/// everything else in a light tint of a palette colour, or grey for `None`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    /// Horizontal extent `(low, high)`.
+    pub x: (f64, f64),
+    /// Vertical extent `(low, high)`.
+    pub y: (f64, f64),
+    /// Index into the palette, or `None` for grey.
+    pub colour: Option<usize>,
+}
+
 /// One x-y chart of a figure.
 #[derive(Debug, Clone, Default)]
 pub struct Panel {
@@ -54,6 +66,13 @@ pub struct Panel {
     /// wrapped to `(-180, 180]`): a line is broken, not drawn, between consecutive points more
     /// than `p / 2` apart, so that a wrap does not draw a vertical line across the chart.
     pub y_period: Option<f64>,
+    /// Text written at data positions without a marker (region names such as `1 impact`).
+    pub regions: Vec<Marker>,
+    /// Closed polygons in data coordinates filled in a light grey under the series (regions
+    /// such as a bistable range).
+    pub shaded: Vec<Vec<(f64, f64)>>,
+    /// Filled rectangles drawn first, under the shading and the series.
+    pub cells: Vec<Cell>,
 }
 
 /// The period of a phase axis in degrees (see [`Panel::y_period`]).
@@ -129,6 +148,13 @@ fn data_range(panel: &Panel) -> ((f64, f64), (f64, f64)) {
         .iter()
         .flat_map(|s| s.points.iter().copied())
         .chain(panel.markers.iter().map(|m| m.at))
+        .chain(panel.shaded.iter().flatten().copied())
+        .chain(
+            panel
+                .cells
+                .iter()
+                .flat_map(|c| [(c.x.0, c.y.0), (c.x.1, c.y.1)]),
+        )
         .filter(|(x, y)| x.is_finite() && y.is_finite());
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
@@ -174,6 +200,39 @@ where
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(plot_error)?;
+    for cell in &panel.cells {
+        let finite = [cell.x.0, cell.x.1, cell.y.0, cell.y.1]
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite {
+            continue;
+        }
+        let fill = match cell.colour {
+            Some(i) => PALETTE[i % PALETTE.len()].mix(0.25).filled(),
+            None => RGBColor(150, 150, 150).mix(0.5).filled(),
+        };
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(cell.x.0, cell.y.0), (cell.x.1, cell.y.1)],
+                fill,
+            )))
+            .map_err(plot_error)?;
+    }
+    for polygon in &panel.shaded {
+        let finite: Vec<(f64, f64)> = polygon
+            .iter()
+            .copied()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .collect();
+        if finite.len() >= 3 {
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    finite,
+                    RGBColor(200, 200, 200).mix(0.6).filled(),
+                )))
+                .map_err(plot_error)?;
+        }
+    }
     let mut legend = false;
     for series in &panel.series {
         let colour = PALETTE[series.colour % PALETTE.len()];
@@ -225,6 +284,15 @@ where
                 marker.label.clone(),
                 marker.at,
                 ("sans-serif", 14).into_font(),
+            )))
+            .map_err(plot_error)?;
+    }
+    for region in &panel.regions {
+        chart
+            .draw_series(std::iter::once(Text::new(
+                region.label.clone(),
+                region.at,
+                ("sans-serif", 15).into_font().color(&RGBColor(90, 90, 90)),
             )))
             .map_err(plot_error)?;
     }

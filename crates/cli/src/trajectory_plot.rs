@@ -49,6 +49,9 @@ pub fn trajectory_panels(
             series: vec![series("", |s| s.u_nm)],
             markers: Vec::new(),
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: String::from("tip-sample force (Hertz)"),
@@ -57,6 +60,9 @@ pub fn trajectory_panels(
             series: vec![series("", |s| s.force_nn)],
             markers: Vec::new(),
             y_period: None,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ])
 }

@@ -257,11 +257,11 @@ fn bad_options_are_refused_by_name() {
                 "a0, drive-frequency, sample-modulus, tip-radius, quality-factor-N, stiffness-N",
             ],
         ),
-        (&[("--from", "-1")], &[], &["--from", "(0, 100000] nm"]),
+        (&[("--from", "-1")], &[], &["--from", "[0.001, 100000] nm"]),
         (
             &[("--vary", "sample-modulus"), ("--to", "2e4")],
             &[],
-            &["--to", "(0, 10000] GPa"],
+            &["--to", "[1e-7, 10000] GPa"],
         ),
         (
             &[

@@ -190,6 +190,28 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
     ])];
     printed.extend(check(&schema, "`drumroll continue --json`", &continued));
 
+    // map: the MAClever on mica over Q_1 (a closed fold curve with two cusps), with --at and
+    // --labels.
+    let mapped = [one(&[
+        "map",
+        "--case",
+        "maclever-mica",
+        "--vary",
+        "quality-factor-1",
+        "--from",
+        "1",
+        "--to",
+        "8",
+        "--at",
+        "2,3",
+        "--labels",
+        "G1,fold",
+        "--points",
+        "10",
+        "--json",
+    ])];
+    printed.extend(check(&schema, "`drumroll map --json`", &mapped));
+
     // approach, JSON Lines: the inputs line, then records of both directions.
     let text = stdout_of(&[
         "approach",
@@ -328,6 +350,47 @@ fn csv_columns_are_the_documented_json_keys_in_order() {
         .filter(|word| header.contains(word))
         .collect();
     assert_eq!(listed, header);
+
+    // map's CSV: `label`, then the documented point keys in order.
+    let map_csv = directory.path().join("map.csv");
+    stdout_of(&[
+        "map",
+        "--vary",
+        "a0",
+        "--from",
+        "9.9",
+        "--to",
+        "10.1",
+        "--points",
+        "4",
+        "--labels",
+        "G2",
+        "--csv",
+        map_csv.to_str().expect("utf-8 path"),
+    ]);
+    let written = std::fs::read_to_string(&map_csv).expect("CSV");
+    let header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    assert_eq!(header[0], "label");
+    let curve_points = &schema["`drumroll map --json`"];
+    for column in &header[1..] {
+        let types = curve_points
+            .get(&format!("curves[].points[].{column}"))
+            .unwrap_or_else(|| panic!("map CSV column `{column}` is no JSON point key"));
+        assert!(!types.contains("array") && !types.contains("object"));
+    }
+    let section = text
+        .split("## `drumroll map --csv FILE`")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .expect("the map CSV section");
+    let listed: Vec<&str> = section
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|word| header.contains(word))
+        .collect();
+    assert_eq!(listed, header);
+    assert!(written.lines().skip(1).all(|l| l.starts_with("G2,")));
 
     // approach's CSV header is the documented line, each column a record key.
     let sweep = stdout_of(&["approach", "--from", "8.8", "--to", "8.79", "--rate", "10"]);
