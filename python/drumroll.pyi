@@ -97,6 +97,25 @@ class Case:
         cycle, z_nm, amplitude_ratio, phase_deg, impacts_per_period, peak_force_nn (nN),
         direction; a DataFrame's attrs["inputs"] holds the inputs. Releases the GIL; Ctrl-C
         stops it."""
+    def map(
+        self,
+        vary: str,
+        start: float,
+        stop: float,
+        *,
+        at: Optional[Sequence[float]] = None,
+        labels: Optional[Sequence[str]] = None,
+        points: int = 100,
+        floor: Optional[float] = None,
+        min_amplitude_ratio: float = 0.3,
+        max_step: Optional[float] = None,
+    ) -> "RegimeMap":
+        """The impact-regime map, as `drumroll map`: each special point of the approach
+        diagram (G_n, fold, period-doubling; or those in `labels`) continued over `vary`
+        ("a0" nm, "drive-frequency" kHz, "sample-modulus" GPa, "tip-radius" nm,
+        "quality-factor-N", "stiffness-N" N/m) from the case's value over [start, stop],
+        exactly at each value of `at`, at least `points` points per curve. Releases the
+        GIL."""
     def to_dict(self) -> Dict[str, Any]:
         """The case in the case files' format, cantilever and sample inline."""
     @classmethod
@@ -209,6 +228,29 @@ class Diagram:
     @classmethod
     def from_dict(cls, data: Dict[str, Any]) -> "Diagram":
         """A diagram from its dict (or a saved `continue --json` file's content)."""
+
+class RegimeMap:
+    """An impact-regime map, as `drumroll map --json`. Pickles."""
+
+    @property
+    def curves(self) -> Dict[str, Table]:
+        """Each curve's points by label: parameter (its unit), z_nm (nm), amplitude_ratio,
+        phase_deg (deg), impacts_before, impacts_after, stable, spectral_radius, residual,
+        at_fixed_parameter, floquet_multipliers, state."""
+    @property
+    def ends(self) -> Dict[str, List[Dict[str, Any]]]:
+        """Each curve's ends by label: reason, parameter, z_nm (nm), error."""
+    @property
+    def codim2_points(self) -> List[Dict[str, Any]]:
+        """The codimension-two points met on the curves."""
+    @property
+    def parameter_info(self) -> Dict[str, Any]:
+        """name, unit, from, to, case_value of the varied parameter."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The `drumroll map --json` object."""
+    @classmethod
+    def from_dict(cls, data: Dict[str, Any]) -> "RegimeMap":
+        """A map from its dict (or a saved `map --json` file's content)."""
 
 def cases() -> Dict[str, Dict[str, Dict[str, Any]]]:
     """The built-in fixtures: {"cases": {...}, "cantilevers": {...}, "samples": {...}}, each

@@ -113,3 +113,36 @@ def test_cases_lists_the_built_in_fixtures():
     case_dict = fixtures["cases"]["maclever-soft"]
     assert case_dict["cantilever"] == inputs["cantilever"]
     assert case_dict["sample"] == inputs["sample"]
+
+
+def test_regime_map_equals_map_json():
+    case = drumroll.Case("biolever-mica")
+    regime = case.map(vary="a0", start=9.0, stop=11.0, at=[10.5], points=10)
+    expected = cli_json(
+        "map", "--case", "biolever-mica", "--vary", "a0", "--from", "9", "--to", "11",
+        "--at", "10.5", "--points", "10", "--json",
+    )
+    assert regime.to_dict() == expected
+    assert set(regime.curves) == {c["label"] for c in expected["curves"]}
+    for curve in expected["curves"]:
+        table = regime.curves[curve["label"]]
+        assert list(table["parameter"]) == [p["parameter"] for p in curve["points"]]
+        assert list(table["z_nm"]) == [p["z_nm"] for p in curve["points"]]
+        assert regime.ends[curve["label"]] == curve["ends"]
+    assert regime.codim2_points == expected["codim2_points"]
+    assert regime.parameter_info["case_value"] == 10.0
+
+
+def test_regime_map_of_chosen_labels_and_its_errors():
+    case = drumroll.Case("biolever-mica")
+    regime = case.map(vary="sample-modulus", start=50.0, stop=70.0, labels=["G2"], points=5)
+    assert regime.to_dict() == cli_json(
+        "map", "--case", "biolever-mica", "--vary", "sample-modulus", "--from", "50", "--to",
+        "70", "--labels", "G2", "--points", "5", "--json",
+    )
+    with pytest.raises(ValueError, match="--labels G9"):
+        case.map(vary="a0", start=9.0, stop=11.0, labels=["G9"])
+    with pytest.raises(ValueError, match="--labels bump"):
+        case.map(vary="a0", start=9.0, stop=11.0, labels=["bump"])
+    with pytest.raises(ValueError):
+        case.map(vary="colour", start=9.0, stop=11.0)

@@ -30,3 +30,4 @@ def test_figure2_notebook_executes(tmp_path):
     outputs = [o for cell in notebook.cells if cell.cell_type == "code" for o in cell.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     assert (tmp_path / "figure2.png").stat().st_size > 10_000
+    assert (tmp_path / "regime_map.png").stat().st_size > 10_000

@@ -23,6 +23,8 @@ def test_case_orbit_and_diagram_pickle_to_equal_objects():
     np.testing.assert_array_equal(u0, u1)
     diagram = drumroll.Case("biolever-mica").diagram(min_amplitude_ratio=0.8)
     assert pickle.loads(pickle.dumps(diagram)).to_dict() == diagram.to_dict()
+    regime = drumroll.Case("biolever-mica").map(vary="a0", start=9.5, stop=10.5, points=4)
+    assert pickle.loads(pickle.dumps(regime)).to_dict() == regime.to_dict()
 
 
 def test_time_series_samples_the_orbit():

@@ -2,7 +2,7 @@
 //! fold and period-doubling points of the approach diagram continued from the case's own value
 //! over a range (`afm::regime_map`), as curves in the `(p, Z)` and `(p, A/A0)` planes.
 
-use afm::{regime_map, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings};
+use afm::{regime_map, Case, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
@@ -97,68 +97,10 @@ pub fn run(args: &MapArgs) -> Result<()> {
         .as_ref()
         .map(|path| read_grid(path, &axis.name()))
         .transpose()?;
-    for label in &args.labels {
-        if !valid_label(label) {
-            bail!("--labels {label}: allowed G<n> (n >= 1), fold, period-doubling");
-        }
-    }
-    if args.points < 2 || args.points > 100_000 {
-        bail!("--points {}: allowed 2 ..= 100000", args.points);
-    }
-    let diagram = approach_settings(&model, args.floor, args.min_amplitude_ratio, args.max_step)?;
-    let settings = RegimeMapSettings {
-        diagram,
-        from: args.from,
-        to: args.to,
-        at: args.at.clone(),
-        labels: (!args.labels.is_empty()).then(|| args.labels.clone()),
-        points_per_range: args.points,
-    };
-    let map = regime_map(&case, axis, &settings)
-        .with_context(|| format!("regime map of case `{}` failed", case.name))?;
-    if !args.labels.is_empty() {
-        for label in &args.labels {
-            if !map.curves.iter().any(|c| c.label == *label) {
-                let found: Vec<&str> = map
-                    .seed
-                    .special_points
-                    .iter()
-                    .map(|s| s.label.as_str())
-                    .collect();
-                bail!(
-                    "--labels {label}: the approach at the case's {} = {} has no such point (it has: {})",
-                    axis.name(),
-                    map.seed_parameter,
-                    found.join(", ")
-                );
-            }
-        }
-    }
+    let settings = map_settings(args, &model)?;
+    let map = compute_map(&case, axis, &settings)?;
     if args.json {
-        let options = json!({
-            "vary": axis.name(),
-            "from": args.from,
-            "to": args.to,
-            "at": args.at,
-            "labels": args.labels,
-            "points": args.points,
-            "floor_nm": settings.diagram.z_limit_nm,
-            "min_amplitude_ratio": settings.diagram.min_amplitude_ratio,
-            "max_step_nm": settings.diagram.max_step,
-        });
-        let object = json!({
-            "case": case.name,
-            "inputs": orbit_inputs_json("map", options, &case, &model, &settings.diagram.orbit),
-            "parameter": {
-                "name": axis.name(),
-                "unit": axis.unit(),
-                "from": args.from,
-                "to": args.to,
-                "case_value": map.seed_parameter,
-            },
-            "curves": map.curves,
-            "codim2_points": map.codim2_points,
-        });
+        let object = map_json(args, &case, &model, axis, &settings, &map);
         println!("{}", serde_json::to_string(&object)?);
     } else {
         print!("{}", table(&case.name, axis, &args.at, &map));
@@ -171,6 +113,92 @@ pub fn run(args: &MapArgs) -> Result<()> {
         write_atomically(&path, svg.as_bytes())?;
     }
     Ok(())
+}
+
+/// The settings of the map of `model` from `map`'s options, every option checked (errors name
+/// the option and its allowed values).
+pub fn map_settings(args: &MapArgs, model: &TappingModel) -> Result<RegimeMapSettings> {
+    for label in &args.labels {
+        if !valid_label(label) {
+            bail!("--labels {label}: allowed G<n> (n >= 1), fold, period-doubling");
+        }
+    }
+    if args.points < 2 || args.points > 100_000 {
+        bail!("--points {}: allowed 2 ..= 100000", args.points);
+    }
+    let diagram = approach_settings(model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    Ok(RegimeMapSettings {
+        diagram,
+        from: args.from,
+        to: args.to,
+        at: args.at.clone(),
+        labels: (!args.labels.is_empty()).then(|| args.labels.clone()),
+        points_per_range: args.points,
+    })
+}
+
+/// The regime map of `case` over `axis` with `settings` ([`afm::regime_map`]); an error when a
+/// curve asked for by its label does not start at the case's own value.
+pub fn compute_map(
+    case: &Case,
+    axis: ParameterAxis,
+    settings: &RegimeMapSettings,
+) -> Result<RegimeMap> {
+    let map = regime_map(case, axis, settings)
+        .with_context(|| format!("regime map of case `{}` failed", case.name))?;
+    for label in settings.labels.iter().flatten() {
+        if !map.curves.iter().any(|c| c.label == *label) {
+            let found: Vec<&str> = map
+                .seed
+                .special_points
+                .iter()
+                .map(|s| s.label.as_str())
+                .collect();
+            bail!(
+                "--labels {label}: the approach at the case's {} = {} has no such point (it has: {})",
+                axis.name(),
+                map.seed_parameter,
+                found.join(", ")
+            );
+        }
+    }
+    Ok(map)
+}
+
+/// The `map --json` object of `map`, computed from `args` with `settings`
+/// (docs/output-schema.md).
+pub fn map_json(
+    args: &MapArgs,
+    case: &Case,
+    model: &TappingModel,
+    axis: ParameterAxis,
+    settings: &RegimeMapSettings,
+    map: &RegimeMap,
+) -> serde_json::Value {
+    let options = json!({
+        "vary": axis.name(),
+        "from": args.from,
+        "to": args.to,
+        "at": args.at,
+        "labels": args.labels,
+        "points": args.points,
+        "floor_nm": settings.diagram.z_limit_nm,
+        "min_amplitude_ratio": settings.diagram.min_amplitude_ratio,
+        "max_step_nm": settings.diagram.max_step,
+    });
+    json!({
+        "case": case.name,
+        "inputs": orbit_inputs_json("map", options, case, model, &settings.diagram.orbit),
+        "parameter": {
+            "name": axis.name(),
+            "unit": axis.unit(),
+            "from": args.from,
+            "to": args.to,
+            "case_value": map.seed_parameter,
+        },
+        "curves": map.curves,
+        "codim2_points": map.codim2_points,
+    })
 }
 
 /// The readable summary: per curve its ends and its points at the range ends, the `--at`

@@ -259,6 +259,43 @@ impl Case {
         crate::approach::compute_approach(py, &self.resolved, &options)
     }
 
+    /// The impact-regime map, as `drumroll map`: every special point of the case's approach
+    /// diagram (G_n, fold, period doubling; or those named in `labels`) continued as a curve
+    /// over the parameter `vary` (`"a0"` nm, `"drive-frequency"` kHz, `"sample-modulus"` GPa,
+    /// `"tip-radius"` nm, `"quality-factor-N"`, `"stiffness-N"` N/m for mode N) from the
+    /// case's own value over [`start`, `stop`], with a point exactly at each value of `at`
+    /// and at least `points` points per curve over the range. `floor`,
+    /// `min_amplitude_ratio` and `max_step` set the seed approach as in `diagram`. Runs
+    /// without the GIL.
+    #[pyo3(signature = (vary, start, stop, *, at=None, labels=None, points=100, floor=None, min_amplitude_ratio=0.3, max_step=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn map(
+        &self,
+        py: Python<'_>,
+        vary: String,
+        start: f64,
+        stop: f64,
+        at: Option<Vec<f64>>,
+        labels: Option<Vec<String>>,
+        points: usize,
+        floor: Option<f64>,
+        min_amplitude_ratio: f64,
+        max_step: Option<f64>,
+    ) -> PyResult<crate::regime_map::RegimeMap> {
+        let options = crate::regime_map::MapOptions {
+            vary,
+            start,
+            stop,
+            at: at.unwrap_or_default(),
+            labels: labels.unwrap_or_default(),
+            points,
+            floor,
+            min_amplitude_ratio,
+            max_step,
+        };
+        crate::regime_map::compute_regime_map(py, &self.resolved, options)
+    }
+
     /// The case as a dict in the case files' format, the cantilever and the sample inline
     /// (`Case.from_dict` builds it back).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

@@ -12,6 +12,7 @@ pub mod diagram;
 pub mod errors;
 pub mod interrupt;
 pub mod orbit;
+pub mod regime_map;
 pub mod resolved;
 
 use pyo3::prelude::*;
@@ -67,6 +68,7 @@ fn drumroll_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<case::Case>()?;
     m.add_class::<orbit::Orbit>()?;
     m.add_class::<diagram::Diagram>()?;
+    m.add_class::<regime_map::RegimeMap>()?;
     m.add_function(wrap_pyfunction!(cases, m)?)?;
     m.add_function(wrap_pyfunction!(orbit::_restore_orbit, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
