@@ -21,6 +21,7 @@ pub mod amplitude_ratio;
 pub mod bifurcation_diagram;
 pub mod cantilever;
 pub mod case;
+pub mod contact;
 mod contact_series;
 pub mod drive;
 pub mod eigenmode;

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::cantilever::DEFAULT_POISSON_RATIO;
+use crate::contact::{ContactSpec, ElectrostaticSpec};
 use crate::validation::{check, check_name, Interval};
 use crate::AfmError;
 
@@ -24,6 +25,13 @@ pub struct Sample {
     /// Poisson ratio `nu_s`; range (-1, 0.5]; default 0.3 (the paper's note 15).
     #[serde(default = "default_poisson_ratio")]
     pub poisson_ratio: f64,
+    /// The contact law (MODEL.md section 9); absent: Hertz with a spherical tip.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSpec>,
+    /// An electrostatic double layer added to the contact law (MODEL.md section 9); absent:
+    /// none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub electrostatic: Option<ElectrostaticSpec>,
 }
 
 impl Sample {
@@ -41,6 +49,13 @@ impl Sample {
             "poisson_ratio",
             self.poisson_ratio,
             Interval::left_open(-1.0, 0.5, ""),
-        )
+        )?;
+        if let Some(contact) = &self.contact {
+            contact.validate(file)?;
+        }
+        if let Some(electrostatic) = &self.electrostatic {
+            electrostatic.validate(file)?;
+        }
+        Ok(())
     }
 }

@@ -8,19 +8,22 @@ use hybrid::{
 };
 use nalgebra::DMatrix;
 
-use super::{TappingModel, FREE_FLIGHT};
+use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
 use crate::contact_series;
 use crate::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::phase;
 
+/// Offered only when no force acts outside contact ([`HybridSystem::accelerations`]): then
+/// every mode outside contact (`FREE_FLIGHT`, and a clipped Kelvin-Voigt law's free mode on
+/// the clipped side of its release surface) is the force-free Eq. 1.
 impl ExactFlow for TappingModel {
     fn has_exact_flow(&self, mode: Mode) -> bool {
-        mode == FREE_FLIGHT
+        mode & CONTACT == FREE_FLIGHT
     }
 
     /// A quarter of the shortest of the drive period and the modal periods `2 pi / w_i`, us.
     fn exact_step_limit(&self, mode: Mode) -> f64 {
-        if mode == FREE_FLIGHT {
+        if mode & CONTACT == FREE_FLIGHT {
             self.exact_step_limit
         } else {
             f64::INFINITY
@@ -122,6 +125,9 @@ impl ExactFlow for TappingModel {
     }
 }
 
+/// Offered only for the plain Hertz sphere ([`HybridSystem::accelerations`]): the series of
+/// module `contact_series` expand `c (-d)^{3/2}`; every other law's contact is integrated by
+/// the adaptive Runge-Kutta path.
 impl TaylorExpansion for TappingModel {
     /// In contact, 40: the contact flow's Taylor series come from the recurrences of automatic
     /// differentiation (module `contact_series`), whose intermediate series live on the stack.
@@ -179,14 +185,18 @@ impl TaylorExpansion for TappingModel {
 }
 
 impl SwitchingStructure for TappingModel {
-    /// In contact the Hertz force is `c (-d)^{3/2}`: the gap is the half-power surface of
-    /// the contact mode, and the solver integrates next to contact onset and release in the
-    /// square root of the time from them.
+    /// In contact the Hertz sphere's force is `c (-d)^{3/2}` (DMT's, Kelvin-Voigt's and the
+    /// film's have half-integer powers of `d_c - d` too): the contact surface is the
+    /// half-power surface of the contact mode (not of a clipped mode, whose force is zero, nor
+    /// of the cone's or punch's integer powers), and the solver integrates next to contact
+    /// onset and release in the square root of the time from them.
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
-        Self::in_contact(mode).then_some(0)
+        (Self::in_contact(mode) && !Self::is_clipped(mode) && self.force.law.half_power_inside())
+            .then_some(GAP_SURFACE)
     }
 
-    /// The gap `Z(t) + sum_i q_i` is affine: `Z(t)` is a constant or a linear ramp.
+    /// The gap `Z(t) + sum_i q_i` is affine (`Z(t)` is a constant or a linear ramp), and so
+    /// are `h_0 = d - d_c` and `h_1 = -d - tau d'`.
     fn switching_is_affine(&self, _k: usize) -> bool {
         true
     }
@@ -197,16 +207,18 @@ impl SwitchingStructure for TappingModel {
     /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
     /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
     /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
-    /// (extrema inside the sample, the gap's minima, are always wanted).
+    /// (extrema inside the sample, the gap's minima, are always wanted), and `None` for the
+    /// release surface and wherever a force acts outside contact (the bound assumes
+    /// `F_ts = 0`).
     fn switching_curvature_bound(
         &self,
-        _k: usize,
+        k: usize,
         mode: Mode,
         t0: f64,
         x0: &[f64],
         _dt: f64,
     ) -> Option<f64> {
-        if Self::in_contact(mode) {
+        if Self::in_contact(mode) || k != GAP_SURFACE || self.force.acts_outside_contact() {
             return None;
         }
         let w = self.drive.angular_frequency;
