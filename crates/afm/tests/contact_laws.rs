@@ -79,7 +79,10 @@ fn hertz_shapes_match_their_closed_forms() {
         let s: f64 = -d;
         let cone_exact = 2.0 / PI * E * 20f64.to_radians().tan() * s * s;
         assert!(close(cone.force(d, 0.0), cone_exact, 1e-14), "cone at {d}");
-        assert!(close(punch.force(d, 0.0), 2.0 * E * 5.0 * s, 1e-14), "punch at {d}");
+        assert!(
+            close(punch.force(d, 0.0), 2.0 * E * 5.0 * s, 1e-14),
+            "punch at {d}"
+        );
         check_slopes(&cone, true, false, d, 0.0);
         check_slopes(&punch, true, false, d, 0.0);
     }
@@ -105,7 +108,10 @@ fn dmt_matches_its_closed_form_and_is_continuous_at_a0() {
     // H R / 6 in nN nm: H (J) * 1e18.
     let scale = h_j * 1e18 * R / 6.0;
     for d in [0.165, 0.3, 1.0, 5.0] {
-        assert!(close(law.force(d, 0.0), -scale / (d * d), 1e-14), "outside at {d}");
+        assert!(
+            close(law.force(d, 0.0), -scale / (d * d), 1e-14),
+            "outside at {d}"
+        );
         check_slopes(&law, false, false, d, 0.0);
     }
     for d in [0.1, -0.5, -2.0] {
@@ -145,7 +151,10 @@ fn kelvin_voigt_matches_its_closed_form_clips_and_reduces_to_hertz() {
         let s_rate = -rate;
         // (4/3) sqrt(R) [E* s^{3/2} + eta* (3/2) s^{1/2} s'], eta* in nN us/nm^2.
         let exact = 4.0 / 3.0 * R.sqrt() * (E * s.powf(1.5) + eta * 1e-3 * 1.5 * s.sqrt() * s_rate);
-        assert!(close(unclipped.force(d, rate), exact, 1e-13), "at ({d}, {rate})");
+        assert!(
+            close(unclipped.force(d, rate), exact, 1e-13),
+            "at ({d}, {rate})"
+        );
         assert!(close(clipped.force(d, rate), exact.max(0.0), 1e-13));
         check_slopes(&unclipped, true, false, d, rate);
     }
@@ -165,7 +174,13 @@ fn kelvin_voigt_matches_its_closed_form_clips_and_reduces_to_hertz() {
     assert!(unclipped.force(-1e-14, -1.0).abs() < 1e-6);
     let d = -0.5;
     let release_rate = -d / 0.15; // -d - tau d' = 0
-    assert!(unclipped.in_region(true, false, d, release_rate).force.abs() < 1e-12);
+    assert!(
+        unclipped
+            .in_region(true, false, d, release_rate)
+            .force
+            .abs()
+            < 1e-12
+    );
     // eta = 0: Hertz.
     let elastic = alone(ContactLaw::KelvinVoigt(kelvin_voigt(0.0, true)));
     let hertz = alone(ContactLaw::Hertz(sphere()));
@@ -194,9 +209,13 @@ fn film_matches_its_closed_form_and_tends_to_hertz_for_thick_films() {
         for d in [-0.05, -0.5, -2.0] {
             let s: f64 = -d;
             let chi = (R * s).sqrt() / 6.0;
-            let p = a[0] + a[1] * chi + a[2] * chi.powi(2) + a[3] * chi.powi(3) + a[4] * chi.powi(4);
+            let p =
+                a[0] + a[1] * chi + a[2] * chi.powi(2) + a[3] * chi.powi(3) + a[4] * chi.powi(4);
             let exact = 4.0 / 3.0 * E * R.sqrt() * s.powf(1.5) * p;
-            assert!(close(film(6.0).force(d, 0.0), exact, 1e-13), "{correction:?} at {d}");
+            assert!(
+                close(film(6.0).force(d, 0.0), exact, 1e-13),
+                "{correction:?} at {d}"
+            );
             check_slopes(&film(6.0), true, false, d, 0.0);
             // h -> infinity: the correction's first term, a_1 chi, vanishes like 1/h.
             for h in [1e3, 1e6, 1e9] {
@@ -229,7 +248,11 @@ fn double_layer_matches_its_closed_form_and_is_held_inside_contact() {
     }
     // Inside contact: Hertz plus the double layer's value at d = 0.
     let hertz = alone(ContactLaw::Hertz(sphere()));
-    assert!(close(force.force(-1.0, 0.0), hertz.force(-1.0, 0.0) + amplitude, 1e-13));
+    assert!(close(
+        force.force(-1.0, 0.0),
+        hertz.force(-1.0, 0.0) + amplitude,
+        1e-13
+    ));
     assert!(force.acts_outside_contact());
 }
 
@@ -253,19 +276,34 @@ fn sample_files_parse_default_and_check_the_contact_object() {
             r#"{"law": "dmt", "hamaker_constant_j": 1e-20, "intermolecular_distance_nm": 0}"#,
             "contact.intermolecular_distance_nm",
         ),
-        (r#"{"law": "kelvin-voigt", "viscosity_pa_s": -1}"#, "contact.viscosity_pa_s"),
-        (r#"{"law": "film", "thickness_nm": 0}"#, "contact.thickness_nm"),
-        (r#"{"law": "hertz", "tip_shape": "cone"}"#, "contact.cone_half_angle_deg"),
+        (
+            r#"{"law": "kelvin-voigt", "viscosity_pa_s": -1}"#,
+            "contact.viscosity_pa_s",
+        ),
+        (
+            r#"{"law": "film", "thickness_nm": 0}"#,
+            "contact.thickness_nm",
+        ),
+        (
+            r#"{"law": "hertz", "tip_shape": "cone"}"#,
+            "contact.cone_half_angle_deg",
+        ),
         (
             r#"{"law": "hertz", "tip_shape": "flat-punch", "punch_radius_nm": 1e9}"#,
             "contact.punch_radius_nm",
         ),
-        (r#"{"law": "hertz", "cone_half_angle_deg": 20}"#, "contact.cone_half_angle_deg"),
+        (
+            r#"{"law": "hertz", "cone_half_angle_deg": 20}"#,
+            "contact.cone_half_angle_deg",
+        ),
     ];
     for (contact, field) in cases {
         let text = format!(r#"{{"name": "s", "youngs_modulus_gpa": 1, "contact": {contact}}}"#);
         let error = parse_sample("bad.json", &text).unwrap_err().to_string();
-        assert!(error.contains("bad.json") && error.contains(field), "{error}");
+        assert!(
+            error.contains("bad.json") && error.contains(field),
+            "{error}"
+        );
     }
     for text in [
         r#"{"law": "magic"}"#,
@@ -278,6 +316,11 @@ fn sample_files_parse_default_and_check_the_contact_object() {
     let electrostatic = r#"{"name": "s", "youngs_modulus_gpa": 1, "electrostatic":
         {"debye_length_nm": 1, "tip_charge_c_per_m2": 2, "sample_charge_c_per_m2": 0.01,
          "relative_permittivity": 80}}"#;
-    let error = parse_sample("bad.json", electrostatic).unwrap_err().to_string();
-    assert!(error.contains("electrostatic.tip_charge_c_per_m2"), "{error}");
+    let error = parse_sample("bad.json", electrostatic)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("electrostatic.tip_charge_c_per_m2"),
+        "{error}"
+    );
 }

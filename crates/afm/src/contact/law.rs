@@ -129,7 +129,13 @@ impl TipSampleForce {
     /// The force and slopes on one side: inside contact (`inside`), with the contact law
     /// zeroed when `clipped`, or outside. The double layer adds `F_dl(d)` outside and its
     /// value on the contact surface, `F_dl(d_c)`, inside (held constant).
-    pub fn in_region(&self, inside: bool, clipped: bool, gap_nm: f64, gap_rate: f64) -> ForceSlopes {
+    pub fn in_region(
+        &self,
+        inside: bool,
+        clipped: bool,
+        gap_nm: f64,
+        gap_rate: f64,
+    ) -> ForceSlopes {
         let mut total = match (inside, clipped) {
             (true, true) => ForceSlopes::ZERO,
             (true, false) => self.law.inside(gap_nm, gap_rate),
