@@ -87,9 +87,11 @@ fn orbit(
     }
 }
 
-/// The warning printed when the drive is not at `w_1` (Eq. 3's assumption), else `None`.
+/// The warning printed when the drive is not at `w_1` (Eq. 3's assumption) or a force acts
+/// outside contact (DMT, a double layer: Eqs. 3-4 assume force-free flight between impacts;
+/// MODEL.md section 9), else `None`.
 pub fn assumption_warning(model: &TappingModel, comparison: &TheoryComparison) -> Option<String> {
-    (!comparison.theory.drive_at_fundamental).then(|| {
+    let drive = (!comparison.theory.drive_at_fundamental).then(|| {
         format!(
             "the drive ({:.4} kHz) is not at f_1 = {:.4} kHz: Eqs. 3-4 assume w = w_1 and do not \
              hold here (computed anyway with a_0 at the actual drive); the first-harmonic balance \
@@ -98,7 +100,17 @@ pub fn assumption_warning(model: &TappingModel, comparison: &TheoryComparison) -
             model.cantilever().fundamental_frequency_khz(),
             comparison.measurement.harmonic_balance_impulse_nn_us
         )
-    })
+    });
+    let outside = model.contact_force().acts_outside_contact().then(|| {
+        "the sample's contact law acts outside contact (van der Waals or double layer): \
+         Eqs. 3-4 assume short impacts and force-free flight between them and do not apply \
+         (MODEL.md section 9); computed anyway"
+            .to_string()
+    });
+    match (drive, outside) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    }
 }
 
 /// The JSON object of `drumroll theory --json` (units in the key names; NaN as null).
