@@ -59,8 +59,8 @@ fn hertz_shapes_match_their_closed_forms() {
     // (4/3) E* sqrt(R) delta^{3/2} at delta = 1 nm: 4.2164 nN (the number).
     let law = alone(ContactLaw::Hertz(sphere()));
     assert!((law.force(-1.0, 0.0) - 4.2164).abs() < 5e-5);
-    for d in [-3.0, -1.0, -0.2, -1e-3] {
-        let exact = 4.0 / 3.0 * E * R.sqrt() * (-d as f64).powf(1.5);
+    for d in [-3.0f64, -1.0, -0.2, -1e-3] {
+        let exact = 4.0 / 3.0 * E * R.sqrt() * (-d).powf(1.5);
         assert!(close(law.force(d, 0.0), exact, 1e-14), "sphere at {d}");
         check_slopes(&law, true, false, d, 0.0);
     }
@@ -114,8 +114,8 @@ fn dmt_matches_its_closed_form_and_is_continuous_at_a0() {
         );
         check_slopes(&law, false, false, d, 0.0);
     }
-    for d in [0.1, -0.5, -2.0] {
-        let exact = 4.0 / 3.0 * E * R.sqrt() * (a0 - d as f64).powf(1.5) - scale / (a0 * a0);
+    for d in [0.1f64, -0.5, -2.0] {
+        let exact = 4.0 / 3.0 * E * R.sqrt() * (a0 - d).powf(1.5) - scale / (a0 * a0);
         assert!(close(law.force(d, 0.0), exact, 1e-14), "inside at {d}");
         check_slopes(&law, true, false, d, 0.0);
     }
