@@ -33,6 +33,13 @@ impl FilmCorrection {
     pub const VALID_CHI: f64 = 1.0;
 }
 
+impl FilmContact {
+    /// The deepest indentation inside the correction's range, `s = h^2 / R` (`chi = 1`), nm.
+    pub fn deepest_valid_indentation_nm(&self) -> f64 {
+        self.indentation_at_chi(FilmCorrection::VALID_CHI)
+    }
+}
+
 /// A film of thickness `h` on a rigid substrate: `F = (4/3) E* sqrt(R) s^{3/2} P(chi)`,
 /// `chi = sqrt(R s) / h`, `s = max(-d, 0)`, `P` the [`FilmCorrection`]; written as
 /// `F = c sum_k b_k s^{(3+k)/2}` with `b_k = a_k (sqrt(R)/h)^k`. As `h -> infinity`, Hertz.
