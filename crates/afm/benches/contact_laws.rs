@@ -63,7 +63,9 @@ fn main() {
         ("hertz", None),
         (
             "dmt",
-            Some(r#"{"law": "dmt", "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}"#),
+            Some(
+                r#"{"law": "dmt", "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}"#,
+            ),
         ),
         (
             "kelvin-voigt",

@@ -22,8 +22,8 @@ pub struct DmtContact {
 }
 
 impl DmtContact {
-    /// `H R / 6`, nN nm.
-    fn adhesion_scale(&self) -> f64 {
+    /// `A = H R / 6`, nN nm (the van der Waals force is `-A / d^2`).
+    pub fn adhesion_scale(&self) -> f64 {
         self.hamaker_constant_j * JOULE_IN_NN_NM * self.tip_radius_nm / 6.0
     }
 
@@ -44,10 +44,15 @@ impl DmtContact {
         }
     }
 
+    /// The Hertz coefficient `c = (4/3) E* sqrt(R)`, nN/nm^{3/2}.
+    pub fn hertz_coefficient(&self) -> f64 {
+        4.0 / 3.0 * self.effective_modulus_gpa * self.tip_radius_nm.sqrt()
+    }
+
     /// Inside contact: `F = c s^{3/2} - H R/(6 a0^2)` with `s = max(a0 - d, 0)`,
     /// `c = (4/3) E* sqrt(R)`; `dF/dd = -1.5 c s^{1/2}`.
     pub fn inside(&self, gap_nm: f64) -> ForceSlopes {
-        let c = 4.0 / 3.0 * self.effective_modulus_gpa * self.tip_radius_nm.sqrt();
+        let c = self.hertz_coefficient();
         let s = (self.intermolecular_distance_nm - gap_nm).max(0.0);
         let root = s.sqrt();
         ForceSlopes {

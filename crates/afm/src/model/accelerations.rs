@@ -9,7 +9,8 @@ use hybrid::{
 use nalgebra::DMatrix;
 
 use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
-use crate::contact_series;
+use crate::contact::ContactLaw;
+use crate::contact_series::{self, SeriesForce};
 use crate::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::phase;
 
@@ -125,40 +126,73 @@ impl ExactFlow for TappingModel {
     }
 }
 
-/// Offered only for the plain Hertz sphere ([`HybridSystem::accelerations`]): the series of
-/// module `contact_series` expand `c (-d)^{3/2}`; every other law's contact is integrated by
-/// the adaptive Runge-Kutta path.
-impl TaylorExpansion for TappingModel {
-    /// In contact, 40: the contact flow's Taylor series come from the recurrences of automatic
-    /// differentiation (module `contact_series`), whose intermediate series live on the stack.
-    fn taylor_order_limit(&self, mode: Mode) -> usize {
+impl TappingModel {
+    /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
+    /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
+    /// outside it (van der Waals, when `H > 0`); `None` for every other law, mode, or with a
+    /// double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
+    pub(crate) fn series_force(&self, mode: Mode) -> Option<SeriesForce> {
+        if self.plain_hertz {
+            return Self::in_contact(mode).then_some(SeriesForce::Hertz {
+                coefficient: self.hertz.coefficient,
+                contact_gap: 0.0,
+                constant: 0.0,
+            });
+        }
+        let (ContactLaw::Dmt(dmt), None) = (self.force.law, self.force.double_layer) else {
+            return None;
+        };
         if Self::in_contact(mode) {
+            Some(SeriesForce::Hertz {
+                coefficient: dmt.hertz_coefficient(),
+                contact_gap: dmt.intermolecular_distance_nm,
+                constant: dmt.adhesion_force_nn(),
+            })
+        } else {
+            (dmt.hamaker_constant_j != 0.0).then_some(SeriesForce::VanDerWaals {
+                scale: dmt.adhesion_scale(),
+            })
+        }
+    }
+}
+
+/// Offered for the plain Hertz sphere (its contact) and DMT (its contact and, with `H > 0`,
+/// its free flight) ([`HybridSystem::accelerations`]): the series of module `contact_series`.
+/// Every other law integrates by the adaptive Runge-Kutta path.
+impl TaylorExpansion for TappingModel {
+    /// Where [`TappingModel::series_force`] has a force, 40: the Taylor series come from the
+    /// recurrences of automatic differentiation (module `contact_series`), whose intermediate
+    /// series live on the stack.
+    fn taylor_order_limit(&self, mode: Mode) -> usize {
+        if self.series_force(mode).is_some() {
             contact_series::MAX_ORDER
         } else {
             0
         }
     }
 
-    /// In contact, the series of Eq. 1 with the Hertz force in the step's clock (module
-    /// `contact_series`); `false` in free flight (which has its exact flow).
+    /// The series of Eq. 1 with the mode's force in the step's clock (module
+    /// `contact_series`); `false` where the mode has none (the Hertz free flight has its exact
+    /// flow).
     fn taylor_series(
         &self,
         mode: Mode,
         clock: &ClockPolynomial,
         series: &mut TaylorSeries,
     ) -> bool {
-        Self::in_contact(mode)
-            && contact_series::contact_state_series(
+        self.series_force(mode).is_some_and(|force| {
+            contact_series::contact_state_series(
                 &self.modes,
-                self.hertz.coefficient,
+                force,
                 self.drive.angular_frequency,
                 &self.separation,
                 clock,
                 series,
             )
+        })
     }
 
-    /// In contact, the series of the variational equations along the contact series (module
+    /// Where the mode has a series, the series of the variational equations along it (module
     /// `contact_series`).
     fn taylor_tangents(
         &self,
@@ -169,10 +203,10 @@ impl TaylorExpansion for TappingModel {
         parameter_column: bool,
         scratch: &mut Vec<f64>,
     ) {
-        if Self::in_contact(mode) {
+        if let Some(force) = self.series_force(mode) {
             contact_series::contact_tangent_series(
                 &self.modes,
-                self.hertz.coefficient,
+                force,
                 &self.separation,
                 clock,
                 state,

@@ -146,13 +146,13 @@ impl HybridSystem for TappingModel {
         }
     }
 
-    /// The free flight's closed-form flow (where no force acts outside contact), the plain
-    /// Hertz contact's Taylor series, and the surfaces' shape (affine; the gap's curvature
+    /// The free flight's closed-form flow (where no force acts outside contact), the Taylor
+    /// series of the plain Hertz contact and of DMT (`TappingModel::series_force`), and the surfaces' shape (affine; the gap's curvature
     /// bounded in force-free flight; a half-power surface in contact).
     fn accelerations(&self) -> Accelerations<'_> {
         Accelerations {
             exact_flow: (!self.force.acts_outside_contact()).then_some(self as _),
-            taylor: self.plain_hertz.then_some(self as _),
+            taylor: Some(self),
             switching: Some(self),
         }
     }
