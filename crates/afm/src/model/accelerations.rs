@@ -229,6 +229,51 @@ impl SwitchingStructure for TappingModel {
             .then_some(GAP_SURFACE)
     }
 
+    /// Kelvin-Voigt in contact (unclipped side): `F = c s^{1/2} (s + tau s')` has
+    /// `dF/dd = -c s^{-1/2} (1.5 s + 0.5 tau s')`, whose part `-0.5 c tau s' s^{-1/2}` is
+    /// unbounded at the crossing; there `s = |s'| sigma^2` on the square-root clock, so
+    /// `(dt/dsigma) dF/dd -> K = -c tau sign(s') |s'|^{1/2}` (`s' = -d'`, nm/us), and the
+    /// limit of `(dt/dsigma) J v` is `(w_i^2/k_i) K sum_j v_{q_j}` on each `v_i` row (`+ K`
+    /// times `(w_i^2/k_i)` on the parameter column, `dd/dZ = 1`), zero on the `q_i` rows.
+    /// Every other law's Jacobian is bounded next to its surface: `false`.
+    fn crossing_tangent_limit(
+        &self,
+        mode: Mode,
+        _t: f64,
+        x: &[f64],
+        tangents: &[f64],
+        tangent_rates: &mut [f64],
+        parameter_column: bool,
+    ) -> bool {
+        let ContactLaw::KelvinVoigt(kv) = self.force.law else {
+            return false;
+        };
+        if !Self::in_contact(mode) || Self::is_clipped(mode) {
+            return false;
+        }
+        let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
+        let indentation_rate = -self.gap_rate(x);
+        let limit =
+            -c * kv.release_time_us() * indentation_rate.signum() * indentation_rate.abs().sqrt();
+        let n = self.dim();
+        let columns = tangents.len() / n;
+        for (column, (v, rate)) in tangents
+            .chunks_exact(n)
+            .zip(tangent_rates.chunks_exact_mut(n))
+            .enumerate()
+        {
+            let mut gap_change: f64 = v.iter().step_by(2).sum();
+            if parameter_column && column + 1 == columns {
+                gap_change += 1.0;
+            }
+            for (m, rows) in self.modes.iter().zip(rate.chunks_exact_mut(2)) {
+                rows[0] = 0.0;
+                rows[1] = m.omega_squared_over_stiffness * limit * gap_change;
+            }
+        }
+        true
+    }
+
     /// The gap `Z(t) + sum_i q_i` is affine (`Z(t)` is a constant or a linear ramp), and so
     /// are `h_0 = d - d_c` and `h_1 = -d - tau d'`.
     fn switching_is_affine(&self, _k: usize) -> bool {
