@@ -487,6 +487,3 @@ impl TangentRecurrence<'_> {
 /// The widest block of tangent columns [`TangentRecurrence::run`] handles at once (`2N + 1`
 /// columns for `N` up to 3 in one).
 const COLUMN_BLOCK: usize = 8;
-
-#[cfg(test)]
-mod tests;

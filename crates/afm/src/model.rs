@@ -7,6 +7,8 @@ use std::f64::consts::PI;
 use hybrid::{HybridSystem, Mode};
 
 mod accelerations;
+#[cfg(test)]
+mod contact_series_tests;
 mod hybrid_system;
 #[cfg(test)]
 mod tests;

@@ -5,7 +5,6 @@
 use std::f64::consts::PI;
 
 use super::ForceSlopes;
-use crate::HertzContact;
 
 /// The tip's shape.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,18 +37,6 @@ pub struct HertzShape {
 }
 
 impl HertzShape {
-    /// The sphere's law as the paper's [`HertzContact`] (`c = (4/3) E* sqrt(R)`), `None` for
-    /// another shape.
-    pub fn sphere(&self) -> Option<HertzContact> {
-        match self.tip {
-            HertzTip::Sphere { radius_nm } => Some(HertzContact::from_modulus(
-                self.effective_modulus_gpa,
-                radius_nm,
-            )),
-            _ => None,
-        }
-    }
-
     /// Whether the force has half-integer powers of the indentation (the sphere).
     pub fn has_half_powers(&self) -> bool {
         matches!(self.tip, HertzTip::Sphere { .. })
@@ -61,7 +48,8 @@ impl HertzShape {
         let e = self.effective_modulus_gpa;
         let (force, slope) = match self.tip {
             HertzTip::Sphere { radius_nm } => {
-                let c = HertzContact::from_modulus(e, radius_nm).coefficient;
+                // c = (4/3) E* sqrt(R), as `HertzContact::from_modulus` forms it.
+                let c = 4.0 / 3.0 * e * radius_nm.sqrt();
                 let root = indentation.sqrt();
                 (c * indentation * root, -1.5 * c * root)
             }
