@@ -203,3 +203,46 @@ fn dmt_grazing_matches_the_brute_force_bisection() {
 fn clipped_kelvin_voigt_grazing_matches_the_brute_force_bisection() {
     check_grazing(r#"{"law": "kelvin-voigt", "viscosity_pa_s": 100}"#);
 }
+
+/// The Hertz limits at orbit level: DMT with H = 0 is Hertz shifted to `d = a0` (its orbit at
+/// `Z + a0` is Hertz's at `Z`) and Kelvin-Voigt with eta = 0 is Hertz: A/A0 and phase agree
+/// with the Hertz sphere's to 1e-9 (the solver's tolerance is 1e-12). A film's correction is
+/// `a_1 sqrt(R s) / h` to first order: its orbit's distance from Hertz's falls like `1/h`
+/// (by 10 +- 2 from h = 1e4 to 1e5 nm, the top of the thickness range).
+#[test]
+fn limits_reproduce_the_hertz_orbit() {
+    let z = 8.5;
+    let settings = SteadyOrbitSettings::default();
+    let observe = |contact: &str, z: f64| {
+        let model = model_with(contact, z);
+        let orbit = steady_orbit(&model, z, OrbitStart::Approach, &settings).unwrap();
+        assert!(orbit.converged, "{contact}");
+        let o = orbit.observables();
+        (o.amplitude_ratio, o.phase_deg)
+    };
+    let hertz = observe(r#"{"law": "hertz"}"#, z);
+    let exact = [
+        (
+            r#"{"law": "dmt", "hamaker_constant_j": 0, "intermolecular_distance_nm": 0.165}"#,
+            z + 0.165,
+        ),
+        (r#"{"law": "kelvin-voigt", "viscosity_pa_s": 0}"#, z),
+    ];
+    for (contact, at) in exact {
+        let (ratio, phase) = observe(contact, at);
+        assert!(
+            (ratio - hertz.0).abs() < 1e-9 && (phase - hertz.1).abs() < 1e-9,
+            "{contact}: ({ratio}, {phase}) vs Hertz {hertz:?}"
+        );
+    }
+    let film_phase_offset = |thickness: f64| {
+        let contact = format!(r#"{{"law": "film", "thickness_nm": {thickness}}}"#);
+        observe(&contact, z).1 - hertz.1
+    };
+    let (thick, thicker) = (film_phase_offset(1e4), film_phase_offset(1e5));
+    let ratio = thick / thicker;
+    assert!(
+        (8.0..12.0).contains(&ratio),
+        "{thick:e} then {thicker:e}: ratio {ratio}"
+    );
+}

@@ -82,12 +82,15 @@ impl ContactLaw {
         matches!(self, Self::Dmt(dmt) if dmt.hamaker_constant_j != 0.0)
     }
 
-    /// The release time constant `tau = 1.5 eta*/E*` (us) of a clipped Kelvin-Voigt law, whose
-    /// force-zero surface `h_1 = -d - tau d' = 0` is a second switching surface; `None` for
-    /// every other law.
+    /// The release time constant `tau = 1.5 eta*/E*` (us) of a clipped Kelvin-Voigt law with
+    /// `eta > 0`, whose force-zero surface `h_1 = -d - tau d' = 0` is a second switching
+    /// surface; `None` for every other law.
     pub fn release_time_us(&self) -> Option<f64> {
         match self {
-            Self::KelvinVoigt(kv) if kv.clip => Some(kv.release_time_us()),
+            // With eta = 0 the force is Hertz's, never negative: no release surface.
+            Self::KelvinVoigt(kv) if kv.clip && kv.effective_viscosity_pa_s > 0.0 => {
+                Some(kv.release_time_us())
+            }
             _ => None,
         }
     }
