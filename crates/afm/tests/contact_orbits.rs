@@ -153,17 +153,18 @@ fn film_orbit_matches_the_brute_force() {
     check_orbit(r#"{"law": "film", "thickness_nm": 6}"#, 8.5);
 }
 
-/// G2 of `contact` from `drumroll continue`'s diagram against a bisection in Z on the
-/// brute-force orbit's gap minimum nearest the surface (each orbit 12 periods from the
-/// diagram's state at G2: the Biolever's transients decay by over 1e-13 in that time).
-fn check_grazing(contact: &str) {
+/// The grazing `label` of `contact` from `drumroll continue`'s diagram against a bisection in
+/// Z on the brute-force orbit's gap minimum nearest the surface (each orbit 12 periods from
+/// the diagram's state at the grazing: the Biolever's transients decay by over 1e-13 in that
+/// time).
+fn check_grazing(contact: &str, label: &str) {
     let model = model_with(contact, 9.0);
     let diagram = approach_diagram(&model, &DiagramSettings::approach(&model)).unwrap();
     let g2 = diagram
         .special_points
         .iter()
-        .find(|p| p.label == "G2")
-        .expect("G2 on the approach");
+        .find(|p| p.label == label)
+        .expect("the grazing on the approach");
     assert!(g2.converged);
     let nearest = |z: f64| {
         let mut at = model.clone();
@@ -196,12 +197,23 @@ fn check_grazing(contact: &str) {
 fn dmt_grazing_matches_the_brute_force_bisection() {
     check_grazing(
         r#"{"law": "dmt", "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}"#,
+        "G2",
+    );
+}
+
+/// DMT's first contact, moved from the force-free estimate `Z_G1 + a0` by the van der Waals
+/// attraction of the free flight.
+#[test]
+fn dmt_first_contact_matches_the_brute_force_bisection() {
+    check_grazing(
+        r#"{"law": "dmt", "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}"#,
+        "G1",
     );
 }
 
 #[test]
 fn clipped_kelvin_voigt_grazing_matches_the_brute_force_bisection() {
-    check_grazing(r#"{"law": "kelvin-voigt", "viscosity_pa_s": 100}"#);
+    check_grazing(r#"{"law": "kelvin-voigt", "viscosity_pa_s": 100}"#, "G2");
 }
 
 /// The Hertz limits at orbit level: DMT with H = 0 is Hertz shifted to `d = a0` (its orbit at
