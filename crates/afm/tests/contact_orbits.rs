@@ -258,3 +258,10 @@ fn limits_reproduce_the_hertz_orbit() {
         "{thick:e} then {thicker:e}: ratio {ratio}"
     );
 }
+
+/// The clipped law's first contact, a double grazing (`d = 0`, `d' = 0` also puts the state on
+/// the release surface `h_1 = -d - tau d' = 0`): located, converged, and at the brute force's Z.
+#[test]
+fn clipped_kelvin_voigt_first_contact_matches_the_brute_force_bisection() {
+    check_grazing(r#"{"law": "kelvin-voigt", "viscosity_pa_s": 100}"#, "G1");
+}
