@@ -97,6 +97,14 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     } else {
         None
     };
+    let orbits = approach
+        .points
+        .iter()
+        .chain(retract.iter().flat_map(|r| r.points.iter()))
+        .map(|point| (point.z_nm, point.min_gap_nm));
+    if let Some(warning) = afm::film_range_warning(&model, orbits) {
+        eprintln!("warning: {warning}");
+    }
     let bistable = retract.as_ref().map(|retract| {
         let mut ranges = approach.bistable_ranges();
         ranges.extend(retract.bistable_ranges());
