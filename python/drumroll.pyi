@@ -22,7 +22,10 @@ class Case:
     `Case("biolever-mica")`: a built-in case or a case file path.
     `Case(cantilever="biolever", sample="soft", a0=10.0)`: a cantilever and a sample (built-in
     names, file paths, or dicts in the files' format). `a0` and `drive_frequency_khz` override
-    a named case's values; `Case()` is `biolever-mica`. Bad input raises ValueError (unknown
+    a named case's values; `Case()` is `biolever-mica`. `contact` and `electrostatic` (dicts in
+    the sample files' format, MODEL.md section 9, e.g. `contact={"law": "dmt",
+    "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}`) set the sample's
+    contact law and double layer (default: the sample's own, Hertz). Bad input raises ValueError (unknown
     name, out-of-range value: the message names the field and its allowed range) or
     TypeError; a file that cannot be read raises OSError. Pickles (travels to Dask workers).
     """
@@ -35,6 +38,8 @@ class Case:
         sample: Union[str, Dict[str, Any], None] = None,
         a0: Optional[float] = None,
         drive_frequency_khz: Optional[float] = None,
+        contact: Optional[Dict[str, Any]] = None,
+        electrostatic: Optional[Dict[str, Any]] = None,
     ) -> None: ...
     @property
     def name(self) -> str:

@@ -146,3 +146,38 @@ def test_regime_map_of_chosen_labels_and_its_errors():
         case.map(vary="a0", start=9.0, stop=11.0, labels=["bump"])
     with pytest.raises(ValueError):
         case.map(vary="colour", start=9.0, stop=11.0)
+
+
+DMT = {"law": "dmt", "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}
+
+
+def test_contact_law_given_in_python_equals_a_sample_file_with_it(tmp_path):
+    soft = drumroll.cases()["samples"]["soft"]
+    path = tmp_path / "soft.json"
+    path.write_text(json.dumps(dict(soft, contact=DMT)))
+    expected = cli_json(
+        "simulate", "--cantilever", "biolever", "--sample", str(path), "--a0", "10", "--z", "8",
+        "--json",
+    )
+    by_keyword = drumroll.Case(cantilever="biolever", sample="soft", a0=10.0, contact=DMT)
+    by_dict = drumroll.Case(cantilever="biolever", sample=dict(soft, contact=DMT), a0=10.0)
+    by_file = drumroll.Case(cantilever="biolever", sample=str(path), a0=10.0)
+    for case in (by_keyword, by_dict, by_file):
+        assert case.orbit(z=8.0).to_dict() == expected
+    assert expected["inputs"]["sample"]["contact"]["law"] == "dmt"
+    hertz = drumroll.Case(cantilever="biolever", sample="soft", a0=10.0).orbit(z=8.0)
+    assert hertz.phase_deg != expected["phase_deg"]
+    with pytest.raises(ValueError, match="contact"):
+        drumroll.Case(cantilever="biolever", sample="soft", a0=10.0, contact={"law": "glue"})
+
+
+def test_film_case_equals_the_cli_and_warns_as_it_does():
+    case = drumroll.Case("maclever-membrane-film")
+    with pytest.warns(UserWarning, match="film correction is used beyond"):
+        orbit = case.orbit(z=10.0)
+    assert orbit.to_dict() == cli_json(
+        "simulate", "--case", "maclever-membrane-film", "--z", "10", "--json"
+    )
+    with pytest.warns(UserWarning, match="film correction is used beyond"):
+        diagram = case.diagram()
+    assert diagram.to_dict() == cli_json("continue", "--case", "maclever-membrane-film", "--json")

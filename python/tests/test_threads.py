@@ -14,8 +14,10 @@ import drumroll
 
 
 def diagram_work(case):
-    # About half a second of work: the Fig. 2 diagram with steps of 0.01 nm (1000 orbits).
-    case.diagram(min_amplitude_ratio=0.0, max_step=0.01)
+    # About half a second of work: the Fig. 2 diagram with steps of 0.01 nm (1000 orbits),
+    # three times.
+    for _ in range(3):
+        case.diagram(min_amplitude_ratio=0.0, max_step=0.01)
 
 
 def best_of(runs, call):
@@ -29,7 +31,7 @@ def best_of(runs, call):
 
 def test_two_threads_run_diagrams_in_parallel():
     case = drumroll.Case("biolever-mica")
-    one = best_of(3, lambda: diagram_work(case))
+    one = best_of(2, lambda: diagram_work(case))
 
     def two_threads():
         threads = [threading.Thread(target=diagram_work, args=(case,)) for _ in range(2)]
@@ -38,7 +40,7 @@ def test_two_threads_run_diagrams_in_parallel():
         for thread in threads:
             thread.join()
 
-    two = best_of(3, two_threads)
+    two = best_of(2, two_threads)
     ratio = two / one
     load = os.getloadavg()[0]
     print(
@@ -56,7 +58,7 @@ def test_python_runs_while_a_diagram_computes():
     # pause between its loop iterations is a scheduling slice, not the diagram's duration
     # (which it would be with the GIL held).
     case = drumroll.Case("biolever-mica")
-    worker = threading.Thread(target=lambda: case.diagram(min_amplitude_ratio=0.0, max_step=0.01))
+    worker = threading.Thread(target=diagram_work, args=(case,))
     stamps = []
     start = time.perf_counter()
     worker.start()
@@ -65,7 +67,7 @@ def test_python_runs_while_a_diagram_computes():
     duration = time.perf_counter() - start
     longest_pause = max(b - a for a, b in zip([start] + stamps, stamps))
     print(f"diagram {duration:.3f} s, longest pause of the main thread {longest_pause * 1e3:.1f} ms")
-    assert duration > 0.2
+    assert duration > 0.3
     assert longest_pause < 0.3 * duration
 
 

@@ -77,6 +77,9 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     let (case, model) = args.model.model()?;
     let settings = diagram_settings(args, &model)?;
     let run = compute_diagrams(&case, &model, &settings, args.retract, &mut || false)?;
+    if let Some(warning) = film_warning(&model, &run) {
+        eprintln!("warning: {warning}");
+    }
     let DiagramRun {
         approach,
         retract,
@@ -256,6 +259,18 @@ pub fn compute_diagrams(
         retract,
         bistable,
     })
+}
+
+/// The warning of [`afm::film_range_warning`] for the orbits of `run` (approach and retract):
+/// where a film law's correction is used beyond its range, if it is.
+pub fn film_warning(model: &TappingModel, run: &DiagramRun) -> Option<String> {
+    let orbits = run
+        .approach
+        .points
+        .iter()
+        .chain(run.retract.iter().flat_map(|r| r.points.iter()))
+        .map(|point| (point.z_nm, point.min_gap_nm));
+    afm::film_range_warning(model, orbits)
 }
 
 /// The `continue --json` object of `run`, computed with `settings` (docs/output-schema.md).

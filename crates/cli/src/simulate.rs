@@ -116,6 +116,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         Some(_) => coexisting_orbit(&model, &orbit, start, &settings),
         None => None,
     };
+    let min_gap = orbit.observables().min_gap_nm();
+    let orbits = [(orbit.z_nm, min_gap.is_finite().then_some(min_gap))];
+    if let Some(warning) = afm::film_range_warning(&model, orbits) {
+        eprintln!("warning: {warning}");
+    }
     if args.json {
         let coexisting = coexisting
             .as_ref()

@@ -60,6 +60,30 @@ fn resolve_sample(reference: &Reference<'_>) -> PyResult<afm::Sample> {
     result.map_err(crate::errors::afm_to_py_err)
 }
 
+/// `sample` with its contact law and electrostatic double layer replaced by the dicts given
+/// (in the sample files' format: `{"law": "dmt", ...}`, `{"debye_length_nm": ...}`; MODEL.md
+/// section 9); errors name the field as for a sample file.
+fn with_contact_law(
+    sample: &afm::Sample,
+    contact: Option<Bound<'_, pyo3::types::PyDict>>,
+    electrostatic: Option<Bound<'_, pyo3::types::PyDict>>,
+) -> PyResult<afm::Sample> {
+    let mut value = serde_json::to_value(sample)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    if let Some(contact) = contact {
+        value["contact"] = py_to_json(contact.as_any())?;
+    }
+    if let Some(electrostatic) = electrostatic {
+        value["electrostatic"] = py_to_json(electrostatic.as_any())?;
+    }
+    from_value(
+        &value,
+        "sample with the contact law given in Python",
+        fixtures::parse_sample,
+    )
+    .map_err(crate::errors::afm_to_py_err)
+}
+
 /// A simulation case: a cantilever tapping a sample at free amplitude `a0` (nm) and a drive
 /// frequency (kHz), resolved into the model of MODEL.md (Eq. 1 with Hertz contact).
 ///
@@ -67,7 +91,10 @@ fn resolve_sample(reference: &Reference<'_>) -> PyResult<afm::Sample> {
 /// `Case(cantilever="biolever", sample="soft", a0=10.0)` combines a cantilever and a sample
 /// (built-in names, file paths, or dicts in the files' format). `a0` and
 /// `drive_frequency_khz` override a named case's values. `Case()` is the default case
-/// (`biolever-mica`), as on the command line.
+/// (`biolever-mica`), as on the command line. `contact` and `electrostatic` (dicts in the
+/// sample files' format, MODEL.md section 9: `contact={"law": "dmt",
+/// "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}`) set the sample's
+/// contact law and double layer; without them the sample's own (Hertz by default).
 #[pyclass(module = "drumroll", frozen)]
 pub struct Case {
     /// The resolved case and its model.
@@ -77,7 +104,8 @@ pub struct Case {
 #[pymethods]
 impl Case {
     #[new]
-    #[pyo3(signature = (name_or_path=None, *, cantilever=None, sample=None, a0=None, drive_frequency_khz=None))]
+    #[pyo3(signature = (name_or_path=None, *, cantilever=None, sample=None, a0=None, drive_frequency_khz=None, contact=None, electrostatic=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         name_or_path: Option<String>,
@@ -85,10 +113,12 @@ impl Case {
         sample: Option<Reference<'_>>,
         a0: Option<f64>,
         drive_frequency_khz: Option<f64>,
+        contact: Option<Bound<'_, pyo3::types::PyDict>>,
+        electrostatic: Option<Bound<'_, pyo3::types::PyDict>>,
     ) -> PyResult<Self> {
         let has_dict = matches!(cantilever, Some(Reference::Dict(_)))
             || matches!(sample, Some(Reference::Dict(_)));
-        let case = if has_dict {
+        let mut case = if has_dict {
             let (Some(cantilever), Some(sample), None) = (&cantilever, &sample, &name_or_path)
             else {
                 return Err(to_py_err(anyhow::anyhow!(
@@ -131,6 +161,9 @@ impl Case {
             };
             py.allow_threads(|| args.case()).map_err(to_py_err)?
         };
+        if contact.is_some() || electrostatic.is_some() {
+            case.sample = with_contact_law(&case.sample, contact, electrostatic)?;
+        }
         let resolved = py
             .allow_threads(|| Resolved::new(case))
             .map_err(to_py_err)?;

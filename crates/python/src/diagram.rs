@@ -2,7 +2,7 @@
 //! as `drumroll continue --json` gives it, with the branch points as a table.
 
 use drumroll::continue_diagram::{
-    compute_diagrams, continue_json, diagram_settings, ContinueArgs, CSV_COLUMNS,
+    compute_diagrams, continue_json, diagram_settings, film_warning, ContinueArgs, CSV_COLUMNS,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -10,7 +10,7 @@ use pyo3::types::PyTuple;
 use serde_json::Value;
 
 use crate::convert::{json_to_py, py_to_json, records_to_table};
-use crate::errors::to_py_err;
+use crate::errors::{to_py_err, warn};
 use crate::interrupt::without_gil;
 use crate::resolved::{resolved_model_args, Resolved};
 use std::sync::Arc;
@@ -172,22 +172,25 @@ pub fn compute_diagram(
         csv: None,
         plot: None,
     };
-    let json = without_gil(py, |interrupted| -> anyhow::Result<Value> {
-        let settings = diagram_settings(&args, &resolved.model)?;
-        let run = compute_diagrams(
-            &resolved.case,
-            &resolved.model,
-            &settings,
-            args.retract,
-            interrupted,
-        )?;
-        Ok(continue_json(
-            &resolved.case,
-            &resolved.model,
-            &settings,
-            &run,
-        ))
-    })?
+    let (json, warning) = without_gil(
+        py,
+        |interrupted| -> anyhow::Result<(Value, Option<String>)> {
+            let settings = diagram_settings(&args, &resolved.model)?;
+            let run = compute_diagrams(
+                &resolved.case,
+                &resolved.model,
+                &settings,
+                args.retract,
+                interrupted,
+            )?;
+            let warning = film_warning(&resolved.model, &run);
+            let json = continue_json(&resolved.case, &resolved.model, &settings, &run);
+            Ok((json, warning))
+        },
+    )?
     .map_err(to_py_err)?;
+    if let Some(warning) = warning {
+        warn(py, &warning)?;
+    }
     Ok(Diagram { json })
 }

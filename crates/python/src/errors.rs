@@ -30,3 +30,12 @@ pub fn to_py_err(error: anyhow::Error) -> PyErr {
 pub fn afm_to_py_err(error: AfmError) -> PyErr {
     to_py_err(anyhow::Error::new(error))
 }
+
+/// Issue `message` as a Python `UserWarning` (what the CLI prints on stderr as `warning: ...`,
+/// e.g. a film law used beyond its range), so that notebooks show it and `warnings` filters
+/// it.
+pub fn warn(py: pyo3::Python<'_>, message: &str) -> pyo3::PyResult<()> {
+    let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+    let text = std::ffi::CString::new(message.replace('\0', " "))?;
+    PyErr::warn(py, &category, &text, 1)
+}

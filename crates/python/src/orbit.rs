@@ -10,7 +10,7 @@ use serde_json::{json, Value};
 use std::sync::{Arc, OnceLock};
 
 use crate::convert::{float_array, json_to_py, py_to_json};
-use crate::errors::{afm_to_py_err, to_py_err};
+use crate::errors::{afm_to_py_err, to_py_err, warn};
 use crate::resolved::Resolved;
 
 /// How an orbit was found: the CLI's starts, or Newton from a given state near the orbit.
@@ -56,14 +56,25 @@ pub struct Orbit {
 }
 
 impl Orbit {
-    /// The orbit `orbit` of `resolved`'s model, found as `origin` says.
-    pub fn new(resolved: Arc<Resolved>, orbit: SteadyOrbit, origin: Origin) -> Self {
-        Self {
+    /// The orbit `orbit` of `resolved`'s model, found as `origin` says; the CLI's warning (a
+    /// film law used beyond its range at this orbit) is issued as a Python warning.
+    pub fn new(
+        py: Python<'_>,
+        resolved: Arc<Resolved>,
+        orbit: SteadyOrbit,
+        origin: Origin,
+    ) -> PyResult<Self> {
+        let min_gap = orbit.observables().min_gap_nm();
+        let orbits = [(orbit.z_nm, min_gap.is_finite().then_some(min_gap))];
+        if let Some(warning) = afm::film_range_warning(&resolved.model, orbits) {
+            warn(py, &warning)?;
+        }
+        Ok(Self {
             resolved,
             computed: Some(Computed { orbit, origin }),
             core: OnceLock::new(),
             full: OnceLock::new(),
-        }
+        })
     }
 
     /// The orbit's state at `t = 0` (a start for the next orbit along a branch).
@@ -311,7 +322,7 @@ pub fn compute_orbit(
             z,
             amplitude_ratio,
         };
-        return Ok(Orbit::new(resolved, orbit, origin));
+        return Orbit::new(py, resolved, orbit, origin);
     }
     let state = match start.downcast::<Orbit>() {
         Ok(previous) => previous.get().state(),
@@ -345,5 +356,5 @@ pub fn compute_orbit(
         .map_err(|e| {
             to_py_err(anyhow::Error::new(e).context(format!("no steady orbit at Z = {z} nm")))
         })?;
-    Ok(Orbit::new(resolved, orbit, Origin::Near))
+    Orbit::new(py, resolved, orbit, Origin::Near)
 }
