@@ -2,19 +2,18 @@
 //! periodic orbits from above first contact down to a floor, every special point labelled and
 //! located, and optionally the retract branch back up.
 
-use afm::{
-    approach_diagram, diagram, BifurcationDiagram, DiagramPoint, DiagramSettings, TappingModel,
-};
+use afm::{approach_diagram, diagram, BifurcationDiagram, Case, DiagramSettings, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use crate::continue_figure::{figure, CaseDiagrams};
 use crate::inputs::orbit_inputs_json;
-use crate::model_args::{output_path, ModelArgs};
+use crate::model_args::{model_of, output_path, ModelArgs};
 use crate::output::write_atomically;
-use crate::plot::{render_svg, Marker, Panel, Series, Stroke, PHASE_PERIOD_DEG};
+use crate::plot::FigureFile;
 
 /// Options of `drumroll continue`.
 #[derive(Debug, Clone, Args)]
@@ -42,26 +41,78 @@ pub struct ContinueArgs {
     /// Write the branch points to this CSV file.
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
-    /// Draw phase vs A/A0 (the paper's Fig. 2) with the special points marked, stable parts
-    /// solid and unstable dashed, beside A/A0 vs Z and impacts per period vs Z.
-    #[arg(long, value_name = "FILE.svg")]
+    /// Draw phase vs A/A0 (the paper's Fig. 2) with the special points labelled, stable parts
+    /// solid and unstable dashed, beside A/A0 vs Z and impacts per period vs Z; with several
+    /// --case, one phase panel per case, (a), (b), ... The format follows the extension:
+    /// .svg, .png or .pdf.
+    #[arg(long, value_name = "FILE.svg|png|pdf")]
     pub plot: Option<PathBuf>,
+    /// With several --case and --plot: draw every case on one set of axes (the three panels,
+    /// a legend naming the cases) instead of one panel per case.
+    #[arg(long, requires = "plot")]
+    pub overlay: bool,
 }
 
-/// Run `drumroll continue`.
+/// One case's approach, its optional retract and their bistable ranges.
+struct Continued {
+    settings: DiagramSettings,
+    approach: BifurcationDiagram,
+    retract: Option<BifurcationDiagram>,
+    bistable: Option<Vec<[f64; 2]>>,
+}
+
+/// Run `drumroll continue`: each `--case` in turn (tables or JSON lines printed as they are
+/// computed), then the CSV (one case) and the figure.
 pub fn run(args: &ContinueArgs) -> Result<()> {
-    let (case, model) = args.model.model()?;
+    let cases = args.model.cases()?;
     let csv_path = args
         .csv
         .as_ref()
         .map(|p| output_path(p, "csv", "--csv"))
         .transpose()?;
-    let plot_path = args
+    if cases.len() > 1 && csv_path.is_some() {
+        bail!(
+            "--csv takes one case ({} given): run once per case",
+            cases.len()
+        );
+    }
+    let plot = args
         .plot
         .as_ref()
-        .map(|p| output_path(p, "svg", "--plot"))
+        .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
-    let mut settings = DiagramSettings::approach(&model);
+    let mut drawn = Vec::new();
+    for case in cases {
+        let (case, model) = model_of(case)?;
+        let continued = continue_case(args, &case, &model)?;
+        print_report(args, &case, &model, &continued)?;
+        if let Some(path) = &csv_path {
+            let mut text = csv_text(&continued.approach, "approach")?;
+            if let Some(retract) = &continued.retract {
+                text.push_str(
+                    csv_text(retract, "retract")?
+                        .split_once('\n')
+                        .map_or("", |(_, rows)| rows),
+                );
+            }
+            write_atomically(path, text.as_bytes())?;
+        }
+        drawn.push(CaseDiagrams {
+            case,
+            model,
+            approach: continued.approach,
+            retract: continued.retract,
+        });
+    }
+    if let Some(plot) = plot {
+        plot.write(&figure(&drawn, args.overlay)?)?;
+    }
+    Ok(())
+}
+
+/// The diagram settings of `model` with the options applied and checked.
+fn settings(args: &ContinueArgs, model: &TappingModel) -> Result<DiagramSettings> {
+    let mut settings = DiagramSettings::approach(model);
     if let Some(floor) = args.floor {
         let lowest = -model.free_amplitude_nm();
         if !(floor >= lowest && floor < model.grazing_separation_nm()) {
@@ -88,7 +139,13 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         }
         settings.max_step = step;
     }
-    let approach = approach_diagram(&model, &settings)
+    Ok(settings)
+}
+
+/// The approach (and retract) of one case.
+fn continue_case(args: &ContinueArgs, case: &Case, model: &TappingModel) -> Result<Continued> {
+    let settings = settings(args, model)?;
+    let approach = approach_diagram(model, &settings)
         .with_context(|| format!("continuation of case `{}` failed", case.name))?;
     let retract = if args.retract {
         let Some(lowest) = approach
@@ -100,10 +157,10 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         };
         let retract_settings = DiagramSettings {
             max_step: settings.max_step,
-            ..DiagramSettings::retract(&model)
+            ..DiagramSettings::retract(model)
         };
         Some(
-            diagram(&model, &lowest.state, lowest.z_nm, &retract_settings)
+            diagram(model, &lowest.state, lowest.z_nm, &retract_settings)
                 .context("retract continuation failed")?,
         )
     } else {
@@ -114,6 +171,27 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         ranges.extend(retract.bistable_ranges());
         merge_ranges(ranges)
     });
+    Ok(Continued {
+        settings,
+        approach,
+        retract,
+        bistable,
+    })
+}
+
+/// Print one case's table (or JSON object, one line).
+fn print_report(
+    args: &ContinueArgs,
+    case: &Case,
+    model: &TappingModel,
+    continued: &Continued,
+) -> Result<()> {
+    let Continued {
+        settings,
+        approach,
+        retract,
+        bistable,
+    } = continued;
     if args.json {
         let options = json!({
             "floor_nm": settings.z_limit_nm,
@@ -123,7 +201,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             "retract": args.retract,
         });
         let mut object = json!({
-            "inputs": orbit_inputs_json("continue", options, &case, &model, &settings.orbit),
+            "inputs": orbit_inputs_json("continue", options, case, model, &settings.orbit),
             "case": case.name,
             "free_amplitude_nm": model.free_amplitude_nm(),
             "first_contact_z_nm": model.grazing_separation_nm(),
@@ -143,9 +221,9 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         }
         println!("{}", serde_json::to_string(&object)?);
     } else {
-        print!("{}", table(&case.name, &model, "approach", &approach));
+        print!("{}", table(&case.name, model, "approach", approach));
         if let Some(retract) = &retract {
-            print!("{}", table(&case.name, &model, "retract", retract));
+            print!("{}", table(&case.name, model, "retract", retract));
             match bistable.as_deref() {
                 Some([]) | None => {
                     println!("no bistable range: approach and retract follow one stable orbit")
@@ -159,26 +237,6 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
                 }
             }
         }
-    }
-    if let Some(path) = csv_path {
-        let mut text = csv_text(&approach, "approach")?;
-        if let Some(retract) = &retract {
-            text.push_str(
-                csv_text(retract, "retract")?
-                    .split_once('\n')
-                    .map_or("", |(_, rows)| rows),
-            );
-        }
-        write_atomically(&path, text.as_bytes())?;
-    }
-    if let Some(path) = plot_path {
-        let svg = render_svg(
-            &panels(&model, &approach, retract.as_ref()),
-            1,
-            3,
-            (520, 440),
-        )?;
-        write_atomically(&path, svg.as_bytes())?;
     }
     Ok(())
 }
@@ -281,114 +339,4 @@ fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
         text.push('\n');
     }
     Ok(text)
-}
-
-/// Split a diagram's points into runs of equal stability, as polylines of `(x, y)`.
-fn runs(
-    points: &[DiagramPoint],
-    xy: impl Fn(&DiagramPoint) -> (f64, f64),
-) -> Vec<(bool, Vec<(f64, f64)>)> {
-    let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
-    for p in points {
-        match runs.last_mut() {
-            Some((stable, line)) if *stable == p.stable => line.push(xy(p)),
-            Some((_, line)) => {
-                // Join the runs so the curve stays continuous.
-                let last = *line.last().unwrap_or(&xy(p));
-                runs.push((p.stable, vec![last, xy(p)]));
-            }
-            None => runs.push((p.stable, vec![xy(p)])),
-        }
-    }
-    runs
-}
-
-fn branch_series(
-    diagram: &BifurcationDiagram,
-    label: &str,
-    colour: usize,
-    xy: impl Fn(&DiagramPoint) -> (f64, f64) + Copy,
-) -> Vec<Series> {
-    runs(&diagram.points, xy)
-        .into_iter()
-        .enumerate()
-        .map(|(i, (stable, points))| Series {
-            label: if i == 0 {
-                label.to_string()
-            } else {
-                String::new()
-            },
-            points,
-            stroke: if stable {
-                Stroke::Solid
-            } else {
-                Stroke::Dashed
-            },
-            colour,
-        })
-        .collect()
-}
-
-/// The three panels of the figure.
-fn panels(
-    model: &TappingModel,
-    approach: &BifurcationDiagram,
-    retract: Option<&BifurcationDiagram>,
-) -> Vec<Panel> {
-    let diagrams: Vec<(&BifurcationDiagram, &str, usize)> =
-        std::iter::once((approach, "approach", 0))
-            .chain(retract.map(|r| (r, "retract", 1)))
-            .collect();
-    let phase_markers = approach
-        .special_points
-        .iter()
-        .map(|p| Marker {
-            label: p.label.clone(),
-            at: (p.amplitude_ratio, p.phase_deg),
-        })
-        .collect();
-    let z_markers = approach
-        .special_points
-        .iter()
-        .map(|p| Marker {
-            label: p.label.clone(),
-            at: (p.z_nm, p.amplitude_ratio),
-        })
-        .collect();
-    let title = format!("A0 = {} nm (dashed: unstable)", model.free_amplitude_nm());
-    vec![
-        Panel {
-            title: format!("phase vs A/A0, {title}"),
-            x_label: String::from("A/A0"),
-            y_label: String::from("phase (deg)"),
-            series: diagrams
-                .iter()
-                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.amplitude_ratio, p.phase_deg)))
-                .collect(),
-            markers: phase_markers,
-            y_period: Some(PHASE_PERIOD_DEG),
-        },
-        Panel {
-            title: String::from("A/A0 vs Z"),
-            x_label: String::from("Z (nm)"),
-            y_label: String::from("A/A0"),
-            series: diagrams
-                .iter()
-                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.amplitude_ratio)))
-                .collect(),
-            markers: z_markers,
-            y_period: None,
-        },
-        Panel {
-            title: String::from("impacts per period vs Z"),
-            x_label: String::from("Z (nm)"),
-            y_label: String::from("impacts per period"),
-            series: diagrams
-                .iter()
-                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.impacts_per_period)))
-                .collect(),
-            markers: Vec::new(),
-            y_period: None,
-        },
-    ]
 }

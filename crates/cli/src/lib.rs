@@ -5,6 +5,7 @@
 pub mod approach;
 pub mod cantilever;
 pub mod continue_diagram;
+pub mod continue_figure;
 pub mod digits;
 pub mod inputs;
 pub mod model_args;

@@ -10,9 +10,10 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, Args)]
 pub struct ModelArgs {
     /// A built-in case (`biolever-mica`, `biolever-soft`, `maclever-mica`, `maclever-soft`,
-    /// `maclever-mica-experiment`, ...) or the path of a case file (JSON).
-    #[arg(long, conflicts_with_all = ["cantilever", "sample"])]
-    pub case: Option<String>,
+    /// `maclever-mica-experiment`, ...) or the path of a case file (JSON); `drumroll cases`
+    /// lists them. `continue` takes several (`--case A --case B`, one panel each).
+    #[arg(long, conflicts_with_all = ["cantilever", "sample"], action = clap::ArgAction::Append)]
+    pub case: Vec<String>,
     /// A cantilever file (JSON) or built-in cantilever name, used with `--sample` and `--a0`
     /// instead of `--case`.
     #[arg(long, requires_all = ["sample", "a0"])]
@@ -30,9 +31,33 @@ pub struct ModelArgs {
 }
 
 impl ModelArgs {
-    /// The resolved case (`biolever-mica` when nothing is given).
+    /// The resolved case (`biolever-mica` when nothing is given); an error when `--case` is
+    /// given more than once.
     pub fn case(&self) -> Result<Case> {
-        let mut case = match (&self.case, &self.cantilever, &self.sample) {
+        if self.case.len() > 1 {
+            bail!(
+                "--case given {} times: only `drumroll continue` draws several cases",
+                self.case.len()
+            );
+        }
+        self.resolve(self.case.first().map(String::as_str))
+    }
+
+    /// Every case given (`--case` repeated), in order, each with the `--a0` and
+    /// `--drive-frequency` overrides; the single resolved case otherwise.
+    pub fn cases(&self) -> Result<Vec<Case>> {
+        if self.case.len() <= 1 {
+            return Ok(vec![self.case()?]);
+        }
+        self.case
+            .iter()
+            .map(|name| self.resolve(Some(name)))
+            .collect()
+    }
+
+    /// The case named `name` (or built from `--cantilever` and `--sample`), overrides applied.
+    fn resolve(&self, name: Option<&str>) -> Result<Case> {
+        let mut case = match (name, &self.cantilever, &self.sample) {
             (Some(name), None, None) => fixtures::find_case(name)?,
             (None, Some(cantilever), Some(sample)) => {
                 let Some(a0) = self.a0 else {
@@ -73,11 +98,15 @@ impl ModelArgs {
 
     /// The tapping model of the resolved case, at first contact `Z = Z_G1`.
     pub fn model(&self) -> Result<(Case, TappingModel)> {
-        let case = self.case()?;
-        let model = TappingModel::from_case(&case)
-            .with_context(|| format!("cannot build the model of case `{}`", case.name))?;
-        Ok((case, model))
+        model_of(self.case()?)
     }
+}
+
+/// The tapping model of `case`, at first contact `Z = Z_G1`.
+pub fn model_of(case: Case) -> Result<(Case, TappingModel)> {
+    let model = TappingModel::from_case(&case)
+        .with_context(|| format!("cannot build the model of case `{}`", case.name))?;
+    Ok((case, model))
 }
 
 /// Whether a command-line reference names a file (it ends in `.json` or exists) rather than a

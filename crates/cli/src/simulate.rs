@@ -12,9 +12,8 @@ use std::path::PathBuf;
 
 use crate::digits;
 use crate::inputs::orbit_inputs_json;
-use crate::model_args::{output_path, ModelArgs};
-use crate::output::write_atomically;
-use crate::plot::render_svg;
+use crate::model_args::ModelArgs;
+use crate::plot::{render_svg, FigureFile};
 use crate::trajectory_plot::trajectory_panels;
 
 /// Options of `drumroll simulate`.
@@ -45,8 +44,9 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of the readable summary.
     #[arg(long)]
     pub json: bool,
-    /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) into this SVG file.
-    #[arg(long, value_name = "FILE.svg")]
+    /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) into this file
+    /// (.svg, .png or .pdf by the extension).
+    #[arg(long, value_name = "FILE.svg|png|pdf")]
     pub plot: Option<PathBuf>,
 }
 
@@ -105,7 +105,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let plot_path = args
         .plot
         .as_ref()
-        .map(|p| output_path(p, "svg", "--plot"))
+        .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
     let settings = SteadyOrbitSettings::default();
     let (orbit, start, coexisting) = match (args.z, args.amplitude_ratio) {
@@ -151,10 +151,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     if let Some(path) = plot_path {
         let panels = trajectory_panels(&model, &orbit, 2)?;
-        let svg = render_svg(&panels, 2, 1, (800, 320))?;
-        write_atomically(&path, svg.as_bytes())?;
+        path.write(&render_svg(&panels, 2, 1, (800, 320))?)?;
         if !args.json {
-            println!("figure: {}", path.display());
+            println!("figure: {}", path.path.display());
         }
     }
     Ok(())

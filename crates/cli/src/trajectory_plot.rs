@@ -44,19 +44,21 @@ pub fn trajectory_panels(
     Ok(vec![
         Panel {
             title,
-            x_label: String::from("t / T"),
-            y_label: String::from("u (nm)"),
+            x_label: String::from("time t / T (drive periods)"),
+            y_label: String::from("photodiode signal u (nm)"),
             series: vec![series("", |s| s.u_nm)],
             markers: Vec::new(),
             y_period: None,
+            y_integer_ticks: false,
         },
         Panel {
             title: String::from("tip-sample force (Hertz)"),
-            x_label: String::from("t / T"),
-            y_label: String::from("F_ts (nN)"),
+            x_label: String::from("time t / T (drive periods)"),
+            y_label: String::from("tip-sample force F_ts (nN)"),
             series: vec![series("", |s| s.force_nn)],
             markers: Vec::new(),
             y_period: None,
+            y_integer_ticks: false,
         },
     ])
 }
