@@ -29,6 +29,9 @@ enum Command {
     /// The Euler-Bernoulli modal table of a cantilever with a point tip mass, and a cantilever
     /// file built from measured k_1, frequencies and quality factors.
     Cantilever(drumroll::cantilever::CantileverArgs),
+    /// The built-in cases, cantilevers and samples with their key parameters; `cases show NAME`
+    /// prints one file to copy and edit.
+    Cases(drumroll::cases::CasesArgs),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +42,7 @@ fn main() -> ExitCode {
         Command::Approach(args) => drumroll::approach::run(args),
         Command::Theory(args) => drumroll::theory::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),
+        Command::Cases(args) => drumroll::cases::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
