@@ -1,7 +1,7 @@
 //! `drumroll`: non-smooth dynamics of AFM cantilevers tapping a sample (Melcher, Xu, Raman,
 //! APL 93, 093111 (2008)). Thin: parses arguments and hands each subcommand to its module.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Non-smooth dynamics of AFM cantilevers tapping a sample: steady orbits, impacts, grazing
@@ -32,6 +32,10 @@ enum Command {
     /// The built-in cases, cantilevers and samples with their key parameters; `cases show NAME`
     /// prints one file to copy and edit.
     Cases(drumroll::cases::CasesArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(drumroll::shell::CompletionsArgs),
+    /// Print the manual page (roff), or write one per subcommand with --out-dir.
+    Man(drumroll::shell::ManArgs),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +47,8 @@ fn main() -> ExitCode {
         Command::Theory(args) => drumroll::theory::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),
         Command::Cases(args) => drumroll::cases::run(args),
+        Command::Completions(args) => drumroll::shell::completions(args, Cli::command()),
+        Command::Man(args) => drumroll::shell::man(args, Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
