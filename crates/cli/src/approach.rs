@@ -6,7 +6,6 @@ use afm::sweep::{MAX_CYCLE_COUNT, MAX_RATE_NM_PER_S, MAX_SEPARATION_NM};
 use afm::{Sweep, SweepDirection, SweepRecord, SweepSettings, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -15,6 +14,7 @@ use std::path::{Path, PathBuf};
 use crate::inputs::inputs_json;
 use crate::model_args::ModelArgs;
 use crate::plot::{render_svg, FigureFile, Panel, Series, Stroke, PHASE_PERIOD_DEG};
+use crate::progress::{note, Progress};
 
 /// The CSV header: the JSON Lines records' keys, in their order (docs/output-schema.md).
 pub const CSV_HEADER: &str =
@@ -250,7 +250,10 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
     if !sink.write_line(&first_line)? {
         return Ok(());
     }
-    let progress = progress_bar(sweep.total_cycles());
+    let mut progress = Progress::new(
+        sweep.total_cycles(),
+        "Z = {msg} nm {wide_bar} {human_pos}/{human_len} cycles, {eta} left",
+    );
     let mut kept: Vec<SweepRecord> = Vec::new();
     let mut line = String::with_capacity(160);
     let mut shown = 0;
@@ -272,7 +275,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         };
         format_record(&record, args.jsonl, &mut line)?;
         if !sink.write_line(&line)? {
-            progress.finish_and_clear();
+            progress.finish();
             return Ok(());
         }
         if plot_path.is_some() {
@@ -280,32 +283,19 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         }
         if sweep.cycles_done() >= shown + PROGRESS_STRIDE {
             shown = sweep.cycles_done();
-            progress.set_position(shown);
-            progress.set_message(format!("{:8.4}", sweep.z_nm()));
+            progress.update(shown, || format!("{:8.4}", sweep.z_nm()));
         }
     }
-    progress.finish_and_clear();
+    progress.finish();
     if let Some(path) = plot_path {
         let panels = sweep_panels(&case.name, &kept);
         path.write(&render_svg(&panels, 1, 2, (640, 480))?)?;
-        eprintln!("figure: {}", path.path.display());
+        note(&format!("figure: {}", path.path.display()));
     }
     if let Some(path) = &args.out {
-        eprintln!("records: {}", Path::new(path).display());
+        note(&format!("records: {}", Path::new(path).display()));
     }
     Ok(())
-}
-
-/// A progress bar on standard error showing Z, cycles done and the time left; indicatif draws
-/// nothing when standard error is not a terminal.
-fn progress_bar(total_cycles: u64) -> ProgressBar {
-    let bar = ProgressBar::new(total_cycles);
-    if let Ok(style) = ProgressStyle::with_template(
-        "Z = {msg} nm {wide_bar} {human_pos}/{human_len} cycles, {eta} left",
-    ) {
-        bar.set_style(style);
-    }
-    bar
 }
 
 /// The two panels of `--plot`: phase vs A/A0, and A/A0 vs Z; approach and retract as dots of

@@ -14,6 +14,7 @@ use crate::inputs::orbit_inputs_json;
 use crate::model_args::{model_of, output_path, ModelArgs};
 use crate::output::write_atomically;
 use crate::plot::FigureFile;
+use crate::progress::Progress;
 
 /// Options of `drumroll continue`.
 #[derive(Debug, Clone, Args)]
@@ -82,7 +83,12 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
     let mut drawn = Vec::new();
-    for case in cases {
+    let mut progress = Progress::new(
+        cases.len() as u64,
+        "{wide_bar} {pos}/{len} cases, now {msg}, {eta} left",
+    );
+    for (done, case) in cases.into_iter().enumerate() {
+        progress.update(done as u64, || case.name.clone());
         let (case, model) = model_of(case)?;
         let continued = continue_case(args, &case, &model)?;
         print_report(args, &case, &model, &continued)?;
@@ -104,6 +110,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             retract: continued.retract,
         });
     }
+    progress.finish();
     if let Some(plot) = plot {
         plot.write(&figure(&drawn, args.overlay)?)?;
     }

@@ -12,6 +12,7 @@ pub mod inputs;
 pub mod model_args;
 pub mod output;
 pub mod plot;
+pub mod progress;
 pub mod shell;
 pub mod simulate;
 pub mod theory;

@@ -9,6 +9,10 @@ use std::process::ExitCode;
 #[derive(Debug, Parser)]
 #[command(name = "drumroll", version, about)]
 struct Cli {
+    /// No progress bars and no notes on standard error (bars are drawn only on a terminal,
+    /// and only for runs longer than about 2 s).
+    #[arg(long, short, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -40,6 +44,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    drumroll::progress::set_quiet(cli.quiet);
     let result = match &cli.command {
         Command::Simulate(args) => drumroll::simulate::run(args),
         Command::Continue(args) => drumroll::continue_diagram::run(args),
