@@ -150,7 +150,10 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     if let Some(path) = plot_path {
-        let panels = trajectory_panels(&model, &orbit, 2)?;
+        let mut panels = trajectory_panels(&model, &orbit, 2)?;
+        if let Some(first) = panels.first_mut() {
+            first.title = format!("{}: {}", case.name, first.title);
+        }
         path.write(&render_svg(&panels, 2, 1, (800, 320))?)?;
         if !args.json {
             println!("figure: {}", path.path.display());
