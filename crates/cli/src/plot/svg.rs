@@ -431,3 +431,52 @@ pub fn document(panels: &[Panel], columns: usize, panel_size: (u32, u32)) -> Str
     svg.push_str("</svg>\n");
     svg
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plot::Series;
+
+    #[test]
+    fn a_legend_with_no_free_corner_goes_outside_the_plot_area() {
+        // Both diagonals of the data range pass through all four corners of the plot area.
+        let diagonal = |points: Vec<(f64, f64)>, label: &str, colour| Series {
+            label: label.to_string(),
+            points,
+            stroke: Stroke::Solid,
+            colour,
+        };
+        let panel = Panel {
+            series: vec![
+                diagonal(vec![(0.0, 0.0), (1.0, 1.0)], "rising", 0),
+                diagonal(vec![(0.0, 1.0), (1.0, 0.0)], "falling", 1),
+            ],
+            ..Panel::default()
+        };
+        let entries: Vec<LegendEntry> = panel
+            .series
+            .iter()
+            .map(|s| LegendEntry {
+                label: s.label.clone(),
+                colour: s.colour,
+                stroke: s.stroke,
+            })
+            .collect();
+        let outer = Rect::new(0.0, 0.0, 500.0, 400.0);
+        let (frame, _, legend) = frame_and_legend(&panel, outer, &entries);
+        let legend = legend.expect("a legend");
+        assert!(
+            legend.x0 > frame.plot.x1,
+            "{legend:?} beside {:?}",
+            frame.plot
+        );
+        assert!(outer.contains_rect(&legend), "inside the panel");
+        // With one diagonal only, two corners stay free and the legend goes inside.
+        let one = Panel {
+            series: panel.series[..1].to_vec(),
+            ..Panel::default()
+        };
+        let (frame, _, legend) = frame_and_legend(&one, outer, &entries[..1]);
+        assert!(frame.plot.contains_rect(&legend.expect("a legend")));
+    }
+}
