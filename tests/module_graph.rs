@@ -1,8 +1,9 @@
 //! The module graph of every crate is acyclic: a lower concept never imports a higher one.
 //!
 //! For each crate under `crates/`, every top-level module (`src/name.rs` or `src/name/`) is a
-//! node, and every path `crate::name...` in its code (a `use` or an inline path; comments and
-//! the `#[cfg(test)]` module at the end of a file excluded) is an edge to module `name`, or to
+//! node, and every path `crate::name...` in its code (a `use` or an inline path; comments, the
+//! `#[cfg(test)]` module at the end of a file and test modules in files of their own, named
+//! `tests.rs`, excluded) is an edge to module `name`, or to
 //! the module an item re-exported at the crate root (`pub use name::{Item}` in `lib.rs`) comes
 //! from. The test fails on any cycle among those edges, naming it, unless it is listed in
 //! [`KNOWN_CYCLES`]; it also fails when a listed cycle no longer exists, so that the list
@@ -138,6 +139,9 @@ fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     let mut sources: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
     let mut root = String::new();
     for file in rust_files(src) {
+        if file.file_name().is_some_and(|name| name == "tests.rs") {
+            continue;
+        }
         let relative = file.strip_prefix(src).expect("under src");
         let first = relative
             .components()

@@ -181,6 +181,10 @@ pub struct BifurcationDiagram {
     pub special_points: Vec<DiagramSpecialPoint>,
     /// Why the branch ended, in words.
     pub stop: String,
+    /// Whether the branch reached its requested end (the separation limit, or an approach's
+    /// amplitude-ratio floor); false when the point cap, a failed corrector or an error ended
+    /// it first.
+    pub completed: bool,
     /// The error that ended the branch early, if any, in words.
     pub error: Option<String>,
 }
@@ -294,6 +298,10 @@ pub fn diagram(
         points,
         special_points,
         stop: stop_words(branch.stop),
+        completed: matches!(
+            branch.stop,
+            StopReason::ParameterBound | StopReason::UserStop
+        ),
         error: branch.error.map(|e| e.to_string()),
     })
 }

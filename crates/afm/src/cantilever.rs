@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::validation::{check, check_name, invalid, Interval};
+use crate::validation::{check_all, check_name, invalid, ranges, warnings_of, NumericField};
 use crate::{AfmError, Eigenmode};
 
 /// The tip's Young's modulus the paper uses, GPa (its note 15).
@@ -27,12 +27,13 @@ pub struct Cantilever {
     /// Free-text description (maker, medium, source of the values); may be empty.
     #[serde(default)]
     pub description: String,
-    /// Tip radius `R`, nm; range (0, 1e5].
+    /// Tip radius `R`, nm; range [0.1, 1e5], typical 1 to 1e4.
     pub tip_radius_nm: f64,
     /// Tip mass over cantilever mass `m_tip / m_c` (informational: the modal constants already
     /// account for it); range [0, 100].
     pub tip_mass_ratio: f64,
-    /// Tip Young's modulus `E_t`, GPa; range (0, 1e4]; default 130 (the paper's note 15).
+    /// Tip Young's modulus `E_t`, GPa; range [1e-7, 1e4], typical 1e-6 to 1500; default 130
+    /// (the paper's note 15).
     #[serde(default = "default_tip_youngs_modulus")]
     pub tip_youngs_modulus_gpa: f64,
     /// Tip Poisson ratio `nu_t`; range (-1, 0.5]; default 0.3 (the paper's note 15).
@@ -48,30 +49,7 @@ impl Cantilever {
     /// increasing, every `Q_i > 0`.
     pub fn validate(&self, file: &str) -> Result<(), AfmError> {
         check_name(file, "name", &self.name)?;
-        check(
-            file,
-            "tip_radius_nm",
-            self.tip_radius_nm,
-            Interval::positive(1e5, "nm"),
-        )?;
-        check(
-            file,
-            "tip_mass_ratio",
-            self.tip_mass_ratio,
-            Interval::closed(0.0, 100.0, ""),
-        )?;
-        check(
-            file,
-            "tip_youngs_modulus_gpa",
-            self.tip_youngs_modulus_gpa,
-            Interval::positive(1e4, "GPa"),
-        )?;
-        check(
-            file,
-            "tip_poisson_ratio",
-            self.tip_poisson_ratio,
-            Interval::left_open(-1.0, 0.5, ""),
-        )?;
+        check_all(file, &self.numeric_fields())?;
         if self.modes.is_empty() {
             return Err(AfmError::InvalidField {
                 file: file.to_string(),
@@ -98,6 +76,58 @@ impl Cantilever {
             }
         }
         Ok(())
+    }
+
+    /// The tip's numeric fields with their ranges ([`crate::validation::ranges`]).
+    fn numeric_fields(&self) -> Vec<NumericField> {
+        vec![
+            (
+                String::from("tip_radius_nm"),
+                self.tip_radius_nm,
+                ranges::TIP_RADIUS_NM,
+            ),
+            (
+                String::from("tip_mass_ratio"),
+                self.tip_mass_ratio,
+                ranges::TIP_MASS_RATIO,
+            ),
+            (
+                String::from("tip_youngs_modulus_gpa"),
+                self.tip_youngs_modulus_gpa,
+                ranges::YOUNGS_MODULUS_GPA,
+            ),
+            (
+                String::from("tip_poisson_ratio"),
+                self.tip_poisson_ratio,
+                ranges::POISSON_RATIO,
+            ),
+        ]
+    }
+
+    /// The plausibility warnings of every field (valid values outside the range typical of
+    /// AFM, with the likely unit mistake), naming `file` and the field.
+    pub fn warnings(&self, file: &str) -> Vec<String> {
+        let mut warnings = warnings_of(file, &self.numeric_fields());
+        for (index, mode) in self.modes.iter().enumerate() {
+            warnings.extend(mode.warnings(file, index));
+        }
+        warnings
+    }
+
+    /// The drive frequencies the model accepts for this cantilever, kHz: from `f_1 / 100` (far
+    /// below, a drive period holds so many free-flight steps that an orbit is out of reach) to
+    /// 100 times the highest modal frequency (far above, N modes no longer describe the
+    /// cantilever), within [`ranges::FREQUENCY_KHZ`].
+    pub fn drive_frequency_range_khz(&self) -> (f64, f64) {
+        let highest = self
+            .modes
+            .iter()
+            .map(|m| m.frequency_khz)
+            .fold(0.0, f64::max);
+        (
+            (0.01 * self.fundamental_frequency_khz()).max(ranges::FREQUENCY_KHZ.min),
+            (100.0 * highest).min(ranges::FREQUENCY_KHZ.max),
+        )
     }
 
     /// Number of eigenmodes N.

@@ -2,29 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::validation::{check, invalid, Interval};
+use crate::validation::{check_all, invalid, ranges, warnings_of, NumericField};
 use crate::AfmError;
-
-/// Smallest accepted modal stiffness, N/m: a thousandth of the softest cantilevers made
-/// (the Biolever's 0.036 N/m is among them). Far below it the contact is so stiff against the
-/// lever that steps underflow (measured on the Biolever on mica: `k_1` = 1e-12 N/m still
-/// converges, 1e-20 N/m does not).
-const MIN_STIFFNESS: f64 = 1e-6;
-/// Largest accepted modal stiffness, N/m.
-const MAX_STIFFNESS: f64 = 1e6;
-/// Smallest accepted natural frequency, kHz (10 Hz, far below any cantilever's: the paper's are
-/// 3.5 to 72 kHz). A drive period of a slower one takes millions of steps at the contact's time
-/// scale (measured: `f_1` = 1 Hz converges in 0.8 s, 0.1 Hz exhausts the step limit).
-pub(crate) const MIN_FREQUENCY: f64 = 1e-2;
-/// Largest accepted natural frequency, kHz (1 GHz).
-pub(crate) const MAX_FREQUENCY: f64 = 1e6;
-/// Smallest accepted quality factor: a mode damped a thousand times past critical (measured:
-/// `Q_2` = 1e-6 still converges, in 2 s; 1e-9 exhausts the step limit).
-const MIN_QUALITY: f64 = 1e-3;
-/// Largest accepted quality factor.
-const MAX_QUALITY: f64 = 1e6;
-/// Largest accepted magnitude of an optical sensitivity or forcing ratio.
-const MAX_RATIO: f64 = 1e3;
 
 /// Convert a frequency in kHz to an angular frequency in rad/us: `w = 2 pi f / 1000`.
 pub fn angular_frequency_rad_per_us(frequency_khz: f64) -> f64 {
@@ -56,28 +35,49 @@ impl Eigenmode {
         angular_frequency_rad_per_us(self.frequency_khz)
     }
 
+    /// The numeric fields with their ranges ([`crate::validation::ranges`]), as paths
+    /// `modes[index].field` (`index` 0-based: mode `index + 1`). Mode 1's ratios are fixed to 1
+    /// and checked apart.
+    pub(crate) fn numeric_fields(&self, index: usize) -> Vec<NumericField> {
+        let field = |name: &str| format!("modes[{index}].{name}");
+        let mut fields = vec![
+            (
+                field("stiffness_n_per_m"),
+                self.stiffness_n_per_m,
+                ranges::STIFFNESS_N_PER_M,
+            ),
+            (
+                field("frequency_khz"),
+                self.frequency_khz,
+                ranges::FREQUENCY_KHZ,
+            ),
+            (
+                field("quality_factor"),
+                self.quality_factor,
+                ranges::QUALITY_FACTOR,
+            ),
+        ];
+        if index > 0 {
+            fields.push((
+                field("optical_sensitivity"),
+                self.optical_sensitivity,
+                ranges::MODE_RATIO,
+            ));
+            fields.push((field("force_ratio"), self.force_ratio, ranges::MODE_RATIO));
+        }
+        fields
+    }
+
+    /// The plausibility warnings of the mode's fields (see [`Self::numeric_fields`]).
+    pub fn warnings(&self, file: &str, index: usize) -> Vec<String> {
+        warnings_of(file, &self.numeric_fields(index))
+    }
+
     /// Check every field's range; `index` is the 0-based position in `modes` (mode `index + 1`),
     /// used in the field path of the error (`modes[index].field`).
     pub fn validate(&self, file: &str, index: usize) -> Result<(), AfmError> {
         let field = |name: &str| format!("modes[{index}].{name}");
-        check(
-            file,
-            &field("stiffness_n_per_m"),
-            self.stiffness_n_per_m,
-            Interval::closed(MIN_STIFFNESS, MAX_STIFFNESS, "N/m"),
-        )?;
-        check(
-            file,
-            &field("frequency_khz"),
-            self.frequency_khz,
-            Interval::closed(MIN_FREQUENCY, MAX_FREQUENCY, "kHz"),
-        )?;
-        check(
-            file,
-            &field("quality_factor"),
-            self.quality_factor,
-            Interval::closed(MIN_QUALITY, MAX_QUALITY, ""),
-        )?;
+        check_all(file, &self.numeric_fields(index))?;
         if index == 0 {
             for (name, value, meaning) in [
                 (
@@ -96,19 +96,6 @@ impl Eigenmode {
                     ));
                 }
             }
-        } else {
-            check(
-                file,
-                &field("optical_sensitivity"),
-                self.optical_sensitivity,
-                Interval::closed(-MAX_RATIO, MAX_RATIO, ""),
-            )?;
-            check(
-                file,
-                &field("force_ratio"),
-                self.force_ratio,
-                Interval::closed(-MAX_RATIO, MAX_RATIO, ""),
-            )?;
         }
         Ok(())
     }

@@ -21,11 +21,14 @@ pub enum AfmError {
         allowed: String,
     },
     /// The file is not valid JSON for its schema (syntax error, unknown or missing field,
-    /// wrong type); the message of `serde_json` names the field and the line and column.
-    #[error("{file}: {source}")]
+    /// wrong type); the message names the field the error is in (empty: the top level), and
+    /// `serde_json`'s the expected type or fields and the line and column.
+    #[error("{file}: {}{source}", if field.is_empty() { String::new() } else { format!("field `{field}`: ") })]
     Json {
         /// The file that failed to parse.
         file: String,
+        /// The path of the field the error is in, e.g. `modes[1].quality_factor`.
+        field: String,
         /// The parser's error (with line and column).
         #[source]
         source: serde_json::Error,

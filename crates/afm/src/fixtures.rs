@@ -86,6 +86,7 @@ fn find<'a>(
 fn parse<T: DeserializeOwned>(file: &str, text: &str) -> Result<T, AfmError> {
     serde_json::from_str(text).map_err(|source| AfmError::Json {
         file: file.to_string(),
+        field: crate::json_path::path_at(text, source.line(), source.column()),
         source,
     })
 }
@@ -153,7 +154,7 @@ pub fn builtin_sample(name: &str) -> Result<Sample, AfmError> {
 pub fn builtin_case(name: &str) -> Result<Case, AfmError> {
     let entry = find(CASES, "case", name)?;
     let file = parse_case_file(entry.path, entry.text)?;
-    resolve_case(file, None)
+    resolve_case(file, None, entry.path)
 }
 
 /// Load and validate a cantilever file.
@@ -170,7 +171,11 @@ pub fn load_sample(path: &Path) -> Result<Sample, AfmError> {
 /// or paths ending in `.json` relative to the case file's directory.
 pub fn load_case(path: &Path) -> Result<Case, AfmError> {
     let file = parse_case_file(&path.display().to_string(), &read(path)?)?;
-    resolve_case(file, Some(path.parent().unwrap_or_else(|| Path::new(""))))
+    resolve_case(
+        file,
+        Some(path.parent().unwrap_or_else(|| Path::new(""))),
+        &path.display().to_string(),
+    )
 }
 
 /// A case named on a command line: a built-in case name, or else a path to a case file.
@@ -190,7 +195,8 @@ pub fn find_case(name_or_path: &str) -> Result<Case, AfmError> {
     }
 }
 
-/// Resolve a reference: a built-in name, or (with a base directory) a `.json` path.
+/// Resolve a reference: a built-in name, or (with a base directory) a `.json` path. A file
+/// that cannot be read is reported as the field `kind` of the case file `case_file`.
 fn resolve<T>(
     reference: &str,
     base: Option<&Path>,
@@ -198,6 +204,7 @@ fn resolve<T>(
     kind: &'static str,
     builtin: fn(&str) -> Result<T, AfmError>,
     load: fn(&Path) -> Result<T, AfmError>,
+    case_file: &str,
 ) -> Result<T, AfmError> {
     if table.iter().any(|entry| entry.name == reference) {
         return builtin(reference);
@@ -205,7 +212,19 @@ fn resolve<T>(
     match base {
         Some(base) if reference.ends_with(".json") => {
             let path: PathBuf = base.join(reference);
-            load(&path)
+            load(&path).map_err(|error| match error {
+                AfmError::Io { file, source } => AfmError::InvalidField {
+                    file: case_file.to_string(),
+                    field: kind.to_string(),
+                    value: format!("{reference:?}"),
+                    allowed: format!(
+                        "a built-in {kind} ({}) or a readable {kind} file (cannot read {file}: \
+                         {source})",
+                        names(table).join(", ")
+                    ),
+                },
+                other => other,
+            })
         }
         _ => Err(AfmError::UnknownFixture {
             kind,
@@ -215,7 +234,7 @@ fn resolve<T>(
     }
 }
 
-fn resolve_case(file: CaseFile, base: Option<&Path>) -> Result<Case, AfmError> {
+fn resolve_case(file: CaseFile, base: Option<&Path>, source: &str) -> Result<Case, AfmError> {
     let cantilever = resolve(
         &file.cantilever,
         base,
@@ -223,6 +242,7 @@ fn resolve_case(file: CaseFile, base: Option<&Path>) -> Result<Case, AfmError> {
         "cantilever",
         builtin_cantilever,
         load_cantilever,
+        source,
     )?;
     let sample = resolve(
         &file.sample,
@@ -231,6 +251,7 @@ fn resolve_case(file: CaseFile, base: Option<&Path>) -> Result<Case, AfmError> {
         "sample",
         builtin_sample,
         load_sample,
+        source,
     )?;
     Ok(Case {
         name: file.name,

@@ -32,12 +32,16 @@ pub mod free_response;
 pub mod gauss_legendre;
 pub mod hertz;
 pub mod impact_numbers;
+mod json_path;
 pub mod lockin;
 mod modal_constants;
 pub mod model;
 pub mod observables;
 pub mod orbit_prediction;
+pub mod parameter_axis;
 pub mod phase;
+pub mod quasi_static;
+pub mod regime_map;
 pub mod sample;
 pub mod separation;
 pub mod steady_orbit;
@@ -45,7 +49,7 @@ pub mod sweep;
 pub mod theory;
 pub mod trajectory;
 pub mod trigonometric;
-mod validation;
+pub mod validation;
 
 pub use amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
 pub use bifurcation_diagram::{
@@ -71,6 +75,11 @@ pub use observables::{
     GapMinimumKind, Harmonic, Impact, OrbitObservables, PeriodObserver, NEAR_IMPACT_FRACTION,
 };
 pub use orbit_prediction::{hermite_state, tangent_state};
+pub use parameter_axis::{CaseFamily, ParameterAxis, PARAMETER_NAMES};
+pub use quasi_static::{quasi_static_row, QuasiStaticCell, QuasiStaticRow};
+pub use regime_map::{
+    regime_map, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap, RegimeMapSettings,
+};
 pub use sample::Sample;
 pub use separation::Separation;
 pub use steady_orbit::{
@@ -79,7 +88,7 @@ pub use steady_orbit::{
 };
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
 pub use theory::{
-    compare_theory, measure_impacts, ImpactImpulse, ImpactMeasurement, ImpactPrediction,
-    ImpactTheory, Ringing, TheoryComparison,
+    compare_theory, measure_impacts, AssumptionFailure, ImpactImpulse, ImpactMeasurement,
+    ImpactPrediction, ImpactTheory, Ringing, TheoryComparison,
 };
 pub use trajectory::{sample_trajectory, TrajectorySample};

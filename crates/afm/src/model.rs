@@ -65,16 +65,7 @@ impl TappingModel {
         check_separation(&separation)?;
         let frequency_khz =
             drive_frequency_khz.unwrap_or_else(|| cantilever.fundamental_frequency_khz());
-        // Far below f_1 a drive period holds so many free-flight steps (a quarter of the
-        // shortest modal period each) that an orbit is out of reach; far above the last mode
-        // the model (N modes) no longer describes the cantilever.
-        let lowest = 0.01 * cantilever.fundamental_frequency_khz();
-        let highest = 100.0
-            * cantilever
-                .modes
-                .iter()
-                .map(|m| m.frequency_khz)
-                .fold(0.0, f64::max);
+        let (lowest, highest) = cantilever.drive_frequency_range_khz();
         if !(lowest..=highest).contains(&frequency_khz) {
             return Err(invalid(
                 "model parameters",

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::cantilever::DEFAULT_POISSON_RATIO;
-use crate::validation::{check, check_name, Interval};
+use crate::validation::{check_all, check_name, ranges, warnings_of, NumericField};
 use crate::AfmError;
 
 fn default_poisson_ratio() -> f64 {
@@ -19,7 +19,7 @@ pub struct Sample {
     /// Free-text description; may be empty.
     #[serde(default)]
     pub description: String,
-    /// Young's modulus `E_s`, GPa; range (0, 1e4].
+    /// Young's modulus `E_s`, GPa; range [1e-7, 1e4], typical 1e-6 to 1500.
     pub youngs_modulus_gpa: f64,
     /// Poisson ratio `nu_s`; range (-1, 0.5]; default 0.3 (the paper's note 15).
     #[serde(default = "default_poisson_ratio")]
@@ -27,20 +27,29 @@ pub struct Sample {
 }
 
 impl Sample {
+    fn numeric_fields(&self) -> Vec<NumericField> {
+        vec![
+            (
+                String::from("youngs_modulus_gpa"),
+                self.youngs_modulus_gpa,
+                ranges::YOUNGS_MODULUS_GPA,
+            ),
+            (
+                String::from("poisson_ratio"),
+                self.poisson_ratio,
+                ranges::POISSON_RATIO,
+            ),
+        ]
+    }
+
+    /// The plausibility warnings of every field, naming `file` and the field.
+    pub fn warnings(&self, file: &str) -> Vec<String> {
+        warnings_of(file, &self.numeric_fields())
+    }
+
     /// Check every field's range (errors name `file`, the field and the allowed range).
     pub fn validate(&self, file: &str) -> Result<(), AfmError> {
         check_name(file, "name", &self.name)?;
-        check(
-            file,
-            "youngs_modulus_gpa",
-            self.youngs_modulus_gpa,
-            Interval::positive(1e4, "GPa"),
-        )?;
-        check(
-            file,
-            "poisson_ratio",
-            self.poisson_ratio,
-            Interval::left_open(-1.0, 0.5, ""),
-        )
+        check_all(file, &self.numeric_fields())
     }
 }

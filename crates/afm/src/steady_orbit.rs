@@ -135,6 +135,11 @@ pub enum OrbitStart<'a> {
     /// instead of three). A worse prediction costs a map, never accuracy: convergence is
     /// decided by measured residuals only.
     Predicted(&'a [f64]),
+    /// `transient_periods` periods integrated from this state before Newton, as [`Self::Transient`]
+    /// does from the free state: the attractor whose basin holds the state rather than the
+    /// orbit nearest to it, as a quasi-static sweep of `Z` follows it (a neighbouring cell's
+    /// orbit, [`crate::quasi_static`]).
+    AfterTransients(&'a [f64]),
 }
 
 impl<'a> OrbitStart<'a> {
@@ -150,6 +155,7 @@ impl<'a> OrbitStart<'a> {
             Self::Transient => "transient",
             Self::Near(_) => "near",
             Self::Predicted(_) => "predicted",
+            Self::AfterTransients(_) => "after-transients",
         }
     }
 }
@@ -203,35 +209,38 @@ pub fn steady_orbit_in(
     let mut model = model.clone();
     model.set_separation(Separation::Constant(z_nm))?;
 
-    let (initial, predicted) = match start {
-        OrbitStart::Near(x) => (x.to_vec(), false),
-        OrbitStart::Predicted(x) => (x.to_vec(), true),
+    let (given, transients, predicted) = match start {
+        OrbitStart::Near(x) => (x.to_vec(), false, false),
+        OrbitStart::Predicted(x) => (x.to_vec(), false, true),
+        OrbitStart::AfterTransients(x) => (x.to_vec(), true, false),
+        OrbitStart::Transient => (model.free_state(), true, false),
         OrbitStart::Approach => match walk_approach(&model, z_nm, settings, workspace)? {
-            WalkEnd::Predicted(x) => (x, true),
-            WalkEnd::Near(x) => (x, false),
+            WalkEnd::Predicted(x) => (x, false, true),
+            WalkEnd::Near(x) => (x, false, false),
         },
-        OrbitStart::Transient => (
-            iterate(
-                &model,
-                &model.free_state(),
-                settings.transient_periods,
-                &settings.integration,
-                workspace,
-            )?,
-            false,
-        ),
     };
-    if initial.len() != model.dim() || initial.iter().any(|v| !v.is_finite()) {
+    if given.len() != model.dim() || given.iter().any(|v| !v.is_finite()) {
         return Err(AfmError::InvalidField {
             file: String::from("steady orbit"),
             field: String::from("start"),
-            value: format!("{initial:?}"),
+            value: format!("{given:?}"),
             allowed: format!(
                 "a finite state of the model's dimension {} ([q_1, q_1', ..., q_N, q_N'])",
                 model.dim()
             ),
         });
     }
+    let initial = if transients {
+        iterate(
+            &model,
+            &given,
+            settings.transient_periods,
+            &settings.integration,
+            workspace,
+        )?
+    } else {
+        given
+    };
 
     let first = shoot_observed(
         &model,

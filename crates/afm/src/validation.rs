@@ -1,28 +1,33 @@
-//! Range checks shared by every input struct: one place that turns a bad value into an
-//! [`AfmError::InvalidField`] naming the file, the field and the allowed range.
+//! Range checks shared by every input, files and command-line options alike: one table of
+//! allowed and typical ranges ([`ranges`]), and one place that turns a bad value into an
+//! [`AfmError::InvalidField`] naming the file (or option), the field and the allowed range, or
+//! a valid but implausible one into a warning with the likely unit mistake.
 
 use crate::AfmError;
 
-/// An interval of allowed values with its unit, printed as e.g. `(0, 1e6] N/m`.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Interval {
+/// An interval of allowed values with its unit, printed as e.g. `(0, 1e6] N/m`, and the
+/// narrower range typical of AFM: a value outside it is accepted with a warning, and a value
+/// that a factor of a unit prefix (1e3, 1e9, ...) would bring into it names that mistake.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Interval {
+    /// Lower bound.
     pub min: f64,
+    /// Whether `min` itself is allowed.
     pub min_inclusive: bool,
+    /// Upper bound.
     pub max: f64,
+    /// Whether `max` itself is allowed.
     pub max_inclusive: bool,
+    /// The unit (`nm`, `kHz`, `GPa`, `N/m`, `nm/s`; empty: dimensionless).
     pub unit: &'static str,
+    /// The closed range typical of AFM, if the quantity has one.
+    pub typical: Option<(f64, f64)>,
 }
 
 impl Interval {
-    /// `(min, max]`: positive quantities with an upper sanity bound.
+    /// `(0, max]`: positive quantities with an upper sanity bound.
     pub const fn positive(max: f64, unit: &'static str) -> Self {
-        Self {
-            min: 0.0,
-            min_inclusive: false,
-            max,
-            max_inclusive: true,
-            unit,
-        }
+        Self::left_open(0.0, max, unit)
     }
 
     /// `[min, max]`.
@@ -33,6 +38,7 @@ impl Interval {
             max,
             max_inclusive: true,
             unit,
+            typical: None,
         }
     }
 
@@ -44,10 +50,32 @@ impl Interval {
             max,
             max_inclusive: true,
             unit,
+            typical: None,
         }
     }
 
-    fn contains(&self, value: f64) -> bool {
+    /// `[min, max)`.
+    pub const fn right_open(min: f64, max: f64, unit: &'static str) -> Self {
+        Self {
+            min,
+            min_inclusive: true,
+            max,
+            max_inclusive: false,
+            unit,
+            typical: None,
+        }
+    }
+
+    /// The same interval with the typical range `[low, high]`.
+    pub const fn with_typical(self, low: f64, high: f64) -> Self {
+        Self {
+            typical: Some((low, high)),
+            ..self
+        }
+    }
+
+    /// Whether `value` is finite and allowed.
+    pub fn contains(&self, value: f64) -> bool {
         let above = if self.min_inclusive {
             value >= self.min
         } else {
@@ -58,38 +86,175 @@ impl Interval {
         } else {
             value < self.max
         };
-        above && below
+        value.is_finite() && above && below
     }
 
-    fn describe(&self) -> String {
+    /// The interval in words, e.g. `[0.1, 100000] nm (typical 1 to 1000 nm)`.
+    pub fn describe(&self) -> String {
         let open = if self.min_inclusive { '[' } else { '(' };
         let close = if self.max_inclusive { ']' } else { ')' };
-        let unit = if self.unit.is_empty() {
+        let unit = self.unit_suffix();
+        let typical = self.typical.map_or_else(String::new, |(low, high)| {
+            format!(
+                " (typical {} to {}{unit})",
+                format_number(low),
+                format_number(high)
+            )
+        });
+        format!(
+            "{open}{}, {}{close}{unit}{typical}",
+            format_number(self.min),
+            format_number(self.max)
+        )
+    }
+
+    fn unit_suffix(&self) -> String {
+        if self.unit.is_empty() {
             String::new()
         } else {
             format!(" {}", self.unit)
-        };
-        format!("{open}{}, {}{close}{unit}", self.min, self.max)
+        }
+    }
+
+    /// Whether `value` is allowed but outside the typical range.
+    pub fn implausible(&self, value: f64) -> bool {
+        self.contains(value)
+            && self
+                .typical
+                .is_some_and(|(low, high)| !(low..=high).contains(&value))
+    }
+
+    /// The likely unit mistake behind `value` (outside the typical range), when one factor of
+    /// [`unit_mistakes`] brings it into the typical range: e.g. `1e-08 looks like metres:
+    /// 1e-08 m = 10 nm`.
+    pub fn unit_hint(&self, value: f64) -> Option<String> {
+        let (low, high) = self.typical?;
+        if !value.is_finite() || (low..=high).contains(&value) {
+            return None;
+        }
+        unit_mistakes(self.unit)
+            .iter()
+            .find(|(factor, _)| (low..=high).contains(&(value * factor)))
+            .map(|(factor, name)| {
+                let typed = format_number(value);
+                format!(
+                    "{typed} looks like a value in {name}: {typed} {name} = {} {}",
+                    format_number(value * factor),
+                    self.unit
+                )
+            })
     }
 }
 
-/// Check that `value` (a finite number) lies in `interval`.
-pub(crate) fn check(
+/// A number as a user would type it: plain decimals from 1e-4 to 1e9 (`0.001`, `3500`),
+/// exponent notation beyond (`1e-8`, `2e-14`), the shortest form that reads back exactly.
+pub fn format_number(value: f64) -> String {
+    let value = round_to_significant(value);
+    let magnitude = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-4..1e9).contains(&magnitude) {
+        value.to_string()
+    } else {
+        format!("{value:e}")
+    }
+}
+
+/// The unit mistakes checked for values in `unit`: (factor to `unit`, the other unit).
+pub fn unit_mistakes(unit: &str) -> &'static [(f64, &'static str)] {
+    match unit {
+        "nm" => &[(1e9, "m"), (1e6, "mm"), (1e3, "um"), (0.1, "angstrom")],
+        "kHz" => &[(1e-3, "Hz"), (1e3, "MHz")],
+        "GPa" => &[(1e-9, "Pa"), (1e-6, "kPa"), (1e-3, "MPa")],
+        "nm/s" => &[(1e9, "m/s"), (1e3, "um/s")],
+        _ => &[],
+    }
+}
+
+/// The table of ranges of every physical input (files and command-line options): allowed
+/// (an error outside) and typical of AFM (a warning outside, with the likely unit mistake).
+pub mod ranges {
+    use super::Interval;
+
+    /// Free amplitude `A0` of `u`, nm: from a picometre (below thermal noise) to 100 um.
+    pub const FREE_AMPLITUDE_NM: Interval =
+        Interval::closed(1e-3, 1e5, "nm").with_typical(0.1, 1e3);
+    /// Drive or natural frequency, kHz: 10 Hz to 1 GHz (the paper's: 3.5 to 72 kHz). A drive
+    /// period of a slower one takes millions of steps at the contact's time scale.
+    pub const FREQUENCY_KHZ: Interval = Interval::closed(1e-2, 1e6, "kHz").with_typical(0.1, 1e5);
+    /// Tip radius `R`, nm: from an atom to 100 um (colloidal probes).
+    pub const TIP_RADIUS_NM: Interval = Interval::closed(0.1, 1e5, "nm").with_typical(1.0, 1e4);
+    /// Young's modulus of tip or sample, GPa: 100 Pa (the softest gels) to 10 TPa.
+    pub const YOUNGS_MODULUS_GPA: Interval =
+        Interval::closed(1e-7, 1e4, "GPa").with_typical(1e-6, 1.5e3);
+    /// Poisson ratio of tip or sample: the thermodynamic range `(-1, 0.5]`.
+    pub const POISSON_RATIO: Interval = Interval::left_open(-1.0, 0.5, "");
+    /// Tip mass over cantilever mass in a cantilever file.
+    pub const TIP_MASS_RATIO: Interval = Interval::closed(0.0, 100.0, "");
+    /// Modal stiffness `k_i`, N/m: a thousandth of the softest cantilevers made (the
+    /// Biolever's 0.036 N/m is among them) to 1e6 N/m. Far below it the contact is so stiff
+    /// against the lever that steps underflow.
+    pub const STIFFNESS_N_PER_M: Interval =
+        Interval::closed(1e-6, 1e6, "N/m").with_typical(1e-3, 1e3);
+    /// Quality factor `Q_i`: a mode damped a thousand times past critical to 1e6 (vacuum).
+    pub const QUALITY_FACTOR: Interval = Interval::closed(1e-3, 1e6, "").with_typical(0.1, 1e5);
+    /// Optical sensitivity `chi_i` or forcing ratio `F_i / F_1` of a higher mode.
+    pub const MODE_RATIO: Interval = Interval::closed(-1e3, 1e3, "");
+}
+
+/// Check that `value` (a finite number) lies in `interval`; the error names `file`, `field`,
+/// the allowed range and, when one fits, the likely unit mistake.
+pub fn check(file: &str, field: &str, value: f64, interval: Interval) -> Result<(), AfmError> {
+    if interval.contains(value) {
+        Ok(())
+    } else {
+        let hint = interval
+            .unit_hint(value)
+            .map_or_else(String::new, |hint| format!("; {hint}"));
+        Err(AfmError::InvalidField {
+            file: file.to_string(),
+            field: field.to_string(),
+            value: format_number(value),
+            allowed: format!("{}{hint}", interval.describe()),
+        })
+    }
+}
+
+/// The warning for an allowed but implausible `value` of `field` in `file`, `None` for a
+/// typical one.
+pub fn plausibility_warning(
     file: &str,
     field: &str,
     value: f64,
     interval: Interval,
-) -> Result<(), AfmError> {
-    if value.is_finite() && interval.contains(value) {
-        Ok(())
-    } else {
-        Err(AfmError::InvalidField {
-            file: file.to_string(),
-            field: field.to_string(),
-            value: value.to_string(),
-            allowed: interval.describe(),
-        })
+) -> Option<String> {
+    interval.implausible(value).then(|| {
+        let hint = interval
+            .unit_hint(value)
+            .map_or_else(String::new, |hint| format!("; {hint}"));
+        format!(
+            "{file}: field `{field}` = {} is unusual for AFM (allowed {}){hint}",
+            format_number(value),
+            interval.describe()
+        )
+    })
+}
+
+/// A field to check: its path (e.g. `modes[1].quality_factor`), value and interval.
+pub(crate) type NumericField = (String, f64, Interval);
+
+/// Check every field of `fields` (the first failure is returned).
+pub(crate) fn check_all(file: &str, fields: &[NumericField]) -> Result<(), AfmError> {
+    for (field, value, interval) in fields {
+        check(file, field, *value, *interval)?;
     }
+    Ok(())
+}
+
+/// The plausibility warnings of `fields`.
+pub(crate) fn warnings_of(file: &str, fields: &[NumericField]) -> Vec<String> {
+    fields
+        .iter()
+        .filter_map(|(field, value, interval)| plausibility_warning(file, field, *value, *interval))
+        .collect()
 }
 
 /// Check that a name is a non-empty string without surrounding whitespace.
@@ -111,7 +276,16 @@ pub(crate) fn invalid(file: &str, field: &str, value: f64, allowed: String) -> A
     AfmError::InvalidField {
         file: file.to_string(),
         field: field.to_string(),
-        value: value.to_string(),
+        value: format_number(value),
         allowed,
     }
+}
+
+/// `value` rounded to 12 significant digits, so that a product reads cleanly (`2e-8 * 1e9`
+/// prints as `20`, not `20.000000000000004`; `0.01 * 9.3` as `0.093`).
+fn round_to_significant(value: f64) -> f64 {
+    if value == 0.0 || !value.is_finite() {
+        return value;
+    }
+    format!("{value:.11e}").parse().unwrap_or(value)
 }

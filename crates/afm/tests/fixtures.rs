@@ -123,7 +123,7 @@ fn negative_stiffness_names_file_field_and_range() {
     assert!(message.contains(&file), "{message}");
     assert!(message.contains("modes[0].stiffness_n_per_m"), "{message}");
     assert!(message.contains("-0.05"), "{message}");
-    assert!(message.contains("[0.000001, 1000000] N/m"), "{message}");
+    assert!(message.contains("[1e-6, 1000000] N/m"), "{message}");
 }
 
 #[test]
@@ -208,7 +208,7 @@ fn other_range_violations() {
     );
     let message = afm::load_case(&path).expect_err("A0 < 0").to_string();
     assert!(
-        message.contains("free_amplitude_nm") && message.contains("(0, 100000] nm"),
+        message.contains("free_amplitude_nm") && message.contains("[0.001, 100000] nm"),
         "{message}"
     );
     let path = write(

@@ -23,8 +23,8 @@ use std::f64::consts::PI;
 
 use afm::{
     builtin_case, compare_theory, find_amplitude_ratio, measure_impacts, sample_trajectory,
-    steady_orbit, AmplitudeRatioSearch, ImpactTheory, OrbitStart, Separation, SteadyOrbit,
-    SteadyOrbitSettings, TappingModel, TheoryComparison,
+    steady_orbit, AmplitudeRatioSearch, AssumptionFailure, ImpactTheory, OrbitStart, Separation,
+    SteadyOrbit, SteadyOrbitSettings, TappingModel, TheoryComparison,
 };
 
 fn model(case: &str) -> TappingModel {
@@ -72,17 +72,20 @@ fn eq3_underestimates_the_simulated_impulse_by_the_neglected_cos_term() {
         // periodic to the Newton tolerance 1e-10; 1e-8 relative leaves room for both.
         let identity = m.impulse_nn_us - m.cos_expansion_residual_nn_us;
         assert!(
-            (c.prediction.impulse_nn_us - identity).abs() <= 1e-8 * m.impulse_nn_us,
+            (c.prediction.expect("a prediction").impulse_nn_us - identity).abs()
+                <= 1e-8 * m.impulse_nn_us,
             "Z = {}: Eq. 3 {} vs impulse - residual {identity}",
             m.z_nm,
-            c.prediction.impulse_nn_us
+            c.prediction.expect("a prediction").impulse_nn_us
         );
         assert!(
-            (m.harmonic_balance_impulse_nn_us - c.prediction.impulse_nn_us).abs()
+            (m.harmonic_balance_impulse_nn_us - c.prediction.expect("a prediction").impulse_nn_us)
+                .abs()
                 <= 1e-12 * m.impulse_nn_us
         );
         // The bound: Eq. 3 is low by at most 1 - cos(theta_bar_max) (plus the 1e-8 above).
-        let shortfall = (m.impulse_nn_us - c.prediction.impulse_nn_us) / m.impulse_nn_us;
+        let shortfall =
+            (m.impulse_nn_us - c.prediction.expect("a prediction").impulse_nn_us) / m.impulse_nn_us;
         let bound = 1.0 - impact.largest_theta_bar_deg.to_radians().cos();
         assert!(
             shortfall >= -1e-8 && shortfall <= bound + 1e-8,
@@ -103,8 +106,8 @@ fn eq3_underestimates_the_simulated_impulse_by_the_neglected_cos_term() {
             m.z_nm,
             m.amplitude_ratio,
             m.impulse_nn_us,
-            c.prediction.impulse_nn_us,
-            100.0 * c.impulse_relative_error,
+            c.prediction.expect("a prediction").impulse_nn_us,
+            100.0 * c.impulse_relative_error.expect("an error"),
             100.0 * bound,
             impact.centroid_theta_bar_deg,
             m.contact_time_periods
@@ -129,7 +132,9 @@ fn eq4_ringing_matches_the_impulse_response_of_the_simulated_impact() {
         let pulse = (c.theory.angular_frequency_2 * t_c).powi(2) / 2.0
             * (t_c / c.theory.q2_decay_time_us).exp();
         let residual = (-(c.theory.period_us - t_c) / c.theory.q2_decay_time_us).exp();
-        let from_impulse = c.q2_initial_amplitude_from_simulated_impulse_nm;
+        let from_impulse = c
+            .q2_initial_amplitude_from_simulated_impulse_nm
+            .expect("an impact");
         assert!(
             (ringing.initial_amplitude_nm / from_impulse - 1.0).abs() <= pulse + residual,
             "Z = {}: ringing {} vs impulse response {from_impulse}",
@@ -140,10 +145,13 @@ fn eq4_ringing_matches_the_impulse_response_of_the_simulated_impact() {
         // Eq. 4 adds Eq. 3's shortfall (bounded in the test above) to these.
         let eq3 = 1.0 - m.impacts[0].largest_theta_bar_deg.to_radians().cos();
         assert!(
-            c.q2_initial_amplitude_relative_error.abs() <= eq3 + pulse + residual,
+            c.q2_initial_amplitude_relative_error
+                .expect("an error")
+                .abs()
+                <= eq3 + pulse + residual,
             "Z = {}: Eq. 4 {} vs measured {}",
             m.z_nm,
-            c.prediction.q2_initial_amplitude_nm,
+            c.prediction.expect("a prediction").q2_initial_amplitude_nm,
             ringing.initial_amplitude_nm
         );
         // Between release and the next onset the ringing is free: its envelope falls by
@@ -152,14 +160,18 @@ fn eq4_ringing_matches_the_impulse_response_of_the_simulated_impact() {
         let t0 = ringing.reference_time_periods * c.theory.period_us;
         let free_decay = (-(start + c.theory.period_us - t0) / c.theory.q2_decay_time_us).exp();
         assert!((ringing.decay_over_period / free_decay - 1.0).abs() < 1e-6);
-        assert!((ringing.effective_decay_time_us / c.theory.q2_decay_time_us - 1.0).abs() < 1e-6);
+        assert!(
+            (ringing.effective_decay_time_us.expect("a decay") / c.theory.q2_decay_time_us - 1.0)
+                .abs()
+                < 1e-6
+        );
         println!(
             "Z = {:.4} nm: q2 ringing {:.6} nm, Eq. 4 {:.6} nm ({:+.2}%), impulse response of the \
              simulated impulse {:.6} nm, psi {:.3} deg",
             m.z_nm,
             ringing.initial_amplitude_nm,
-            c.prediction.q2_initial_amplitude_nm,
-            100.0 * c.q2_initial_amplitude_relative_error,
+            c.prediction.expect("a prediction").q2_initial_amplitude_nm,
+            100.0 * c.q2_initial_amplitude_relative_error.expect("an error"),
             from_impulse,
             ringing.phase_deg
         );
@@ -299,7 +311,7 @@ fn off_resonance_drive_keeps_the_harmonic_balance_but_not_eq3() {
     assert!((m.harmonic_balance_impulse_nn_us - identity).abs() <= 1e-8 * m.impulse_nn_us);
     // Eq. 3 misses by far more than its expansion error (the assumption w = w_1 fails).
     let bound = 1.0 - m.impacts[0].largest_theta_bar_deg.to_radians().cos();
-    assert!(c.impulse_relative_error.abs() > 10.0 * bound);
+    assert!(c.impulse_relative_error.expect("an error").abs() > 10.0 * bound);
 }
 
 #[test]
@@ -332,4 +344,66 @@ fn refuses_what_the_theory_does_not_describe() {
         .expect_err("period 2")
         .to_string();
     assert!(error.contains("period-1"), "{error}");
+}
+
+/// Where the theory's assumptions fail it says which, and gives no number that looks valid:
+/// below the sample surface (`Z = -5 nm`, twelve impacts, a ringing that grows) and without
+/// contact (above first contact); on the single-impact orbits it applies with no failure.
+#[test]
+fn assumption_failures_withhold_the_predictions() {
+    let model = model("biolever-mica");
+    let settings = SteadyOrbitSettings::default();
+    let deep = steady_orbit(&model, -5.0, OrbitStart::Approach, &settings).expect("orbit");
+    let c = compare(&model, &deep);
+    assert!(c
+        .assumption_failures
+        .contains(&AssumptionFailure::SeparationBelowSurface { z_nm: -5.0 }));
+    assert!(c.prediction.is_none() && c.prediction_from_u_phase.is_none());
+    assert!(c.impulse_relative_error.is_none());
+    assert!(c.q2_initial_amplitude_relative_error.is_none());
+    assert!(c.q2_decay_over_period_relative_error.is_none());
+    // The ringing there grows from one main impact to the next: no decay time, never a
+    // negative one.
+    let ringing = c.measurement.ringing.expect("a main impact");
+    assert!(
+        ringing.decay_over_period >= 1.0,
+        "{}",
+        ringing.decay_over_period
+    );
+    assert!(ringing.effective_decay_time_us.is_none());
+    assert!(c
+        .assumption_failures
+        .iter()
+        .any(|f| matches!(f, AssumptionFailure::RingingDoesNotDecay { .. })));
+    assert!(c
+        .assumption_failures
+        .iter()
+        .any(|f| matches!(f, AssumptionFailure::MultipleImpacts { impacts } if *impacts > 1)));
+
+    let above = steady_orbit(
+        &model,
+        model.grazing_separation_nm() + 0.5,
+        OrbitStart::Approach,
+        &settings,
+    )
+    .expect("orbit");
+    let c = compare(&model, &above);
+    assert!(c
+        .assumption_failures
+        .iter()
+        .any(|f| matches!(f, AssumptionFailure::NoContact { .. })));
+    assert!(c.prediction.is_none() && c.impulse_relative_error.is_none());
+    assert!(c.q2_initial_amplitude_from_simulated_impulse_nm.is_none());
+
+    let (model, orbits) = single_impact_orbits();
+    for orbit in &orbits {
+        let c = compare(&model, orbit);
+        assert!(
+            c.assumptions_hold(),
+            "Z = {}: {:?}",
+            orbit.z_nm,
+            c.assumption_failures
+        );
+        assert!(c.prediction.is_some());
+    }
 }

@@ -2,7 +2,8 @@
 //! a lock-in amplifier once per block of drive cycles, as in the paper's simulations and in
 //! every experiment. The records stream out as they are computed (CSV or JSON Lines).
 
-use afm::sweep::{MAX_CYCLE_COUNT, MAX_RATE_NM_PER_S, MAX_SEPARATION_NM};
+use afm::sweep::{MAX_CYCLE_COUNT, MAX_SEPARATION_NM};
+use afm::validation::Interval;
 use afm::{Sweep, SweepDirection, SweepRecord, SweepSettings, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -11,8 +12,11 @@ use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::exit_status::Incomplete;
 use crate::inputs::inputs_json;
 use crate::model_args::ModelArgs;
+use crate::option_ranges::{self, OptionRange};
+use crate::output::check_writable;
 use crate::plot::{render_svg, FigureFile, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 use crate::progress::{note, Progress};
 
@@ -34,7 +38,8 @@ pub struct ApproachArgs {
     /// above first contact Z_G1.
     #[arg(long, allow_negative_numbers = true, value_name = "NM")]
     pub from: Option<f64>,
-    /// The floor: separation at the end of the approach, nm, in [0, --from). Default 0.
+    /// The floor: separation at the end of the approach, nm, in [0, 100000] nm and below
+    /// --from. Default 0.
     #[arg(
         long,
         allow_negative_numbers = true,
@@ -42,7 +47,8 @@ pub struct ApproachArgs {
         default_value_t = 0.0
     )]
     pub to: f64,
-    /// Sweep speed |dZ/dt|, nm/s, in (0, 1e6]. The paper's simulations use 1 nm/s.
+    /// Sweep speed |dZ/dt|, nm/s, in (0, 1000000] nm/s (typical 0.001 to 100000 nm/s). The
+    /// paper's simulations use 1 nm/s.
     #[arg(
         long,
         allow_negative_numbers = true,
@@ -57,18 +63,40 @@ pub struct ApproachArgs {
     /// Drive cycles per lock-in reading: each record averages the Fourier coefficients of u
     /// over this many consecutive, non-overlapping cycles (an integration time of N periods);
     /// impacts are then per cycle, averaged; the peak force is the block's maximum.
-    /// In [1, 1e8].
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub lockin_cycles: usize,
-    /// Output every N-th lock-in reading of each direction (the first included). In [1, 1e8].
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub every: usize,
-    /// Drive cycles integrated at --from before the sweep starts (not reported). In [0, 1e8].
-    #[arg(long, value_name = "N", default_value_t = 20)]
-    pub settle_cycles: usize,
+    /// In [1, 100000000].
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1,
+        allow_negative_numbers = true
+    )]
+    pub lockin_cycles: i64,
+    /// Output every N-th lock-in reading of each direction (the first included). In
+    /// [1, 100000000].
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1,
+        allow_negative_numbers = true
+    )]
+    pub every: i64,
+    /// Drive cycles integrated at --from before the sweep starts (not reported). In
+    /// [0, 100000000].
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 20,
+        allow_negative_numbers = true
+    )]
+    pub settle_cycles: i64,
     /// Relative and absolute tolerance of the contact integration (nm, nm/us), in
-    /// [1e-14, 1e-4]. Free flight is exact regardless.
-    #[arg(long, value_name = "TOL", default_value_t = afm::sweep::DEFAULT_TOLERANCE)]
+    /// [1e-14, 0.0001]. Free flight is exact regardless.
+    #[arg(
+        long,
+        value_name = "TOL",
+        default_value_t = afm::sweep::DEFAULT_TOLERANCE,
+        allow_negative_numbers = true
+    )]
     pub tolerance: f64,
     /// Write JSON Lines (one object per reading) instead of CSV.
     #[arg(long)]
@@ -90,20 +118,18 @@ impl ApproachArgs {
     /// allowed range).
     pub fn settings(&self, model: &TappingModel) -> Result<SweepSettings> {
         let mut settings = SweepSettings::for_model(model);
-        check_range("--rate", self.rate, 0.0, false, MAX_RATE_NM_PER_S, "nm/s")?;
-        check_range("--to", self.to, 0.0, true, MAX_SEPARATION_NM, "nm")?;
+        option_ranges::RATE.check(self.rate)?;
+        option_ranges::TO.check(self.to)?;
         let from = self.from.unwrap_or(settings.from_nm);
-        if !from.is_finite() || from <= self.to || from > MAX_SEPARATION_NM {
-            bail!(
-                "--from {from}: the start must be a finite separation above --to ({} nm) and \
-                 at most {MAX_SEPARATION_NM} nm",
-                self.to
-            );
-        }
-        check_count("--lockin-cycles", self.lockin_cycles, 1)?;
-        check_count("--every", self.every, 1)?;
-        check_count("--settle-cycles", self.settle_cycles, 0)?;
-        check_range("--tolerance", self.tolerance, 1e-14, true, 1e-4, "")?;
+        OptionRange::new(
+            "--from",
+            Interval::left_open(self.to, MAX_SEPARATION_NM, "nm (above --to)"),
+        )
+        .check(from)?;
+        let lockin_cycles = option_ranges::LOCKIN_CYCLES.count(self.lockin_cycles)?;
+        let every = option_ranges::EVERY.count(self.every)?;
+        let settle_cycles = option_ranges::SETTLE_CYCLES.count(self.settle_cycles)?;
+        option_ranges::TOLERANCE.check(self.tolerance)?;
         let cycle_travel = self.rate * 1e-6 * model.period_us();
         if from - self.to < cycle_travel {
             bail!(
@@ -127,41 +153,14 @@ impl ApproachArgs {
         settings.to_nm = self.to;
         settings.rate_nm_per_s = self.rate;
         settings.retract = self.retract;
-        settings.settle_cycles = self.settle_cycles;
-        settings.lockin_cycles = self.lockin_cycles;
-        settings.every = self.every;
+        settings.settle_cycles = settle_cycles;
+        settings.lockin_cycles = lockin_cycles;
+        settings.every = every;
         settings.integration.relative_tolerance = self.tolerance;
         settings.integration.absolute_tolerance = self.tolerance;
         settings.validate().context("invalid sweep settings")?;
         Ok(settings)
     }
-}
-
-fn check_range(
-    option: &str,
-    value: f64,
-    min: f64,
-    min_inclusive: bool,
-    max: f64,
-    unit: &str,
-) -> Result<()> {
-    let above = if min_inclusive {
-        value >= min
-    } else {
-        value > min
-    };
-    if value.is_finite() && above && value <= max {
-        return Ok(());
-    }
-    let open = if min_inclusive { '[' } else { '(' };
-    bail!("{option} {value}: allowed range {open}{min}, {max}] {unit}")
-}
-
-fn check_count(option: &str, value: usize, min: usize) -> Result<()> {
-    if value < min || value > MAX_CYCLE_COUNT {
-        bail!("{option} {value}: allowed range [{min}, {MAX_CYCLE_COUNT}]");
-    }
-    Ok(())
 }
 
 /// Where the records go: standard output or a file, one complete line per write.
@@ -216,12 +215,15 @@ pub fn format_record(record: &SweepRecord, jsonl: bool, line: &mut String) -> Re
 
 /// Run `drumroll approach`.
 pub fn run(args: &ApproachArgs) -> Result<()> {
-    let (case, model) = args.model.model()?;
     let plot_path = args
         .plot
         .as_ref()
         .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
+    if let Some(path) = &args.out {
+        check_writable(path, "--out")?;
+    }
+    let (case, model) = args.model.model()?;
     let settings = args.settings(&model)?;
     let first_line = if args.jsonl {
         let options = json!({
@@ -243,7 +245,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         None => RecordSink::Stdout(std::io::stdout()),
         Some(path) => RecordSink::File(
             std::fs::File::create(path)
-                .with_context(|| format!("cannot create {}", path.display()))?,
+                .with_context(|| format!("--out {}: cannot create it", path.display()))?,
             path.clone(),
         ),
     };
@@ -263,14 +265,14 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
             Ok(None) => break,
             Err(error) => {
                 progress.abandon();
-                return Err(error).with_context(|| {
-                    format!(
-                        "the sweep of case `{}` failed at Z = {} nm after {} cycles",
-                        case.name,
-                        sweep.z_nm(),
-                        sweep.cycles_done()
-                    )
-                });
+                return Err(Incomplete(format!(
+                    "the sweep of case `{}` failed at Z = {} nm after {} cycles ({error}); the \
+                     records before it are written",
+                    case.name,
+                    sweep.z_nm(),
+                    sweep.cycles_done()
+                ))
+                .into());
             }
         };
         format_record(&record, args.jsonl, &mut line)?;
@@ -335,6 +337,9 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             markers: Vec::new(),
             y_period: Some(PHASE_PERIOD_DEG),
             y_integer_ticks: false,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: format!("{case}: amplitude ratio vs separation"),
@@ -344,6 +349,9 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
             markers: Vec::new(),
             y_period: None,
             y_integer_ticks: false,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ]
 }

@@ -10,6 +10,7 @@
 //! for the MAClever, differ from the vacuum ratios 6.27 at `m_tip/m_c = 0` and 6.78 at 0.16);
 //! `k_n = k_1 (k_n/k_1)`, `chi_n` and `F_n/F_1` always come from the beam model.
 
+use afm::validation::ranges;
 use afm::{Cantilever, Eigenmode};
 use anyhow::{bail, Context, Result};
 use beam::ModalProperties;
@@ -19,16 +20,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::model_args::output_path;
-use crate::output::write_atomically;
+use crate::option_ranges::{self, check_option};
+use crate::output::{print_stdout, write_atomically};
 
-/// Largest accepted stiffness `k_1`, N/m (the cantilever file's bound).
-const MAX_STIFFNESS: f64 = 1e6;
-/// Largest accepted frequency, kHz (the cantilever file's bound).
-const MAX_FREQUENCY: f64 = 1e6;
-/// Largest accepted quality factor (the cantilever file's bound).
-const MAX_QUALITY: f64 = 1e6;
-/// Largest accepted tip radius, nm (the cantilever file's bound).
-const MAX_RADIUS: f64 = 1e5;
 /// Modes whose frequency and quality factor have their own option (`--f1 .. --f4`,
 /// `--q1 .. --q4`); more modes take the `--frequencies` and `--quality-factors` lists.
 const NUMBERED_MODES: usize = 4;
@@ -61,17 +55,19 @@ impl DriveKind {
 /// Options of `drumroll cantilever`.
 #[derive(Debug, Clone, Args)]
 pub struct CantileverArgs {
-    /// Tip mass over cantilever mass, m_tip / m_c (dimensionless, 0 to 1000; the paper: 0 for
-    /// the Biolever, 0.16 for the MAClever).
+    /// Tip mass over cantilever mass, m_tip / m_c (dimensionless), in [0, 1000] for the table
+    /// and [0, 100] for a cantilever file (the paper: 0 for the Biolever, 0.16 for the MAClever).
     #[arg(long, allow_negative_numbers = true)]
     pub tip_mass_ratio: f64,
-    /// Number of eigenmodes N (1 to 50).
-    #[arg(long, default_value_t = 2)]
-    pub modes: usize,
-    /// Measured stiffness of the first mode k_1, N/m (e.g. by Sader's method).
+    /// Number of eigenmodes N, in [1, 50].
+    #[arg(long, default_value_t = 2, allow_negative_numbers = true)]
+    pub modes: i64,
+    /// Measured stiffness of the first mode k_1, N/m (e.g. by Sader's method), in
+    /// [1e-6, 1000000] N/m (typical 0.001 to 1000 N/m).
     #[arg(long, allow_negative_numbers = true)]
     pub k1: Option<f64>,
-    /// Measured natural frequency of mode 1 (in liquid), kHz.
+    /// Measured natural frequency of mode 1 (in liquid), kHz. Every frequency is in
+    /// [0.01, 1000000] kHz (typical 0.1 to 100000 kHz).
     #[arg(long, allow_negative_numbers = true)]
     pub f1: Option<f64>,
     /// Measured natural frequency of mode 2, kHz (default: f_1 times the vacuum ratio).
@@ -87,7 +83,8 @@ pub struct CantileverArgs {
     /// --f1 .. --f4; modes beyond the list use f_1 times the vacuum ratio).
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true, conflicts_with_all = ["f1", "f2", "f3", "f4"])]
     pub frequencies: Vec<f64>,
-    /// Measured quality factor of mode 1 (in liquid).
+    /// Measured quality factor of mode 1 (in liquid). Every quality factor is in
+    /// [0.001, 1000000] (typical 0.1 to 100000).
     #[arg(long, allow_negative_numbers = true)]
     pub q1: Option<f64>,
     /// Measured quality factor of mode 2.
@@ -102,7 +99,7 @@ pub struct CantileverArgs {
     /// Measured quality factors of modes 1..N (comma separated; instead of --q1 .. --q4).
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true, conflicts_with_all = ["q1", "q2", "q3", "q4"])]
     pub quality_factors: Vec<f64>,
-    /// Tip radius R, nm.
+    /// Tip radius R, nm, in [0.1, 100000] nm (typical 1 to 10000 nm).
     #[arg(long, allow_negative_numbers = true)]
     pub radius: Option<f64>,
     /// Which forcing ratios F_n / F_1 the file gets: a uniformly distributed drive
@@ -162,7 +159,7 @@ impl CantileverArgs {
     /// The measured frequency of each of the N modes, or `None`.
     fn frequency_inputs(&self) -> Result<Vec<Option<f64>>> {
         per_mode(
-            self.modes,
+            self.modes.max(0) as usize,
             &self.numbered_frequencies(),
             &self.frequencies,
             "--f",
@@ -173,7 +170,7 @@ impl CantileverArgs {
     /// The quality factor of each of the N modes, or `None`.
     fn quality_inputs(&self) -> Result<Vec<Option<f64>>> {
         per_mode(
-            self.modes,
+            self.modes.max(0) as usize,
             &self.numbered_qualities(),
             &self.quality_factors,
             "--q",
@@ -212,23 +209,11 @@ fn per_mode(
     Ok(values)
 }
 
-/// Check `value` lies in `(0, max]` and is finite; the message names the option and the unit.
-fn check_positive(option: &str, value: f64, max: f64, unit: &str) -> Result<()> {
-    if value.is_finite() && value > 0.0 && value <= max {
-        Ok(())
-    } else {
-        let unit = if unit.is_empty() {
-            "(dimensionless)"
-        } else {
-            unit
-        };
-        bail!("{option} {value}: must be in (0, {max}] {unit}")
-    }
-}
-
 /// Run `drumroll cantilever`.
 pub fn run(args: &CantileverArgs) -> Result<()> {
-    let table = beam::modal_table(args.tip_mass_ratio, args.modes)
+    option_ranges::TIP_MASS_RATIO.check(args.tip_mass_ratio)?;
+    let modes = option_ranges::MODES.count(args.modes)?;
+    let table = beam::modal_table(args.tip_mass_ratio, modes)
         .context("invalid --tip-mass-ratio or --modes")?;
     let out = args
         .out
@@ -252,17 +237,10 @@ pub fn run(args: &CantileverArgs) -> Result<()> {
         })?;
     }
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&table_json(
-                args,
-                &table,
-                built.as_ref(),
-                out.as_deref()
-            ))?
-        );
+        let json = table_json(args, &table, built.as_ref(), out.as_deref());
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(&json)?))?;
     } else {
-        print!("{}", summary(args, &table, built.as_ref(), out.as_deref()));
+        print_stdout(&summary(args, &table, built.as_ref(), out.as_deref()))?;
     }
     Ok(())
 }
@@ -278,48 +256,43 @@ fn build(
     // Every value given is checked first, so that a bad value is named even when others are
     // missing.
     if let Some(k1) = args.k1 {
-        check_positive("--k1", k1, MAX_STIFFNESS, "N/m")?;
+        option_ranges::K1.check(k1)?;
     }
     if let Some(radius) = args.radius {
-        check_positive("--radius", radius, MAX_RADIUS, "nm")?;
+        option_ranges::RADIUS.check(radius)?;
     }
     for (index, frequency) in frequencies.iter().enumerate() {
         if let Some(frequency) = frequency {
-            check_positive(
+            check_option(
                 &format!("--f{}", index + 1),
+                ranges::FREQUENCY_KHZ,
                 *frequency,
-                MAX_FREQUENCY,
-                "kHz",
             )?;
         }
     }
     for (index, quality) in qualities.iter().enumerate() {
         if let Some(quality) = quality {
-            check_positive(&format!("--q{}", index + 1), *quality, MAX_QUALITY, "")?;
+            check_option(
+                &format!("--q{}", index + 1),
+                ranges::QUALITY_FACTOR,
+                *quality,
+            )?;
         }
     }
-    let (Some(k1), Some(Some(f1)), Some(radius)) = (args.k1, frequencies.first(), args.radius)
-    else {
+    let missing = missing_options(args, &frequencies, &qualities);
+    let (Some(k1), Some(Some(f1)), Some(radius), true) = (
+        args.k1,
+        frequencies.first(),
+        args.radius,
+        missing.is_empty(),
+    ) else {
         bail!(
-            "to build a cantilever give --k1 (N/m), --f1 (kHz), --radius (nm) and a quality \
-             factor for every mode (--q1 .. --q{}, or --quality-factors); with only \
-             --tip-mass-ratio and --modes the modal table is printed alone",
-            args.modes
-        );
-    };
-    let missing: Vec<String> = qualities
-        .iter()
-        .enumerate()
-        .filter(|(_, q)| q.is_none())
-        .map(|(index, _)| format!("--q{}", index + 1))
-        .collect();
-    if !missing.is_empty() {
-        bail!(
-            "missing quality factor(s) {}: give a measured Q for every mode (e.g. from thermal \
-             spectra in liquid); there is no theory for Q in liquid here",
+            "to build a cantilever, missing: {} (a measured Q for every mode, e.g. from thermal \
+             spectra in liquid: there is no theory for Q in liquid here; with only \
+             --tip-mass-ratio and --modes the modal table is printed alone)",
             missing.join(", ")
         );
-    }
+    };
     let mut modes = Vec::with_capacity(table.len());
     let mut sources = Vec::with_capacity(table.len());
     for ((mode, frequency), quality) in table.iter().zip(&frequencies).zip(&qualities) {
@@ -397,8 +370,37 @@ fn build(
     Ok((cantilever, sources))
 }
 
-/// The JSON of `drumroll cantilever --json`: `{"modes": [...]}` with every table ratio, plus
-/// the built values per mode and the whole cantilever when one is built.
+/// The options a build needs that are not given: `--k1`, `--f1`, `--radius` and a quality
+/// factor for every mode.
+fn missing_options(
+    args: &CantileverArgs,
+    frequencies: &[Option<f64>],
+    qualities: &[Option<f64>],
+) -> Vec<String> {
+    let mut missing: Vec<String> = Vec::new();
+    if args.k1.is_none() {
+        missing.push(String::from("--k1 (N/m)"));
+    }
+    if frequencies.first().copied().flatten().is_none() {
+        missing.push(String::from("--f1 (kHz)"));
+    }
+    if args.radius.is_none() {
+        missing.push(String::from("--radius (nm)"));
+    }
+    missing.extend(
+        qualities
+            .iter()
+            .enumerate()
+            .filter(|(_, q)| q.is_none())
+            .map(|(index, _)| format!("--q{}", index + 1)),
+    );
+    missing
+}
+
+/// The JSON of `drumroll cantilever --json` (docs/output-schema.md): `{"modes": [...]}` with
+/// every table ratio (the optical sensitivity `chi_n` under the cantilever file's name,
+/// `optical_sensitivity`), plus the built values per mode and the whole cantilever when one is
+/// built, and the `inputs` it was computed from.
 fn table_json(
     args: &CantileverArgs,
     table: &[ModalProperties],
@@ -414,7 +416,7 @@ fn table_json(
                 "eigenvalue": mode.eigenvalue,
                 "frequency_ratio": mode.frequency_ratio,
                 "stiffness_ratio": mode.stiffness_ratio,
-                "chi": mode.chi,
+                "optical_sensitivity": mode.chi,
                 "force_ratio_distributed": mode.force_ratio_distributed,
                 "force_ratio_tip": mode.force_ratio_tip,
             });
@@ -427,16 +429,27 @@ fn table_json(
                 map.insert("frequency_khz".into(), eigenmode.frequency_khz.into());
                 map.insert("frequency_source".into(), sources[index].name().into());
                 map.insert("quality_factor".into(), eigenmode.quality_factor.into());
-                map.insert(
-                    "optical_sensitivity".into(),
-                    eigenmode.optical_sensitivity.into(),
-                );
                 map.insert("force_ratio".into(), eigenmode.force_ratio.into());
             }
             entry
         })
         .collect();
     let mut value = json!({
+        "inputs": {
+            "drumroll_version": env!("CARGO_PKG_VERSION"),
+            "command": "cantilever",
+            "options": {
+                "tip_mass_ratio": args.tip_mass_ratio,
+                "modes": args.modes,
+                "drive": args.drive.name(),
+                "k1_n_per_m": args.k1,
+                "frequencies_khz": args.frequency_inputs().ok(),
+                "quality_factors": args.quality_inputs().ok(),
+                "radius_nm": args.radius,
+                "name": args.name,
+                "out": out.map(|path| path.display().to_string()),
+            },
+        },
         "tip_mass_ratio": args.tip_mass_ratio,
         "drive": args.drive.name(),
         "frequency_ratios": "in vacuum (liquid loading changes them)",

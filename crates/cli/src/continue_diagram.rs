@@ -2,6 +2,7 @@
 //! periodic orbits from above first contact down to a floor, every special point labelled and
 //! located, and optionally the retract branch back up.
 
+use afm::validation::Interval;
 use afm::{approach_diagram, diagram, BifurcationDiagram, Case, DiagramSettings, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -10,9 +11,11 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::continue_figure::{figure, CaseDiagrams};
+use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{model_of, output_path, ModelArgs};
-use crate::output::write_atomically;
+use crate::option_ranges::{self, OptionRange};
+use crate::output::{print_stdout, write_atomically};
 use crate::plot::FigureFile;
 use crate::progress::Progress;
 
@@ -25,12 +28,19 @@ pub struct ContinueArgs {
     /// Lowest separation of the approach, nm, in [-A0, Z_G1) (default 0.05 A0).
     #[arg(long, allow_negative_numbers = true)]
     pub floor: Option<f64>,
-    /// The approach also stops when A/A0 falls below this ratio (default 0.3; 0 disables).
-    #[arg(long, default_value_t = 0.3)]
+    /// The approach also stops when A/A0 falls below this ratio, in [0, 1) (default 0.3; 0
+    /// disables).
+    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
     pub min_amplitude_ratio: f64,
-    /// Largest arclength step, in nm (default A0/250: several hundred points per diagram).
-    #[arg(long)]
+    /// Largest arclength step, in nm, in (0, A0] (default A0/250: several hundred points per
+    /// diagram).
+    #[arg(long, allow_negative_numbers = true)]
     pub max_step: Option<f64>,
+    /// Largest number of points per branch, in [2, 10000000]. A branch that reaches it before
+    /// its end stops there: the points so far are printed and written, stderr says so, and the
+    /// exit status is 3.
+    #[arg(long, default_value_t = 20_000, allow_negative_numbers = true)]
+    pub max_points: i64,
     /// After the approach, continue back up from its lowest point (Z increasing), so that
     /// hysteresis shows; the bistable range is reported.
     #[arg(long)]
@@ -65,24 +75,29 @@ struct Continued {
 /// Run `drumroll continue`: each `--case` in turn (tables or JSON lines printed as they are
 /// computed), then the CSV (one case) and the figure.
 pub fn run(args: &ContinueArgs) -> Result<()> {
-    let cases = args.model.cases()?;
+    // The options that need no model, checked before the output paths and the models.
+    option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
+    option_ranges::MAX_POINTS.count(args.max_points)?;
     let csv_path = args
         .csv
         .as_ref()
         .map(|p| output_path(p, "csv", "--csv"))
         .transpose()?;
+    let plot = args
+        .plot
+        .as_ref()
+        .map(|p| FigureFile::new(p, "--plot"))
+        .transpose()?;
+    let cases = args.model.cases()?;
     if cases.len() > 1 && csv_path.is_some() {
         bail!(
             "--csv takes one case ({} given): run once per case",
             cases.len()
         );
     }
-    let plot = args
-        .plot
-        .as_ref()
-        .map(|p| FigureFile::new(p, "--plot"))
-        .transpose()?;
+    let several = cases.len() > 1;
     let mut drawn = Vec::new();
+    let mut unfinished = Vec::new();
     let mut progress = Progress::new(
         cases.len() as u64,
         "{wide_bar} {pos}/{len} cases, now {msg}, {eta} left",
@@ -103,6 +118,13 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             }
             write_atomically(path, text.as_bytes())?;
         }
+        if let Some(why) = unfinished_branches(&continued.approach, continued.retract.as_ref()) {
+            unfinished.push(if several {
+                format!("case `{}`: {why}", case.name)
+            } else {
+                why
+            });
+        }
         drawn.push(CaseDiagrams {
             case,
             model,
@@ -114,36 +136,76 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     if let Some(plot) = plot {
         plot.write(&figure(&drawn, args.overlay)?)?;
     }
-    Ok(())
+    if unfinished.is_empty() {
+        return Ok(());
+    }
+    let hint = if unfinished
+        .iter()
+        .any(|u| u.contains("maximum number of points"))
+    {
+        format!(
+            "; raise --max-points (now {}) or --max-step",
+            args.max_points
+        )
+    } else {
+        String::new()
+    };
+    Err(Incomplete(format!("{}{hint}", unfinished.join("; "))).into())
 }
 
-/// The diagram settings of `model` with the options applied and checked.
-fn settings(args: &ContinueArgs, model: &TappingModel) -> Result<DiagramSettings> {
+/// `None` when every branch reached its requested end, else which did not and why (the run
+/// then ends with an [`Incomplete`] error: `main` exits with status 3).
+fn unfinished_branches(
+    approach: &BifurcationDiagram,
+    retract: Option<&BifurcationDiagram>,
+) -> Option<String> {
+    let unfinished: Vec<String> = std::iter::once(("approach", approach))
+        .chain(retract.map(|retract| ("retract", retract)))
+        .filter(|(_, diagram)| !diagram.completed)
+        .map(|(direction, diagram)| {
+            let error = diagram
+                .error
+                .as_deref()
+                .map_or_else(String::new, |error| format!(" ({error})"));
+            format!("the {direction} ended because {}{error}", diagram.stop)
+        })
+        .collect();
+    (!unfinished.is_empty()).then(|| unfinished.join("; "))
+}
+
+/// The approach's settings for `model` from `continue`'s options, every option checked
+/// against [`crate::option_ranges`] (see [`approach_settings`]; `--max-points` besides).
+pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<DiagramSettings> {
+    let mut settings =
+        approach_settings(model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    settings.max_points = option_ranges::MAX_POINTS.count(args.max_points)?;
+    Ok(settings)
+}
+
+/// The approach diagram's settings of `model` with the options `--floor` (in `[-A0, Z_G1)`),
+/// `--min-amplitude-ratio` and `--max-step` (in `(0, A0]`) applied, each checked against
+/// [`crate::option_ranges`] (errors name the option and its range); shared by `continue` and
+/// `map`.
+pub fn approach_settings(
+    model: &TappingModel,
+    floor: Option<f64>,
+    min_amplitude_ratio: f64,
+    max_step: Option<f64>,
+) -> Result<DiagramSettings> {
+    option_ranges::MIN_AMPLITUDE_RATIO.check(min_amplitude_ratio)?;
     let mut settings = DiagramSettings::approach(model);
-    if let Some(floor) = args.floor {
-        let lowest = -model.free_amplitude_nm();
-        if !(floor >= lowest && floor < model.grazing_separation_nm()) {
-            bail!(
-                "--floor {floor}: allowed [{lowest}, {:.6}) nm, from -A0 up to just below first contact Z_G1",
-                model.grazing_separation_nm()
-            );
-        }
+    let a0 = model.free_amplitude_nm();
+    if let Some(floor) = floor {
+        OptionRange::new(
+            "--floor",
+            Interval::right_open(-a0, model.grazing_separation_nm(), "nm"),
+        )
+        .check(floor)?;
         settings.z_limit_nm = floor;
     }
-    if !(0.0..1.0).contains(&args.min_amplitude_ratio) {
-        bail!(
-            "--min-amplitude-ratio {}: allowed 0 <= R < 1",
-            args.min_amplitude_ratio
-        );
-    }
-    settings.min_amplitude_ratio = args.min_amplitude_ratio;
-    if let Some(step) = args.max_step {
-        if !(step.is_finite() && step > 0.0 && step <= model.free_amplitude_nm()) {
-            bail!(
-                "--max-step {step}: allowed 0 < step <= A0 = {} nm",
-                model.free_amplitude_nm()
-            );
-        }
+    settings.min_amplitude_ratio = min_amplitude_ratio;
+    if let Some(step) = max_step {
+        OptionRange::new("--max-step", Interval::positive(a0, "nm")).check(step)?;
         settings.max_step = step;
     }
     Ok(settings)
@@ -151,7 +213,7 @@ fn settings(args: &ContinueArgs, model: &TappingModel) -> Result<DiagramSettings
 
 /// The approach (and retract) of one case.
 fn continue_case(args: &ContinueArgs, case: &Case, model: &TappingModel) -> Result<Continued> {
-    let settings = settings(args, model)?;
+    let settings = diagram_settings(args, model)?;
     let approach = approach_diagram(model, &settings)
         .with_context(|| format!("continuation of case `{}` failed", case.name))?;
     let retract = if args.retract {
@@ -164,6 +226,7 @@ fn continue_case(args: &ContinueArgs, case: &Case, model: &TappingModel) -> Resu
         };
         let retract_settings = DiagramSettings {
             max_step: settings.max_step,
+            max_points: settings.max_points,
             ..DiagramSettings::retract(model)
         };
         Some(
@@ -215,6 +278,7 @@ fn print_report(
             "points": approach.points,
             "special_points": approach.special_points,
             "stop": approach.stop,
+            "completed": approach.completed,
             "error": approach.error,
         });
         if let Some(retract) = &retract {
@@ -222,24 +286,25 @@ fn print_report(
                 "points": retract.points,
                 "special_points": retract.special_points,
                 "stop": retract.stop,
+                "completed": retract.completed,
                 "error": retract.error,
             });
             object["bistable_ranges_nm"] = json!(bistable);
         }
-        println!("{}", serde_json::to_string(&object)?);
+        print_stdout(&format!("{}\n", serde_json::to_string(&object)?))?;
     } else {
-        print!("{}", table(&case.name, model, "approach", approach));
+        print_stdout(&table(&case.name, model, "approach", approach))?;
         if let Some(retract) = &retract {
-            print!("{}", table(&case.name, model, "retract", retract));
+            print_stdout(&table(&case.name, model, "retract", retract))?;
             match bistable.as_deref() {
-                Some([]) | None => {
-                    println!("no bistable range: approach and retract follow one stable orbit")
-                }
+                Some([]) | None => print_stdout(
+                    "no bistable range: approach and retract follow one stable orbit\n",
+                )?,
                 Some(ranges) => {
                     for [low, high] in ranges {
-                        println!(
-                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)"
-                        );
+                        print_stdout(&format!(
+                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)\n"
+                        ))?;
                     }
                 }
             }

@@ -259,6 +259,7 @@ fn shared_panels(cases: &[CaseDiagrams]) -> Vec<Panel> {
             markers: markers(cases, |p| (p.amplitude_ratio, p.phase_deg)),
             y_period: Some(PHASE_PERIOD_DEG),
             y_integer_ticks: false,
+            ..Panel::default()
         },
         Panel {
             title: ratio_title,
@@ -268,6 +269,7 @@ fn shared_panels(cases: &[CaseDiagrams]) -> Vec<Panel> {
             markers: markers(cases, |p| (p.z_nm, p.amplitude_ratio)),
             y_period: None,
             y_integer_ticks: false,
+            ..Panel::default()
         },
         Panel {
             title: String::from("impacts per period vs Z"),
@@ -277,6 +279,7 @@ fn shared_panels(cases: &[CaseDiagrams]) -> Vec<Panel> {
             markers: Vec::new(),
             y_period: None,
             y_integer_ticks: true,
+            ..Panel::default()
         },
     ]
 }
@@ -292,5 +295,6 @@ fn case_panel(index: usize, c: &CaseDiagrams) -> Panel {
         markers: markers(one, |p| (p.amplitude_ratio, p.phase_deg)),
         y_period: Some(PHASE_PERIOD_DEG),
         y_integer_ticks: false,
+        ..Panel::default()
     }
 }

@@ -7,7 +7,14 @@ use std::process::ExitCode;
 /// Non-smooth dynamics of AFM cantilevers tapping a sample: steady orbits, impacts, grazing
 /// bifurcations (Melcher, Xu, Raman, Appl. Phys. Lett. 93, 093111 (2008)).
 #[derive(Debug, Parser)]
-#[command(name = "drumroll", version, about)]
+#[command(
+    name = "drumroll",
+    version,
+    about,
+    after_help = "Exit status: 0 success; 1 error (bad input or a failed computation); 2 the \
+                  command line does not parse; 3 the run stopped before its requested end (the \
+                  output computed so far is written, and stderr says why)."
+)]
 struct Cli {
     /// No progress bars and no notes on standard error (bars are drawn only on a terminal,
     /// and only for runs longer than about 2 s).
@@ -24,12 +31,20 @@ enum Command {
     /// The bifurcation diagram in Z: periodic orbits continued from above first contact down
     /// to a floor, grazing points G1, G2, G3, ..., folds and period doubling located.
     Continue(drumroll::continue_diagram::ContinueArgs),
+    /// The impact-regime map over a second parameter (a0, drive-frequency, sample-modulus,
+    /// tip-radius, quality-factor-N, stiffness-N): the G_n, fold and period-doubling points of
+    /// the approach continued over a range, in the (PARAM, Z) and (PARAM, A/A0) planes.
+    Map(drumroll::map::MapArgs),
     /// A time-domain approach (and retract) sweep at a constant rate, read by a lock-in once
     /// per drive cycle (or block of cycles); the records stream out as CSV or JSON Lines.
     Approach(drumroll::approach::ApproachArgs),
     /// The paper's approximate theory (Eqs. 3-4, lambda_1..3, the ring-down criterion) beside
     /// the same quantities measured on the simulated steady orbit at one Z or A/A0.
     Theory(drumroll::theory::TheoryArgs),
+    /// The brute-force regime map: for each value of a parameter (a row), a quasi-static
+    /// approach (and retract) in Z by transients, each cell's impacts per period, period, A/A0
+    /// and phase; shardable (`--shard I/N`, then `grid merge`) and resumable.
+    Grid(drumroll::grid::GridArgs),
     /// The Euler-Bernoulli modal table of a cantilever with a point tip mass, and a cantilever
     /// file built from measured k_1, frequencies and quality factors.
     Cantilever(drumroll::cantilever::CantileverArgs),
@@ -48,8 +63,10 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => drumroll::simulate::run(args),
         Command::Continue(args) => drumroll::continue_diagram::run(args),
+        Command::Map(args) => drumroll::map::run(args),
         Command::Approach(args) => drumroll::approach::run(args),
         Command::Theory(args) => drumroll::theory::run(args),
+        Command::Grid(args) => drumroll::grid::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),
         Command::Cases(args) => drumroll::cases::run(args),
         Command::Completions(args) => drumroll::shell::completions(args, Cli::command()),
@@ -58,11 +75,31 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
+            if let Some(incomplete) = error.downcast_ref::<drumroll::exit_status::Incomplete>() {
+                eprintln!("drumroll: {incomplete}");
+                return ExitCode::from(drumroll::exit_status::INCOMPLETE);
+            }
             eprintln!("drumroll: error: {error}");
-            for cause in error.chain().skip(1) {
+            for cause in distinct_causes(&error) {
                 eprintln!("  caused by: {cause}");
             }
             ExitCode::FAILURE
         }
     }
+}
+
+/// The causes of `error` below its top message, each once: a cause whose text the message
+/// above it already contains (an error that prints its source, e.g. `solver failure: ...`)
+/// is skipped.
+fn distinct_causes(error: &anyhow::Error) -> Vec<String> {
+    let mut above = error.to_string();
+    let mut causes = Vec::new();
+    for cause in error.chain().skip(1) {
+        let text = cause.to_string();
+        if !above.contains(&text) {
+            causes.push(text.clone());
+        }
+        above = text;
+    }
+    causes
 }

@@ -6,6 +6,8 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
+use crate::option_ranges;
+
 /// Which cantilever taps which sample, and how it is driven.
 #[derive(Debug, Clone, Args)]
 pub struct ModelArgs {
@@ -21,18 +23,23 @@ pub struct ModelArgs {
     /// A sample file (JSON) or built-in sample name (`mica`, `soft`, `purple-membrane`).
     #[arg(long, requires = "cantilever")]
     pub sample: Option<String>,
-    /// Free amplitude A0 of the photodiode signal u, nm (MODEL.md section 3). With `--case`
-    /// it overrides the case's value.
+    /// Free amplitude A0 of the photodiode signal u, nm (MODEL.md section 3), in
+    /// [0.001, 100000] nm (typical 0.1 to 1000 nm). With `--case` it overrides the case's value.
     #[arg(long, allow_negative_numbers = true)]
     pub a0: Option<f64>,
-    /// Drive frequency, kHz (default: the case's, else the fundamental f_1).
+    /// Drive frequency, kHz (default: the case's, else the fundamental f_1), in [0.01, 1000000]
+    /// kHz (typical 0.1 to 100000 kHz) and, in every command, from f_1/100 to 100 times the
+    /// cantilever's highest modal frequency; a drive over ten times away from every mode is
+    /// warned about.
     #[arg(long, allow_negative_numbers = true)]
     pub drive_frequency: Option<f64>,
 }
 
 impl ModelArgs {
-    /// The resolved case (`biolever-mica` when nothing is given); an error when `--case` is
-    /// given more than once.
+    /// The resolved case (`biolever-mica` when nothing is given), every option and file
+    /// checked (errors name the option or the file and field, and the allowed range; valid but
+    /// implausible values are warned about on stderr); an error when `--case` is given more
+    /// than once.
     pub fn case(&self) -> Result<Case> {
         if self.case.len() > 1 {
             bail!(
@@ -40,44 +47,66 @@ impl ModelArgs {
                 self.case.len()
             );
         }
+        self.check_overrides()?;
         self.resolve(self.case.first().map(String::as_str))
     }
 
     /// Every case given (`--case` repeated), in order, each with the `--a0` and
-    /// `--drive-frequency` overrides; the single resolved case otherwise.
+    /// `--drive-frequency` overrides and checked as [`ModelArgs::case`]; the single resolved
+    /// case otherwise.
     pub fn cases(&self) -> Result<Vec<Case>> {
         if self.case.len() <= 1 {
             return Ok(vec![self.case()?]);
         }
+        self.check_overrides()?;
         self.case
             .iter()
             .map(|name| self.resolve(Some(name)))
             .collect()
     }
 
-    /// The case named `name` (or built from `--cantilever` and `--sample`), overrides applied.
+    /// Check `--a0` and `--drive-frequency` against the option range table.
+    fn check_overrides(&self) -> Result<()> {
+        if let Some(a0) = self.a0 {
+            option_ranges::A0.check(a0)?;
+        }
+        if let Some(frequency) = self.drive_frequency {
+            // The warning, if any, comes with the cantilever's range in `resolve`.
+            option_ranges::DRIVE_FREQUENCY.warning(frequency)?;
+        }
+        Ok(())
+    }
+
+    /// The case named `name` (or built from `--cantilever` and `--sample`), overrides applied
+    /// and checked.
     fn resolve(&self, name: Option<&str>) -> Result<Case> {
         let mut case = match (name, &self.cantilever, &self.sample) {
-            (Some(name), None, None) => fixtures::find_case(name)?,
+            (Some(name), None, None) => {
+                let case = fixtures::find_case(name)?;
+                warn_all(case.warnings(name));
+                case
+            }
             (None, Some(cantilever), Some(sample)) => {
                 let Some(a0) = self.a0 else {
                     bail!("--cantilever and --sample need --a0 (the free amplitude, nm)");
                 };
-                let cantilever = if is_file_reference(cantilever) {
+                let cantilever_model = if is_file_reference(cantilever) {
                     fixtures::load_cantilever(Path::new(cantilever))?
                 } else {
                     fixtures::builtin_cantilever(cantilever)?
                 };
-                let sample = if is_file_reference(sample) {
+                warn_all(cantilever_model.warnings(cantilever));
+                let sample_model = if is_file_reference(sample) {
                     fixtures::load_sample(Path::new(sample))?
                 } else {
                     fixtures::builtin_sample(sample)?
                 };
+                warn_all(sample_model.warnings(sample));
                 Case {
-                    name: format!("{}-{}", cantilever.name, sample.name),
+                    name: format!("{}-{}", cantilever_model.name, sample_model.name),
                     description: String::from("from the command line"),
-                    cantilever,
-                    sample,
+                    cantilever: cantilever_model,
+                    sample: sample_model,
                     free_amplitude_nm: a0,
                     drive_frequency_khz: None,
                 }
@@ -89,7 +118,11 @@ impl ModelArgs {
             case.free_amplitude_nm = a0;
         }
         if let Some(frequency) = self.drive_frequency {
+            option_ranges::drive_frequency_for(&case.cantilever).check(frequency)?;
             case.drive_frequency_khz = Some(frequency);
+            if let Some(warning) = case.drive_warning() {
+                eprintln!("drumroll: warning: --drive-frequency {warning}");
+            }
         }
         case.validate("the command line")
             .context("invalid model parameters")?;
@@ -109,6 +142,13 @@ pub fn model_of(case: Case) -> Result<(Case, TappingModel)> {
     Ok((case, model))
 }
 
+/// Print each warning on stderr.
+fn warn_all(warnings: Vec<String>) {
+    for warning in warnings {
+        eprintln!("drumroll: warning: {warning}");
+    }
+}
+
 /// Whether a command-line reference names a file (it ends in `.json` or exists) rather than a
 /// built-in fixture.
 fn is_file_reference(reference: &str) -> bool {
@@ -119,12 +159,16 @@ fn is_file_reference(reference: &str) -> bool {
 /// The case used when none is named.
 pub const DEFAULT_CASE: &str = "biolever-mica";
 
-/// A path for an output file, checked to have the expected extension.
+/// A path for an output file, checked to have the expected extension and to be writable
+/// (before any computation: [`crate::output::check_writable`]).
 pub fn output_path(path: &Path, extension: &str, option: &str) -> Result<PathBuf> {
     match path.extension().and_then(|e| e.to_str()) {
-        Some(e) if e.eq_ignore_ascii_case(extension) => Ok(path.to_path_buf()),
+        Some(e) if e.eq_ignore_ascii_case(extension) => {
+            crate::output::check_writable(path, option)?;
+            Ok(path.to_path_buf())
+        }
         _ => bail!(
-            "{option} {}: the file name must end in .{extension}",
+            "{option} {}: allowed: a file name ending in .{extension}",
             path.display()
         ),
     }

@@ -1,14 +1,78 @@
 //! Writing output files so that a user never finds a half-written one: the whole content goes
-//! to a temporary file beside the target, which is then renamed over it.
+//! to a temporary file beside the target, which is then renamed over it; and checking, before
+//! computing, that the target can be written at all.
 
-use anyhow::{Context, Result};
-use std::io::Write;
+use anyhow::{bail, Context, Result};
+use std::io::{BufWriter, Write};
 use std::path::Path;
+
+/// Check, before any computation, that `path` (the value of `option`) can be written: its
+/// directory exists and takes a new file (a probe file is created there and removed), and
+/// `path` is not a directory. The error names the option and the user's path.
+pub fn check_writable(path: &Path, option: &str) -> Result<()> {
+    let fail = |reason: String| -> Result<()> {
+        bail!("{option} {}: cannot write there: {reason}", path.display())
+    };
+    if path.is_dir() {
+        return fail(String::from("it is a directory"));
+    }
+    let Some(file_name) = path.file_name() else {
+        return fail(String::from("it names no file"));
+    };
+    let mut probe_name = std::ffi::OsString::from(".");
+    probe_name.push(file_name);
+    probe_name.push(format!(".{}.probe", std::process::id()));
+    let probe = path.with_file_name(probe_name);
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+    {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+        }
+        Err(error) => return fail(error.to_string()),
+    }
+    if path.exists() {
+        if let Err(error) = std::fs::OpenOptions::new().append(true).open(path) {
+            return fail(error.to_string());
+        }
+    }
+    Ok(())
+}
+
+/// Print `text` on standard output; a reader that closed the pipe (`drumroll ... | head`)
+/// ends the output quietly instead of a panic.
+pub fn print_stdout(text: &str) -> Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        Err(error) if error.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(error).context("cannot write to standard output")
+        }
+        _ => Ok(()),
+    }
+}
 
 /// Write `content` to `path` atomically: into `path` + a temporary suffix in the same
 /// directory, flushed and synced, then renamed to `path`. On any error the temporary file is
 /// removed and the target is left as it was.
 pub fn write_atomically(path: &Path, content: &[u8]) -> Result<()> {
+    write_atomically_with(path, |writer| {
+        writer.write_all(content)?;
+        Ok(())
+    })
+}
+
+/// As [`write_atomically`], the content streamed by `write` into a buffered writer of the
+/// temporary file (for content too large to hold in memory at once); an error of `write`
+/// leaves the target as it was.
+pub fn write_atomically_with(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> Result<()>,
+) -> Result<()> {
     let file_name = path
         .file_name()
         .with_context(|| format!("output path {} names no file", path.display()))?;
@@ -16,15 +80,15 @@ pub fn write_atomically(path: &Path, content: &[u8]) -> Result<()> {
     temporary_name.push(format!(".{}.partial", std::process::id()));
     let temporary = path.with_file_name(temporary_name);
     let result = (|| -> Result<()> {
-        let mut file = std::fs::File::create(&temporary)
-            .with_context(|| format!("cannot create {}", temporary.display()))?;
-        file.write_all(content)
-            .with_context(|| format!("cannot write {}", temporary.display()))?;
-        file.sync_all()
-            .with_context(|| format!("cannot sync {}", temporary.display()))?;
-        std::fs::rename(&temporary, path)
-            .with_context(|| format!("cannot move {} to {}", temporary.display(), path.display()))
-    })();
+        let file = std::fs::File::create(&temporary)?;
+        let mut writer = BufWriter::new(file);
+        write(&mut writer)?;
+        let file = writer.into_inner().map_err(|error| error.into_error())?;
+        file.sync_all()?;
+        std::fs::rename(&temporary, path)?;
+        Ok(())
+    })()
+    .with_context(|| format!("cannot write {}", path.display()));
     if result.is_err() {
         let _ = std::fs::remove_file(&temporary);
     }

@@ -4,7 +4,8 @@
 //!
 //! One concept per submodule: [`axis`] (ticks), [`geometry`] (pixel rectangles),
 //! [`decimate`] (thinning), [`layout`] (plot area and data-to-pixel map), [`legend`],
-//! [`labels`] (leader-line placement), [`font`] (the embedded typeface), [`svg`] (the
+//! [`labels`] (leader-line placement), [`regions`] (region names placed clear of curves),
+//! [`font`] (the embedded typeface), [`svg`] (the
 //! document), [`raster`] (PNG and PDF), [`file`] (format by extension).
 
 pub mod axis;
@@ -16,11 +17,13 @@ pub mod labels;
 pub mod layout;
 pub mod legend;
 pub mod raster;
+pub mod regions;
 pub mod svg;
 
 pub use file::{FigureFile, FigureFormat};
 
 use anyhow::{anyhow, Result};
+
 /// How a series is stroked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stroke {
@@ -61,6 +64,29 @@ pub struct Marker {
     pub at: (f64, f64),
 }
 
+/// A region of the plane named by a text without a marker (such as `1 impact` between two
+/// grazing curves): the text is centred on the first of `anchors` where it covers no curve,
+/// label or legend (see [`regions`]).
+#[derive(Debug, Clone)]
+pub struct Region {
+    /// The name.
+    pub label: String,
+    /// Points inside the region in data coordinates, preferred first.
+    pub anchors: Vec<(f64, f64)>,
+}
+
+/// A filled rectangle in data coordinates (a cell of a brute-force grid), drawn under
+/// everything else in a light tint of a palette colour, or grey for `None`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    /// Horizontal extent `(low, high)`.
+    pub x: (f64, f64),
+    /// Vertical extent `(low, high)`.
+    pub y: (f64, f64),
+    /// Index into the palette, or `None` for grey.
+    pub colour: Option<usize>,
+}
+
 /// One x-y chart of a figure.
 #[derive(Debug, Clone, Default)]
 pub struct Panel {
@@ -80,6 +106,13 @@ pub struct Panel {
     pub y_period: Option<f64>,
     /// Whether the vertical axis counts something (impacts per period): ticks at integers only.
     pub y_integer_ticks: bool,
+    /// Names written inside regions of the plane, without a marker (such as `1 impact`).
+    pub regions: Vec<Region>,
+    /// Closed polygons in data coordinates filled in a light grey under the series (regions
+    /// such as a bistable range).
+    pub shaded: Vec<Vec<(f64, f64)>>,
+    /// Filled rectangles drawn first, under the shading and the series.
+    pub cells: Vec<Cell>,
 }
 
 /// The period of a phase axis in degrees (see [`Panel::y_period`]).

@@ -13,6 +13,8 @@ use std::path::PathBuf;
 use crate::digits;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::ModelArgs;
+use crate::option_ranges;
+use crate::output::print_stdout;
 use crate::plot::{render_svg, FigureFile};
 use crate::trajectory_plot::trajectory_panels;
 
@@ -22,7 +24,8 @@ pub struct SimulateArgs {
     /// The cantilever, sample and drive.
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Separation Z between the cantilever base and the sample, nm (Z > 0 above the sample).
+    /// Separation Z between the cantilever base and the sample, nm (Z > 0 above the sample), in
+    /// [-A0, 100000] nm.
     #[arg(
         long,
         allow_hyphen_values = true,
@@ -31,7 +34,7 @@ pub struct SimulateArgs {
     )]
     pub z: Option<f64>,
     /// Instead of --z: approach from above first contact (Z decreasing, each orbit started from
-    /// the previous one) and stop at the Z where A/A0 equals this ratio (0 < R < 1).
+    /// the previous one) and stop at the Z where A/A0 equals this ratio, in (0, 1).
     #[arg(long, allow_negative_numbers = true)]
     pub amplitude_ratio: Option<f64>,
     /// Which orbit --z reports where several coexist: `approach`, the orbit of the quasi-static
@@ -101,18 +104,17 @@ fn coexisting_orbit(
 
 /// Run `drumroll simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
-    let (case, model) = args.model.model()?;
+    check_orbit_options(args.z, args.amplitude_ratio)?;
     let plot_path = args
         .plot
         .as_ref()
         .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
+    let (case, model) = args.model.model()?;
     let settings = SteadyOrbitSettings::default();
     let (orbit, start, coexisting) = match (args.z, args.amplitude_ratio) {
         (Some(z), None) => {
-            if !z.is_finite() {
-                bail!("--z {z}: the separation must be a finite number of nm");
-            }
+            option_ranges::separation_for(model.free_amplitude_nm()).check(z)?;
             let orbit = steady_orbit(&model, z, args.start.orbit_start(), &settings)
                 .with_context(|| format!("no steady orbit at Z = {z} nm"))?;
             let coexisting = coexisting_orbit(&model, &orbit, args.start, &settings);
@@ -142,11 +144,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             "start": start.name(),
         });
         object["inputs"] = orbit_inputs_json("simulate", options, &case, &model, &settings);
-        println!("{}", serde_json::to_string_pretty(&object)?);
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;
     } else {
-        print!("{}", summary(&case.name, &model, &orbit));
+        print_stdout(&summary(&case.name, &model, &orbit))?;
         if let Some(other) = &coexisting {
-            print!("{}", coexisting_note(&model, start, other));
+            print_stdout(&coexisting_note(&model, start, other))?;
         }
     }
     if let Some(path) = plot_path {
@@ -156,8 +158,20 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
         path.write(&render_svg(&panels, 2, 1, (800, 320))?)?;
         if !args.json {
-            println!("figure: {}", path.path.display());
+            print_stdout(&format!("figure: {}\n", path.path.display()))?;
         }
+    }
+    Ok(())
+}
+
+/// Check `--z` and `--amplitude-ratio` of `simulate` and `theory` against the table of
+/// [`crate::option_ranges`] (`--z` again against the model's `-A0` once it is built).
+pub fn check_orbit_options(z: Option<f64>, amplitude_ratio: Option<f64>) -> Result<()> {
+    if let Some(z) = z {
+        option_ranges::Z.check(z)?;
+    }
+    if let Some(ratio) = amplitude_ratio {
+        option_ranges::AMPLITUDE_RATIO.check(ratio)?;
     }
     Ok(())
 }

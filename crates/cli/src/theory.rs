@@ -3,15 +3,17 @@
 //! measured on the simulated steady orbit at one `Z` or `A/A0`, with relative errors.
 
 use afm::{
-    compare_theory, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, OrbitStart,
-    SteadyOrbit, SteadyOrbitSettings, TappingModel, TheoryComparison,
+    compare_theory, find_amplitude_ratio, steady_orbit, AmplitudeRatioSearch, AssumptionFailure,
+    OrbitStart, SteadyOrbit, SteadyOrbitSettings, TappingModel, TheoryComparison,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
 use std::fmt::Write as _;
 
+use crate::inputs::orbit_inputs_json;
 use crate::model_args::ModelArgs;
+use crate::output::print_stdout;
 
 /// The amplitude ratio used when neither `--z` nor `--amplitude-ratio` is given: the paper's
 /// single-impact example (its Fig. 1(a)).
@@ -23,10 +25,11 @@ pub struct TheoryArgs {
     /// The cantilever, sample and drive.
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Compare at this separation Z between the cantilever base and the sample, nm.
+    /// Compare at this separation Z between the cantilever base and the sample, nm, in
+    /// [-A0, 100000] nm (at Z <= 0 the theory gives no prediction: the tip rests in the sample).
     #[arg(long, allow_hyphen_values = true, conflicts_with = "amplitude_ratio")]
     pub z: Option<f64>,
-    /// Compare at the Z where the approach from first contact reaches this A/A0 (0 < R < 1);
+    /// Compare at the Z where the approach from first contact reaches this A/A0, in (0, 1);
     /// default 0.95 (the paper's single-impact example, Fig. 1(a)) when --z is not given.
     #[arg(long, allow_negative_numbers = true)]
     pub amplitude_ratio: Option<f64>,
@@ -37,6 +40,7 @@ pub struct TheoryArgs {
 
 /// Run `drumroll theory`.
 pub fn run(args: &TheoryArgs) -> Result<()> {
+    crate::simulate::check_orbit_options(args.z, args.amplitude_ratio)?;
     let (case, model) = args.model.model()?;
     let settings = SteadyOrbitSettings::default();
     let orbit = orbit(args, &model, &settings)?;
@@ -53,13 +57,16 @@ pub fn run(args: &TheoryArgs) -> Result<()> {
             orbit.z_nm
         )
     })?;
+    for warning in warnings(&comparison) {
+        eprintln!("drumroll: warning: {warning}");
+    }
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&comparison_json(&case.name, &model, &comparison))?
-        );
+        let mut object = comparison_json(&case.name, &model, &comparison);
+        let options = json!({ "z_nm": args.z, "amplitude_ratio": args.amplitude_ratio });
+        object["inputs"] = orbit_inputs_json("theory", options, &case, &model, &settings);
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;
     } else {
-        print!("{}", summary(&case.name, &model, &comparison));
+        print_stdout(&summary(&case.name, &model, &comparison))?;
     }
     Ok(())
 }
@@ -71,10 +78,8 @@ fn orbit(
 ) -> Result<SteadyOrbit> {
     match (args.z, args.amplitude_ratio) {
         (Some(z), None) => {
-            if !z.is_finite() {
-                bail!("--z {z}: the separation must be a finite number of nm");
-            }
-            steady_orbit(model, z, OrbitStart::Transient, settings)
+            crate::option_ranges::separation_for(model.free_amplitude_nm()).check(z)?;
+            steady_orbit(model, z, OrbitStart::Approach, settings)
                 .with_context(|| format!("no steady orbit at Z = {z} nm"))
         }
         (None, ratio) => {
@@ -87,21 +92,20 @@ fn orbit(
     }
 }
 
-/// The warning printed when the drive is not at `w_1` (Eq. 3's assumption), else `None`.
-pub fn assumption_warning(model: &TappingModel, comparison: &TheoryComparison) -> Option<String> {
-    (!comparison.theory.drive_at_fundamental).then(|| {
-        format!(
-            "the drive ({:.4} kHz) is not at f_1 = {:.4} kHz: Eqs. 3-4 assume w = w_1 and do not \
-             hold here (computed anyway with a_0 at the actual drive); the first-harmonic balance \
-             at the actual w gives {:.6} nN us",
-            model.drive_frequency_khz(),
-            model.cantilever().fundamental_frequency_khz(),
-            comparison.measurement.harmonic_balance_impulse_nn_us
-        )
-    })
+/// The warnings of a comparison: every assumption of the theory that the orbit violates
+/// ([`afm::AssumptionFailure`], in words), printed on stderr, in the table and in the JSON's
+/// `warnings`.
+pub fn warnings(comparison: &TheoryComparison) -> Vec<String> {
+    comparison
+        .assumption_failures
+        .iter()
+        .map(ToString::to_string)
+        .collect()
 }
 
-/// The JSON object of `drumroll theory --json` (units in the key names; NaN as null).
+/// The JSON object of `drumroll theory --json` (docs/output-schema.md; units in the key
+/// names): a prediction the theory withholds, a relative error without both sides, and a
+/// quantity that is undefined on the orbit are `null`, and `warnings` says why.
 pub fn comparison_json(
     case: &str,
     model: &TappingModel,
@@ -119,7 +123,12 @@ pub fn comparison_json(
         "free_q1_amplitude_nm": theory.free_q1_amplitude_nm,
         "drive_frequency_khz": model.drive_frequency_khz(),
         "drive_at_fundamental": theory.drive_at_fundamental,
-        "assumption_warning": assumption_warning(model, comparison),
+        "assumption_failures": comparison
+            .assumption_failures
+            .iter()
+            .map(AssumptionFailure::kind)
+            .collect::<Vec<_>>(),
+        "warnings": warnings(comparison),
         "lambda_1": theory.lambda_1,
         "lambda_2": theory.lambda_2,
         "lambda_3": theory.lambda_3,
@@ -131,41 +140,98 @@ pub fn comparison_json(
         "phase_used": "q1_first_harmonic",
         "q1_phase_deg": measurement.q1_phase_deg,
         "u_phase_deg": measurement.u_phase_deg,
-        "impulse_eq3_nn_us": prediction.impulse_nn_us,
-        "q2_initial_amplitude_nm": prediction.q2_initial_amplitude_nm,
-        "q2_decay_time_us": prediction.q2_decay_time_us,
-        "q2_decay_over_period": prediction.q2_decay_over_period,
-        "impulse_eq3_from_u_phase_nn_us": comparison.prediction_from_u_phase.impulse_nn_us,
+        "impulse_eq3_nn_us": prediction.map(|p| p.impulse_nn_us),
+        "q2_initial_amplitude_nm": prediction.map(|p| p.q2_initial_amplitude_nm),
+        "q2_decay_time_us": prediction.map(|p| p.q2_decay_time_us),
+        "q2_decay_over_period": prediction.map(|p| p.q2_decay_over_period),
+        "impulse_eq3_from_u_phase_nn_us": comparison.prediction_from_u_phase.map(|p| p.impulse_nn_us),
+        "q2_initial_amplitude_from_simulated_impulse_nm": comparison
+            .q2_initial_amplitude_from_simulated_impulse_nm,
         "simulated": {
-            "impacts_per_period": measurement.impacts.len(),
+            "impacts_per_period": measurement.impacts.len() as f64,
             "impulse_nn_us": measurement.impulse_nn_us,
-            "q2_initial_amplitude_nm": ringing.map(|r| r.initial_amplitude_nm),
-            "q2_phase_deg": ringing.map(|r| r.phase_deg),
-            "q2_decay_over_period": ringing.map(|r| r.decay_over_period),
-            "q2_effective_decay_time_us": ringing.map(|r| r.effective_decay_time_us),
+            "q1_amplitude_nm": measurement.q1_amplitude_nm,
+            "cos_expansion_residual_nn_us": measurement.cos_expansion_residual_nn_us,
+            "harmonic_balance_impulse_nn_us": measurement.harmonic_balance_impulse_nn_us,
             "contact_time_periods": measurement.contact_time_periods,
+            "impacts": measurement.impacts,
+            "main_impact": measurement.main_impact,
+            "ringing": ringing,
         },
         "relative_error": {
             "impulse": comparison.impulse_relative_error,
             "q2_initial_amplitude": comparison.q2_initial_amplitude_relative_error,
             "q2_decay_over_period": comparison.q2_decay_over_period_relative_error,
         },
-        "comparison": comparison,
     })
 }
 
-fn relative(value: f64) -> String {
-    if value.is_finite() {
-        format!("{:+.2}%", 100.0 * value)
-    } else {
-        String::from("-")
+/// A relative error as a signed percentage, `-` when there is none.
+fn relative(value: Option<f64>) -> String {
+    value
+        .filter(|v| v.is_finite())
+        .map_or_else(|| String::from("-"), |v| format!("{:+.2}%", 100.0 * v))
+}
+
+/// A value with `format`, `-` when there is none.
+fn optional(value: Option<f64>, format: &dyn Fn(f64) -> String) -> String {
+    value.map_or_else(|| String::from("-"), format)
+}
+
+/// The four rows theory / simulated / relative error of the table (`-` where a value is
+/// withheld or undefined).
+fn comparison_rows(s: &mut String, comparison: &TheoryComparison) {
+    let (p, m) = (comparison.prediction, &comparison.measurement);
+    let ringing = m.ringing;
+    let six = |v: f64| format!("{v:.6}");
+    let four_e = |v: f64| format!("{v:.4e}");
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16.6}{:>12}",
+        "impulse per period (Eq. 3), nN us",
+        optional(p.map(|p| p.impulse_nn_us), &six),
+        m.impulse_nn_us,
+        relative(comparison.impulse_relative_error)
+    );
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16}{:>12}",
+        "q_2 initial amplitude (Eq. 4), nm",
+        optional(p.map(|p| p.q2_initial_amplitude_nm), &six),
+        optional(ringing.map(|r| r.initial_amplitude_nm), &six),
+        relative(comparison.q2_initial_amplitude_relative_error)
+    );
+    let decay_time = ringing.and_then(|r| r.effective_decay_time_us);
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16}{:>12}",
+        "q_2 decay time tau (Eq. 4), us",
+        optional(p.map(|p| p.q2_decay_time_us), &six),
+        optional(decay_time, &six),
+        relative(
+            p.zip(decay_time)
+                .map(|(p, measured)| p.q2_decay_time_us / measured - 1.0)
+        )
+    );
+    let _ = writeln!(
+        s,
+        "{:<34}{:>16}{:>16}{:>12}",
+        "q_2 decay over one period (Eq. 4)",
+        optional(p.map(|p| p.q2_decay_over_period), &four_e),
+        optional(ringing.map(|r| r.decay_over_period), &four_e),
+        relative(comparison.q2_decay_over_period_relative_error)
+    );
+    if p.is_none() {
+        let _ = writeln!(
+            s,
+            "(-: no prediction, the theory's assumptions fail on this orbit; see the warnings)"
+        );
     }
 }
 
 /// The readable table of `drumroll theory`.
 pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) -> String {
     let theory = &comparison.theory;
-    let p = &comparison.prediction;
     let m = &comparison.measurement;
     let mut s = String::new();
     let _ = writeln!(
@@ -175,7 +241,7 @@ pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) 
         theory.free_q1_amplitude_nm,
         model.drive_frequency_khz()
     );
-    if let Some(warning) = assumption_warning(model, comparison) {
+    for warning in warnings(comparison) {
         let _ = writeln!(s, "WARNING: {warning}");
     }
     let _ = writeln!(s, "nondimensional numbers (the paper, below Eq. 4):");
@@ -225,57 +291,15 @@ pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) 
         "{:<34}{:>16}{:>16}{:>12}",
         "quantity", "theory", "simulated", "error"
     );
+    comparison_rows(&mut s, comparison);
     let ringing = m.ringing;
-    let measured = |value: Option<f64>, format: &dyn Fn(f64) -> String| {
-        value.map_or_else(|| String::from("-"), format)
-    };
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16.6}{:>16.6}{:>12}",
-        "impulse per period (Eq. 3), nN us",
-        p.impulse_nn_us,
-        m.impulse_nn_us,
-        relative(comparison.impulse_relative_error)
-    );
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16.6}{:>16}{:>12}",
-        "q_2 initial amplitude (Eq. 4), nm",
-        p.q2_initial_amplitude_nm,
-        measured(ringing.map(|r| r.initial_amplitude_nm), &|v| format!(
-            "{v:.6}"
-        )),
-        relative(comparison.q2_initial_amplitude_relative_error)
-    );
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16.6}{:>16}{:>12}",
-        "q_2 decay time tau (Eq. 4), us",
-        p.q2_decay_time_us,
-        measured(ringing.map(|r| r.effective_decay_time_us), &|v| format!(
-            "{v:.6}"
-        )),
-        relative(
-            ringing.map_or(f64::NAN, |r| p.q2_decay_time_us / r.effective_decay_time_us
-                - 1.0)
-        )
-    );
-    let _ = writeln!(
-        s,
-        "{:<34}{:>16.4e}{:>16}{:>12}",
-        "q_2 decay over one period (Eq. 4)",
-        p.q2_decay_over_period,
-        measured(ringing.map(|r| r.decay_over_period), &|v| format!(
-            "{v:.4e}"
-        )),
-        relative(comparison.q2_decay_over_period_relative_error)
-    );
-    let _ = writeln!(
-        s,
-        "with u's phase Phi instead of phi: impulse {:.6} nN us, q_2 amplitude {:.6} nm",
-        comparison.prediction_from_u_phase.impulse_nn_us,
-        comparison.prediction_from_u_phase.q2_initial_amplitude_nm
-    );
+    if let Some(from_u) = comparison.prediction_from_u_phase {
+        let _ = writeln!(
+            s,
+            "with u's phase Phi instead of phi: impulse {:.6} nN us, q_2 amplitude {:.6} nm",
+            from_u.impulse_nn_us, from_u.q2_initial_amplitude_nm
+        );
+    }
     let _ = writeln!(
         s,
         "what Eq. 3 neglects: int F_ts (1 + cos theta) dt = {:.6} nN us (cos theta = -1 over the \
@@ -300,7 +324,10 @@ pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) 
             impact.largest_theta_bar_deg
         );
     }
-    if let Some(ringing) = ringing {
+    if let (Some(ringing), Some(from_impulse)) = (
+        ringing,
+        comparison.q2_initial_amplitude_from_simulated_impulse_nm,
+    ) {
         let _ = writeln!(
             s,
             "q_2 ringing = q_2 minus its free steady response to the drive, referred to the main \
@@ -311,12 +338,8 @@ pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) 
             s,
             "Eq. 4 with the simulated main impulse instead of Eq. 3: {:.6} nm ({} from the \
              measured ringing: the impulse-response idealisation alone)",
-            comparison.q2_initial_amplitude_from_simulated_impulse_nm,
-            relative(
-                comparison.q2_initial_amplitude_from_simulated_impulse_nm
-                    / ringing.initial_amplitude_nm
-                    - 1.0
-            )
+            from_impulse,
+            relative(Some(from_impulse / ringing.initial_amplitude_nm - 1.0))
         );
     }
     s

@@ -50,6 +50,9 @@ pub fn trajectory_panels(
             markers: Vec::new(),
             y_period: None,
             y_integer_ticks: false,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
         Panel {
             title: String::from("tip-sample force (Hertz)"),
@@ -59,6 +62,9 @@ pub fn trajectory_panels(
             markers: Vec::new(),
             y_period: None,
             y_integer_ticks: false,
+            regions: Vec::new(),
+            shaded: Vec::new(),
+            cells: Vec::new(),
         },
     ])
 }

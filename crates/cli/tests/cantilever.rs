@@ -21,7 +21,7 @@ fn second_mode(tip_mass_ratio: &str) -> Value {
     for key in [
         "stiffness_ratio",
         "frequency_ratio",
-        "chi",
+        "optical_sensitivity",
         "force_ratio_distributed",
         "force_ratio_tip",
     ] {
@@ -37,7 +37,7 @@ fn table_reproduces_the_papers_numbers() {
     // and -1.54 at 0.16 (+-0.005).
     let bare = second_mode("0");
     assert!((number(&bare, "stiffness_ratio") - 39.0).abs() <= 0.5);
-    assert!((number(&bare, "chi") - 3.47).abs() <= 0.005);
+    assert!((number(&bare, "optical_sensitivity") - 3.47).abs() <= 0.005);
     assert!((number(&bare, "force_ratio_distributed") + 0.554).abs() <= 0.0005);
     assert_eq!(number(&bare, "force_ratio_tip"), 1.0);
     // The classical clamped-free eigenvalues: (b_2/b_1)^2 = (4.694091/1.875104)^2.
@@ -45,7 +45,7 @@ fn table_reproduces_the_papers_numbers() {
     assert!((number(&bare, "frequency_ratio") - ratio).abs() <= 1e-9 * ratio);
     assert!((number(&second_mode("0.1"), "stiffness_ratio") - 74.0).abs() <= 0.5);
     let mac = second_mode("0.16");
-    assert!((number(&mac, "chi") - 5.26).abs() <= 0.005);
+    assert!((number(&mac, "optical_sensitivity") - 5.26).abs() <= 0.005);
     assert!((number(&mac, "force_ratio_distributed") + 1.54).abs() <= 0.005);
 }
 
@@ -87,7 +87,7 @@ fn built_file_loads_and_drives_a_simulation() {
         // Stiffness k_1 times the table's ratio; chi and F_n/F_1 from the table.
         let k = 0.1 * number(row, "stiffness_ratio");
         assert!((mode.stiffness_n_per_m - k).abs() <= 1e-15 * k);
-        assert_eq!(mode.optical_sensitivity, number(row, "chi"));
+        assert_eq!(mode.optical_sensitivity, number(row, "optical_sensitivity"));
         assert_eq!(mode.force_ratio, number(row, "force_ratio_distributed"));
     }
     // Measured frequencies kept; the third from f_1 times the vacuum ratio.
@@ -197,7 +197,7 @@ fn bad_input_is_refused_with_a_message_naming_it() {
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
             [&base[..], &["--q1", "1.6"]].concat(),
-            "missing quality factor(s) --q2",
+            "to build a cantilever, missing: --q2 (",
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "4", "--q3", "5"]].concat(),
@@ -205,7 +205,7 @@ fn bad_input_is_refused_with_a_message_naming_it() {
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "-4"]].concat(),
-            "--q2 -4: must be in (0, 1000000]",
+            "--q2 -4: allowed [0.001, 1000000]",
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "4", "--f2", "3"]].concat(),
@@ -213,23 +213,23 @@ fn bad_input_is_refused_with_a_message_naming_it() {
         ),
         (
             [&base[..], &["--q1", "1.6", "--q2", "4", "--out", &text_out]].concat(),
-            "must end in .json",
+            "allowed: a file name ending in .json",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "0", "--k1", "-1"],
-            "--k1 -1: must be in (0, 1000000] N/m",
+            "--k1 -1: allowed [1e-6, 1000000] N/m",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "0", "--radius", "30"],
-            "to build a cantilever give --k1",
+            "to build a cantilever, missing: --k1 (N/m), --f1 (kHz), --q1, --q2 (",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "-0.1"],
-            "tip_mass_ratio",
+            "--tip-mass-ratio -0.1: allowed [0, 1000]",
         ),
         (
             vec!["cantilever", "--tip-mass-ratio", "0", "--modes", "51"],
-            "must be in 1..=50",
+            "--modes 51: allowed [1, 50]",
         ),
     ];
     for (args, message) in cases {

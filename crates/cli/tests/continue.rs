@@ -224,7 +224,7 @@ fn bad_options_are_refused_with_a_message_naming_the_option_and_its_range() {
         // First contact of the Biolever is 10.0115 nm: a floor above it is refused.
         (
             &["--case", "biolever-mica", "--floor", "12"],
-            &["--floor 12", "below first contact"],
+            &["--floor 12: allowed [-10, 10.011526"],
         ),
         // A floor deeper than -A0 (-10 nm) is refused: Hertz contact is long invalid there and
         // the branch would run through ever more impacts.
@@ -234,11 +234,11 @@ fn bad_options_are_refused_with_a_message_naming_the_option_and_its_range() {
         ),
         (
             &["--case", "biolever-mica", "--min-amplitude-ratio", "2"],
-            &["--min-amplitude-ratio 2", "0 <= R < 1"],
+            &["--min-amplitude-ratio 2: allowed [0, 1)"],
         ),
         (
             &["--case", "biolever-mica", "--max-step", "0"],
-            &["--max-step 0", "0 < step <= A0"],
+            &["--max-step 0: allowed (0, 10] nm"],
         ),
         (
             &["--case", "biolever-mica", "--csv", "diagram.txt"],

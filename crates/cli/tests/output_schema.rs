@@ -190,6 +190,28 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
     ])];
     printed.extend(check(&schema, "`drumroll continue --json`", &continued));
 
+    // map: the MAClever on mica over Q_1 (a closed fold curve with two cusps), with --at and
+    // --labels.
+    let mapped = [one(&[
+        "map",
+        "--case",
+        "maclever-mica",
+        "--vary",
+        "quality-factor-1",
+        "--from",
+        "1",
+        "--to",
+        "8",
+        "--at",
+        "2,3",
+        "--labels",
+        "G1,fold",
+        "--points",
+        "10",
+        "--json",
+    ])];
+    printed.extend(check(&schema, "`drumroll map --json`", &mapped));
+
     // approach, JSON Lines: the inputs line, then records of both directions.
     let text = stdout_of(&[
         "approach",
@@ -212,6 +234,76 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
         "`drumroll approach` (CSV, `--jsonl`)",
         &[lines],
     ));
+
+    // grid, JSON Lines: the header line, then rows with approach, retract and bistable.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let map = directory.path().join("map.jsonl");
+    stdout_of(&[
+        "grid",
+        "--vary",
+        "a0",
+        "--from",
+        "9",
+        "--to",
+        "10",
+        "--steps",
+        "2",
+        "--z-from",
+        "9.5",
+        "--z-to",
+        "8.5",
+        "--z-steps",
+        "3",
+        "--retract",
+        "--output",
+        map.to_str().expect("utf-8 path"),
+    ]);
+    let lines: Vec<Value> = std::fs::read_to_string(&map)
+        .expect("map")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one object per line"))
+        .collect();
+    assert!(lines[0].get("inputs").is_some() && lines[0].get("row").is_none());
+    printed.extend(check(&schema, "`drumroll grid` (JSON Lines)", &[lines]));
+
+    // theory: the paper's example (every number), below the surface and without contact
+    // (predictions withheld: `null`).
+    let theory = [
+        one(&["theory", "--case", "biolever-mica", "--json"]),
+        one(&["theory", "--case", "biolever-mica", "--z", "-5", "--json"]),
+        one(&["theory", "--case", "biolever-mica", "--z", "11", "--json"]),
+    ];
+    printed.extend(check(&schema, "`drumroll theory --json`", &theory));
+
+    // cantilever: the table alone, and a cantilever built and written.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let out = directory.path().join("lever.json");
+    let cantilever = [
+        one(&["cantilever", "--tip-mass-ratio", "0", "--json"]),
+        one(&[
+            "cantilever",
+            "--tip-mass-ratio",
+            "0.16",
+            "--k1",
+            "0.1",
+            "--f1",
+            "3.5",
+            "--f2",
+            "28",
+            "--q1",
+            "1.6",
+            "--q2",
+            "4.3",
+            "--radius",
+            "50",
+            "--name",
+            "lever",
+            "--out",
+            out.to_str().expect("utf-8 path"),
+            "--json",
+        ]),
+    ];
+    printed.extend(check(&schema, "`drumroll cantilever --json`", &cantilever));
 
     // Every documented key of the inputs object is printed by some command.
     for path in schema["The `inputs` object"].keys() {
@@ -258,6 +350,47 @@ fn csv_columns_are_the_documented_json_keys_in_order() {
         .filter(|word| header.contains(word))
         .collect();
     assert_eq!(listed, header);
+
+    // map's CSV: `label`, then the documented point keys in order.
+    let map_csv = directory.path().join("map.csv");
+    stdout_of(&[
+        "map",
+        "--vary",
+        "a0",
+        "--from",
+        "9.9",
+        "--to",
+        "10.1",
+        "--points",
+        "4",
+        "--labels",
+        "G2",
+        "--csv",
+        map_csv.to_str().expect("utf-8 path"),
+    ]);
+    let written = std::fs::read_to_string(&map_csv).expect("CSV");
+    let header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    assert_eq!(header[0], "label");
+    let curve_points = &schema["`drumroll map --json`"];
+    for column in &header[1..] {
+        let types = curve_points
+            .get(&format!("curves[].points[].{column}"))
+            .unwrap_or_else(|| panic!("map CSV column `{column}` is no JSON point key"));
+        assert!(!types.contains("array") && !types.contains("object"));
+    }
+    let section = text
+        .split("## `drumroll map --csv FILE`")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .expect("the map CSV section");
+    let listed: Vec<&str> = section
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|word| header.contains(word))
+        .collect();
+    assert_eq!(listed, header);
+    assert!(written.lines().skip(1).all(|l| l.starts_with("G2,")));
 
     // approach's CSV header is the documented line, each column a record key.
     let sweep = stdout_of(&["approach", "--from", "8.8", "--to", "8.79", "--rate", "10"]);

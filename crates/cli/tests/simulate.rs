@@ -94,11 +94,11 @@ fn bad_input_is_refused_with_a_message_naming_it() {
                 "--amplitude-ratio",
                 "1.5",
             ],
-            "0 < R < 1",
+            "--amplitude-ratio 1.5: allowed (0, 1)",
         ),
         (
             &["simulate", "--case", "biolever-mica", "--z", "NaN"],
-            "finite",
+            "--z NaN: allowed [-100000, 100000] nm",
         ),
         (
             &[
@@ -110,7 +110,7 @@ fn bad_input_is_refused_with_a_message_naming_it() {
                 "--z",
                 "5",
             ],
-            "free_amplitude_nm",
+            "--a0 -3: allowed [0.001, 100000] nm",
         ),
     ];
     for (args, message) in cases {

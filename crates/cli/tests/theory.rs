@@ -27,7 +27,9 @@ fn json_has_the_documented_keys_and_the_papers_closed_forms() {
     assert!((number(&theory, "amplitude_ratio") - 0.95).abs() < 1e-8);
     assert_eq!(theory["phase_used"], "q1_first_harmonic");
     assert_eq!(theory["drive_at_fundamental"], true);
-    assert!(theory["assumption_warning"].is_null());
+    assert_eq!(theory["warnings"], serde_json::json!([]));
+    assert_eq!(theory["assumption_failures"], serde_json::json!([]));
+    assert_eq!(theory["inputs"]["command"], "theory");
     // The paper's formulas typed in for the Biolever (k_1 = 0.036 N/m, Q_1 = 1.2, f_1 = 9.3
     // kHz; k_2 = 1.4 N/m, Q_2 = 2, f_2 = 72 kHz), with a_0 and phi as the command reports them.
     let (w1, w2) = (2.0 * PI * 9.3e-3, 2.0 * PI * 72e-3);
@@ -61,7 +63,7 @@ fn json_has_the_documented_keys_and_the_papers_closed_forms() {
     assert!((simulated - observed).abs() <= 1e-9 * observed);
     // Eq. 3 neglects int F (1 + cos theta) >= 0, at most 1 - cos(theta_bar_max) of the impulse
     // (see crates/afm/tests/theory.rs).
-    let impact = &theory["comparison"]["measurement"]["impacts"][0];
+    let impact = &theory["simulated"]["impacts"][0];
     let bound = 1.0 - number(impact, "largest_theta_bar_deg").to_radians().cos();
     let error = number(&theory["relative_error"], "impulse");
     assert!(
@@ -84,8 +86,16 @@ fn eq3_brackets_the_simulated_impulse_in_the_single_impact_regime() {
     for z in ["9.9", "9.7", "9.4"] {
         let theory = json_of(&["theory", "--case", "biolever-mica", "--z", z]);
         let simulated = &theory["simulated"];
-        assert_eq!(simulated["impacts_per_period"], 1, "Z = {z}");
-        let impact = &theory["comparison"]["measurement"]["impacts"][0];
+        assert_eq!(
+            simulated["impacts_per_period"].as_f64(),
+            Some(1.0),
+            "Z = {z}"
+        );
+        assert!(
+            simulated["impacts_per_period"].is_f64(),
+            "a float like simulate's"
+        );
+        let impact = &theory["simulated"]["impacts"][0];
         let bound = 1.0 - number(impact, "largest_theta_bar_deg").to_radians().cos();
         let error = number(&theory["relative_error"], "impulse");
         assert!(
@@ -105,7 +115,8 @@ fn off_resonance_drive_is_flagged() {
         "19.5",
     ]);
     assert_eq!(theory["drive_at_fundamental"], false);
-    let warning = theory["assumption_warning"].as_str().expect("a warning");
+    assert_eq!(theory["assumption_failures"][0], "drive_off_fundamental");
+    let warning = theory["warnings"][0].as_str().expect("a warning");
     assert!(warning.contains("assume w = w_1"), "{warning}");
     let text = drumroll()
         .args([
@@ -142,11 +153,11 @@ fn bad_input_is_refused_with_a_message_naming_it() {
                 "--amplitude-ratio",
                 "1.5",
             ],
-            "0 < R < 1",
+            "--amplitude-ratio 1.5: allowed (0, 1)",
         ),
         (
             &["theory", "--case", "biolever-mica", "--z", "NaN"],
-            "finite",
+            "--z NaN: allowed [-100000, 100000] nm",
         ),
         (
             &[
@@ -182,4 +193,64 @@ fn bad_input_is_refused_with_a_message_naming_it() {
         assert!(stderr.contains(message), "{args:?}: stderr was {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
     }
+}
+
+/// Issue 21, defect 2: below the sample surface (`--z -5`, the tip resting 5 nm inside the
+/// sample) and above first contact the theory's assumptions fail: every prediction and
+/// relative error is `null`, no negative decay time appears anywhere, and the reasons are in
+/// `warnings`, on stderr and in the table.
+#[test]
+fn where_the_assumptions_fail_no_number_looks_valid() {
+    for (z, kind) in [("-5", "separation_below_surface"), ("11", "no_contact")] {
+        let output = drumroll()
+            .args(["theory", "--case", "biolever-mica", "--z", z, "--json"])
+            .output()
+            .expect("runs");
+        assert!(output.status.success(), "Z = {z}");
+        let theory: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+        let kinds = theory["assumption_failures"].as_array().expect("an array");
+        assert!(kinds.iter().any(|k| k == kind), "Z = {z}: {kinds:?}");
+        for key in [
+            "impulse_eq3_nn_us",
+            "q2_initial_amplitude_nm",
+            "q2_decay_time_us",
+            "q2_decay_over_period",
+            "impulse_eq3_from_u_phase_nn_us",
+        ] {
+            assert!(theory[key].is_null(), "Z = {z}: `{key}` = {}", theory[key]);
+        }
+        for error in theory["relative_error"]
+            .as_object()
+            .expect("object")
+            .values()
+        {
+            assert!(error.is_null(), "Z = {z}: a relative error {error}");
+        }
+        if let Some(time) = theory["simulated"]["ringing"]["effective_decay_time_us"].as_f64() {
+            assert!(time > 0.0, "Z = {z}: decay time {time}");
+        }
+        let warnings = theory["warnings"].as_array().expect("warnings");
+        assert_eq!(warnings.len(), kinds.len());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        for warning in warnings {
+            let warning = warning.as_str().expect("text");
+            assert!(
+                stderr.contains(warning),
+                "Z = {z}: not on stderr: {warning}"
+            );
+        }
+        let table = drumroll()
+            .args(["theory", "--case", "biolever-mica", "--z", z])
+            .output()
+            .expect("runs");
+        let text = String::from_utf8_lossy(&table.stdout);
+        assert!(text.contains("WARNING: "), "Z = {z}: {text}");
+        assert!(
+            !text.contains("-243"),
+            "Z = {z}: the negative decay time is printed"
+        );
+    }
+    // Z = -5: the ringing grows between main impacts, so it has no decay time at all.
+    let deep = json_of(&["theory", "--case", "biolever-mica", "--z", "-5"]);
+    assert!(deep["simulated"]["ringing"]["effective_decay_time_us"].is_null());
 }

@@ -75,6 +75,15 @@ pub enum ContinuationError {
         /// The last corrector residual (state units; infinite if the period map failed).
         residual: f64,
     },
+    /// The system refused a value of its second parameter (see
+    /// [`crate::TwoParametrised::set_second_parameter`]).
+    #[error("second parameter q = {value:e} not allowed: {message}")]
+    SecondParameter {
+        /// The refused value.
+        value: f64,
+        /// The system's reason.
+        message: String,
+    },
     /// A settings field is outside its allowed range.
     #[error("invalid setting `{field}` = {value:e}: allowed {allowed}")]
     InvalidSettings {

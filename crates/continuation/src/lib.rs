@@ -11,7 +11,10 @@
 //! * [`Continuation`]: pseudo-arclength continuation in `(x, p)` through folds, an iterator of
 //!   [`BranchPoint`]s, which detects and locates [`SpecialPoint`]s: folds, period doubling,
 //!   Neimark-Sacker, grazing `G<n>` (a minimum of the gap through zero), merging and
-//!   splitting of impacts, and impact-count changes that are not grazing.
+//!   splitting of impacts, and impact-count changes that are not grazing;
+//! * [`continue_curve`]: two-parameter continuation of a grazing, fold or period-doubling
+//!   point of a [`TwoParametrised`] hybrid system in `(p, q)`, with located
+//!   codimension-two points ([`Codim2Point`]) and the reason each end stopped.
 //!
 //! ```
 //! use continuation::{
@@ -51,7 +54,12 @@
 #![warn(missing_docs)]
 
 pub mod branch;
+pub mod codim_one;
+pub mod codim_two;
 mod corrector;
+pub mod curve;
+mod curve_corrector;
+pub mod curve_settings;
 pub mod error;
 pub mod floquet;
 pub mod hermite;
@@ -62,8 +70,13 @@ pub mod settings;
 pub mod shooting;
 pub mod special_point;
 pub mod test_function;
+pub mod two_parameter;
 
 pub use branch::{Branch, BranchPoint, Continuation, StopReason};
+pub use codim_one::CodimOneKind;
+pub use codim_two::{Codim2Kind, Codim2Point};
+pub use curve::{continue_curve, Curve, CurveEnd, CurvePoint, CurveStart, CurveStop};
+pub use curve_settings::CurveSettings;
 pub use error::ContinuationError;
 pub use floquet::{floquet_multipliers, is_stable, spectral_radius};
 pub use hermite::hermite_basis;
@@ -73,3 +86,4 @@ pub use settings::{ContinuationSettings, ParameterDirection};
 pub use shooting::{newton_update, shoot, NewtonSettings, ShootingResult};
 pub use special_point::{SpecialPoint, SpecialPointKind};
 pub use test_function::{neimark_sacker_test, period_doubling_test, TestValues};
+pub use two_parameter::{SystemFamily, TwoParameterProblem, TwoParametrised};

@@ -74,7 +74,9 @@ pub struct Ringing {
     pub decay_over_period: f64,
     /// The decay time that the envelope's fall from `t_0` to the next onset implies,
     /// `(t_s + T - t_0) / ln(C / C_next)`, us; equals `tau` when no other impact intervenes.
-    pub effective_decay_time_us: f64,
+    /// `None` when the envelope does not fall (`C_next >= C`: other impacts kick `q_2` again),
+    /// where the formula would give a negative or infinite time.
+    pub effective_decay_time_us: Option<f64>,
 }
 
 /// The theory's quantities measured on one period of a period-1 steady orbit.
@@ -400,7 +402,9 @@ fn ringing(
         amplitude_at_release_nm: at_release,
         amplitude_at_next_impact_nm: at_next,
         decay_over_period: at_next / initial,
-        effective_decay_time_us: elapsed / (initial / at_next).ln(),
+        effective_decay_time_us: (at_next < initial && at_next > 0.0)
+            .then(|| elapsed / (initial / at_next).ln())
+            .filter(|time| time.is_finite() && *time > 0.0),
     }
 }
 

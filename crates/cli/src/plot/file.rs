@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Result};
 
 use super::raster;
-use crate::output::write_atomically;
+use crate::output::{check_writable, write_atomically};
 
 /// The file format of a figure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,7 +30,8 @@ pub struct FigureFile {
 
 impl FigureFile {
     /// The figure file `path` given to `option`; its name must end in `.svg`, `.png` or `.pdf`
-    /// (any case).
+    /// (any case), and it must be writable (checked before any computation:
+    /// [`crate::output::check_writable`]).
     pub fn new(path: &Path, option: &str) -> Result<Self> {
         let extension = path
             .extension()
@@ -41,10 +42,11 @@ impl FigureFile {
             Some("png") => FigureFormat::Png,
             Some("pdf") => FigureFormat::Pdf,
             _ => bail!(
-                "{option} {}: the file name must end in .svg, .png or .pdf (the format follows the extension)",
+                "{option} {}: allowed: a file name ending in .svg, .png or .pdf (the format follows the extension)",
                 path.display()
             ),
         };
+        check_writable(path, option)?;
         Ok(Self {
             path: path.to_path_buf(),
             format,
@@ -68,7 +70,8 @@ mod tests {
 
     #[test]
     fn the_extension_chooses_the_format_and_others_are_refused() {
-        let f = FigureFile::new(Path::new("a/fig.PNG"), "--plot").expect("png");
+        let directory = tempfile::tempdir().expect("temporary directory");
+        let f = FigureFile::new(&directory.path().join("fig.PNG"), "--plot").expect("png");
         assert_eq!(f.format, FigureFormat::Png);
         let error = FigureFile::new(Path::new("fig.jpg"), "--plot").unwrap_err();
         let message = error.to_string();

@@ -53,14 +53,23 @@ impl Frame {
     }
 }
 
-/// The data range of a panel's finite points and markers, padded by 5 % on each side (a
-/// degenerate range is widened to a unit around its value).
+/// The data range of a panel's finite points, markers, region anchors, shaded polygons and
+/// cells, padded by 5 % on each side (a degenerate range is widened to a unit around its
+/// value).
 pub fn data_range(panel: &Panel) -> ((f64, f64), (f64, f64)) {
     let points = panel
         .series
         .iter()
         .flat_map(|s| s.points.iter().copied())
         .chain(panel.markers.iter().map(|m| m.at))
+        .chain(panel.regions.iter().flat_map(|r| r.anchors.iter().copied()))
+        .chain(panel.shaded.iter().flatten().copied())
+        .chain(
+            panel
+                .cells
+                .iter()
+                .flat_map(|c| [(c.x.0, c.y.0), (c.x.1, c.y.1)]),
+        )
         .filter(|(x, y)| x.is_finite() && y.is_finite());
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,

@@ -1,7 +1,8 @@
 //! The SVG document of a figure: each panel's frame, ticks, axis labels, curves (thinned to
-//! the figure's resolution), special points with their labels, and legend. Elements carry ids
-//! (`p<panel>-xtick-<k>`, `p<panel>-ytick-<k>`, `p<panel>-label-<k>`, `p<panel>-legend`,
-//! `p<panel>-curve-<k>`) so that tests and scripts can find them.
+//! the figure's resolution), special points with their labels, region names, shaded areas,
+//! grid cells and legend. Elements carry ids (`p<panel>-xtick-<k>`, `p<panel>-ytick-<k>`,
+//! `p<panel>-label-<k>`, `p<panel>-region-<k>`, `p<panel>-legend`, `p<panel>-curve-<k>`) or
+//! classes (`cell`, `shaded`) so that tests and scripts can find them.
 
 use std::fmt::Write as _;
 
@@ -14,7 +15,17 @@ use super::layout::{
     TITLE_LINE, TITLE_SIZE,
 };
 use super::legend::{free_corner, legend_size, LegendEntry, LEGEND_LINE, LEGEND_PADDING, SWATCH};
+use super::regions::{place_regions, PlacedRegion, REGION_LABEL_SIZE};
 use super::{unwrapped_pieces, Panel, Stroke};
+
+/// Fill of a bistable cell of a grid and its opacity.
+const GREY_CELL: &str = r##"fill="#969696" fill-opacity="0.5""##;
+/// Opacity of a grid cell tinted in its palette colour.
+const CELL_OPACITY: &str = "0.25";
+/// Fill of a shaded area (a bistable range).
+const SHADE: &str = r##"fill="#c8c8c8" fill-opacity="0.6""##;
+/// Colour of region names.
+const REGION_COLOUR: &str = "#5a5a5a";
 
 /// The palette (Tableau 10's first six, then black), indexed by [`super::Series::colour`].
 pub const PALETTE: [&str; 7] = [
@@ -287,6 +298,62 @@ fn draw_curves(svg: &mut String, index: usize, drawn: &[Drawn]) {
     }
 }
 
+/// The grid cells, then the shaded polygons, clipped to the plot area (under the curves).
+fn draw_background(svg: &mut String, index: usize, panel: &Panel, frame: &Frame) {
+    for cell in &panel.cells {
+        let corners = [cell.x.0, cell.x.1, cell.y.0, cell.y.1];
+        if !corners.iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        let (x0, y0) = frame.to_pixel((cell.x.0, cell.y.1));
+        let (x1, y1) = frame.to_pixel((cell.x.1, cell.y.0));
+        let fill = match cell.colour {
+            Some(c) => format!(r#"fill="{}" fill-opacity="{CELL_OPACITY}""#, colour(c)),
+            None => GREY_CELL.to_string(),
+        };
+        let _ = writeln!(
+            svg,
+            r#"<rect class="cell" x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {fill} clip-path="url(#clip-{index})"/>"#,
+            x0.min(x1),
+            y0.min(y1),
+            (x1 - x0).abs(),
+            (y1 - y0).abs()
+        );
+    }
+    for polygon in &panel.shaded {
+        let points: Vec<String> = polygon
+            .iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .map(|&p| {
+                let (x, y) = frame.to_pixel(p);
+                format!("{x:.1},{y:.1}")
+            })
+            .collect();
+        if points.len() >= 3 {
+            let _ = writeln!(
+                svg,
+                r#"<polygon class="shaded" points="{}" {SHADE} clip-path="url(#clip-{index})"/>"#,
+                points.join(" ")
+            );
+        }
+    }
+}
+
+fn draw_regions(svg: &mut String, index: usize, regions: &[PlacedRegion]) {
+    let fill = format!(r#" fill="{REGION_COLOUR}""#);
+    for (k, region) in regions.iter().enumerate() {
+        text_element(
+            svg,
+            &format!("p{index}-region-{k}"),
+            region.baseline(),
+            REGION_LABEL_SIZE,
+            Anchor::Middle,
+            &fill,
+            &region.text,
+        );
+    }
+}
+
 fn draw_labels(svg: &mut String, index: usize, labels: &[PlacedLabel]) {
     for label in labels {
         if let Some((a, b)) = label.leader {
@@ -379,6 +446,7 @@ pub fn draw_panel(svg: &mut String, index: usize, panel: &Panel, outer: Rect) {
         plot.height()
     );
     draw_axes(svg, index, panel, &frame);
+    draw_background(svg, index, panel, &frame);
     draw_curves(svg, index, &drawn);
     let markers: Vec<(String, Pixel)> = panel
         .markers
@@ -396,6 +464,42 @@ pub fn draw_panel(svg: &mut String, index: usize, panel: &Panel, outer: Rect) {
         },
     );
     draw_labels(svg, index, &labels);
+    if !panel.regions.is_empty() {
+        let names: Vec<(String, Vec<Pixel>)> = panel
+            .regions
+            .iter()
+            .map(|r| {
+                let anchors = r
+                    .anchors
+                    .iter()
+                    .filter(|(x, y)| x.is_finite() && y.is_finite())
+                    .map(|&a| frame.to_pixel(a))
+                    .collect();
+                (r.label.clone(), anchors)
+            })
+            .collect();
+        let mut taken = boxes.clone();
+        let mut lines = curve_segments.clone();
+        for label in &labels {
+            taken.push(label.bounds);
+            taken.push(Rect::new(
+                label.at.0 - MARKER_RADIUS,
+                label.at.1 - MARKER_RADIUS,
+                2.0 * MARKER_RADIUS,
+                2.0 * MARKER_RADIUS,
+            ));
+            lines.extend(label.leader);
+        }
+        let regions = place_regions(
+            &names,
+            Obstacles {
+                bounds: plot,
+                segments: &lines,
+                boxes: &taken,
+            },
+        );
+        draw_regions(svg, index, &regions);
+    }
     if let Some(at) = legend {
         draw_legend(svg, index, &entries, at);
     }

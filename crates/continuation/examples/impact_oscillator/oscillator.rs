@@ -1,10 +1,10 @@
 //! The hard impact oscillator `x'' + c x' + k x = A cos(w t)` with a rigid stop at `x = d`
 //! (switching function `h = d - x`) and Newton's restitution law `v+ = -e v-`, as a
-//! [`Parametrised`] hybrid system with parameter `p = A`; shared by the example and its test.
+//! [`Parametrised`] hybrid system with parameter `p = A` and second parameter `q = w`; shared by the example and its test.
 
 use continuation::{
     Branch, Continuation, ContinuationError, ContinuationSettings, HybridPeriodicProblem,
-    Parametrised, SpecialPointKind,
+    Parametrised, SpecialPointKind, TwoParametrised,
 };
 use hybrid::{Direction, HybridSystem, Mode, Settings, SwitchingPartials};
 use nalgebra::DMatrix;
@@ -123,6 +123,21 @@ impl Parametrised for ImpactOscillator {
 
     fn period(&self) -> f64 {
         2.0 * std::f64::consts::PI / self.w
+    }
+}
+
+impl TwoParametrised for ImpactOscillator {
+    /// The drive frequency `w` (the period `2 pi / w` follows it).
+    fn second_parameter(&self) -> f64 {
+        self.w
+    }
+
+    fn set_second_parameter(&mut self, q: f64) -> Result<(), String> {
+        if !(q.is_finite() && q > 0.0) {
+            return Err(format!("drive frequency w = {q}: need w > 0, finite"));
+        }
+        self.w = q;
+        Ok(())
     }
 }
 

@@ -1,0 +1,187 @@
+//! The regime map against independent one-parameter diagrams: at several values of the varied
+//! parameter, `approach_diagram` of the case rebuilt at that value locates the same special
+//! points as the map's curves hold there.
+
+use afm::{
+    approach_diagram, builtin_case, regime_map, DiagramSettings, ParameterAxis, RegimeMapSettings,
+    TappingModel,
+};
+
+/// Biolever on mica over `A0 = 8 .. 12 nm`: at six `at` values and at the case's own
+/// `A0 = 10 nm`, every curve's point lies within 1e-9 nm in `Z` of the special point of the
+/// same label found by an independent approach diagram at that `A0`. Budget: the diagram
+/// locates its points to a bracket of 1e-9 nm (the reported precision, added to the
+/// tolerance); the map's points solve the grazing equations to a residual of 1e-10 nm, which
+/// moves `Z` by at most that over `|dh/dZ| ~ 1`.
+#[test]
+fn map_points_match_independent_diagrams() {
+    let case = builtin_case("biolever-mica").expect("case");
+    let model = TappingModel::from_case(&case).expect("model");
+    let at = vec![8.0, 8.7, 9.4, 10.6, 11.3, 12.0];
+    let settings = RegimeMapSettings {
+        at: at.clone(),
+        points_per_range: 10,
+        ..RegimeMapSettings::new(&model, 8.0, 12.0)
+    };
+    let map = regime_map(&case, ParameterAxis::FreeAmplitude, &settings).expect("map");
+    let labels: Vec<&str> = map.curves.iter().map(|c| c.label.as_str()).collect();
+    assert_eq!(labels, ["G1", "G2", "G3"]);
+    let mut values = at.clone();
+    values.push(10.0);
+    for a0 in values {
+        let rebuilt = ParameterAxis::FreeAmplitude
+            .apply(&case, a0, "test")
+            .expect("in range");
+        let model = TappingModel::from_case(&rebuilt).expect("model");
+        let diagram =
+            approach_diagram(&model, &DiagramSettings::approach(&model)).expect("diagram");
+        for curve in &map.curves {
+            let on_curve: Vec<_> = curve.points.iter().filter(|p| p.parameter == a0).collect();
+            assert_eq!(on_curve.len(), 1, "{} at A0 = {a0}", curve.label);
+            let point = on_curve[0];
+            assert!(point.at_fixed_parameter);
+            let special = diagram
+                .special_points
+                .iter()
+                .find(|s| s.label == curve.label)
+                .unwrap_or_else(|| panic!("{} in the diagram at A0 = {a0}", curve.label));
+            let error = (point.z_nm - special.z_nm).abs();
+            assert!(
+                error <= 1e-9 + special.precision_nm,
+                "{} at A0 = {a0}: map Z = {} vs diagram {} (precision {:e})",
+                curve.label,
+                point.z_nm,
+                special.z_nm,
+                special.precision_nm
+            );
+            let n: usize = curve.label[1..].parse().expect("G<n>");
+            assert_eq!((point.impacts_before, point.impacts_after), (n - 1, n));
+        }
+    }
+}
+
+/// The MAClever on mica has a pair of folds near first contact. Over `A0 = 5 .. 25 nm` its fold
+/// curve passes a cusp (both folds of the pair are one curve) near `A0 = 8.73 nm`: at four `at`
+/// values the curve's points at that `A0` are the two folds an independent approach diagram
+/// locates there (same tolerance as above), and just below the cusp's `A0` the diagram has no
+/// fold, just above it two (0.3 nm either side: closer above it the pair of folds is narrower than
+/// the diagram's step).
+#[test]
+fn fold_curve_and_cusp_match_independent_diagrams() {
+    let case = builtin_case("maclever-mica").expect("case");
+    let model = TappingModel::from_case(&case).expect("model");
+    let at = vec![12.0, 16.0, 22.0, 25.0];
+    let settings = RegimeMapSettings {
+        at: at.clone(),
+        labels: Some(vec!["fold".into()]),
+        points_per_range: 20,
+        ..RegimeMapSettings::new(&model, 5.0, 25.0)
+    };
+    let map = regime_map(&case, ParameterAxis::FreeAmplitude, &settings).expect("map");
+    assert_eq!(map.curves.len(), 1, "the two folds are one curve");
+    let fold = &map.curves[0];
+    let cusps: Vec<_> = map
+        .codim2_points
+        .iter()
+        .filter(|c| c.label == "cusp")
+        .collect();
+    assert_eq!(cusps.len(), 1, "{:?}", map.codim2_points);
+    let cusp = cusps[0].parameter;
+    let diagram_at = |a0: f64| {
+        let rebuilt = ParameterAxis::FreeAmplitude
+            .apply(&case, a0, "test")
+            .expect("in range");
+        let model = TappingModel::from_case(&rebuilt).expect("model");
+        approach_diagram(&model, &DiagramSettings::approach(&model)).expect("diagram")
+    };
+    for a0 in at.iter().copied().chain([20.0]) {
+        let mut on_curve: Vec<f64> = fold
+            .points
+            .iter()
+            .filter(|p| p.parameter == a0)
+            .map(|p| p.z_nm)
+            .collect();
+        on_curve.sort_by(f64::total_cmp);
+        let diagram = diagram_at(a0);
+        let mut folds: Vec<(f64, f64)> = diagram
+            .special_points
+            .iter()
+            .filter(|s| s.label == "fold")
+            .map(|s| (s.z_nm, s.precision_nm))
+            .collect();
+        folds.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert_eq!(on_curve.len(), 2, "A0 = {a0}: {on_curve:?}");
+        assert_eq!(folds.len(), 2, "A0 = {a0}: {folds:?}");
+        for (z, (zd, precision)) in on_curve.iter().zip(&folds) {
+            assert!(
+                (z - zd).abs() <= 1e-9 + precision,
+                "A0 = {a0}: map fold Z = {z} vs diagram {zd}"
+            );
+        }
+    }
+    let count = |a0: f64| {
+        diagram_at(a0)
+            .special_points
+            .iter()
+            .filter(|s| s.label == "fold")
+            .count()
+    };
+    assert_eq!(count(cusp - 0.3), 0, "below the cusp at {cusp}");
+    assert_eq!(count(cusp + 0.3), 2, "above the cusp at {cusp}");
+}
+
+/// Driven at 20 kHz the Biolever on mica has four period doublings on its approach. Their four
+/// curves over `A0 = 9 .. 11 nm` hold, at both ends and at 9.5 and 10.5, the period doublings
+/// an independent approach diagram locates there (same tolerance as above).
+#[test]
+fn period_doubling_curves_match_independent_diagrams() {
+    let mut case = builtin_case("biolever-mica").expect("case");
+    case.drive_frequency_khz = Some(20.0);
+    let model = TappingModel::from_case(&case).expect("model");
+    let at = vec![9.5, 10.5];
+    let settings = RegimeMapSettings {
+        at: at.clone(),
+        labels: Some(vec!["period-doubling".into()]),
+        points_per_range: 4,
+        ..RegimeMapSettings::new(&model, 9.0, 11.0)
+    };
+    let map = regime_map(&case, ParameterAxis::FreeAmplitude, &settings).expect("map");
+    assert_eq!(map.curves.len(), 4);
+    for a0 in [9.0, 9.5, 10.5, 11.0] {
+        let mut on_curves: Vec<f64> = map
+            .curves
+            .iter()
+            .flat_map(|c| {
+                c.points
+                    .iter()
+                    .filter(|p| p.parameter == a0)
+                    .map(|p| p.z_nm)
+            })
+            .collect();
+        on_curves.sort_by(f64::total_cmp);
+        let rebuilt = ParameterAxis::FreeAmplitude
+            .apply(&case, a0, "test")
+            .expect("in range");
+        let model = TappingModel::from_case(&rebuilt).expect("model");
+        let diagram =
+            approach_diagram(&model, &DiagramSettings::approach(&model)).expect("diagram");
+        let mut found: Vec<(f64, f64)> = diagram
+            .special_points
+            .iter()
+            .filter(|s| s.label == "period-doubling")
+            .map(|s| (s.z_nm, s.precision_nm))
+            .collect();
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert_eq!(
+            on_curves.len(),
+            found.len(),
+            "A0 = {a0}: {on_curves:?} vs {found:?}"
+        );
+        for (z, (zd, precision)) in on_curves.iter().zip(&found) {
+            assert!(
+                (z - zd).abs() <= 1e-9 + precision,
+                "A0 = {a0}: map Z = {z} vs diagram {zd}"
+            );
+        }
+    }
+}

@@ -1,0 +1,306 @@
+//! `drumroll map`: the impact-regime map of a case over a second parameter: the grazing `G_n`,
+//! fold and period-doubling points of the approach diagram continued from the case's own value
+//! over a range (`afm::regime_map`), as curves in the `(p, Z)` and `(p, A/A0)` planes.
+
+use afm::{regime_map, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use crate::continue_diagram::approach_settings;
+use crate::grid_overlay::read_grid;
+use crate::inputs::orbit_inputs_json;
+use crate::map_plot::map_panels;
+use crate::model_args::{output_path, ModelArgs};
+use crate::output::write_atomically;
+use crate::plot::{render_svg, FigureFile};
+
+/// Options of `drumroll map`.
+#[derive(Debug, Clone, Args)]
+pub struct MapArgs {
+    /// The cantilever, sample and drive (the case's own value of PARAM is where the curves
+    /// start).
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// The parameter varied along the map: a0 (nm), drive-frequency (kHz), sample-modulus
+    /// (GPa), tip-radius (nm), quality-factor-N, stiffness-N (N/m) for mode N.
+    #[arg(long, value_name = "PARAM")]
+    pub vary: String,
+    /// One end of the range of PARAM (its unit).
+    #[arg(long, allow_negative_numbers = true)]
+    pub from: f64,
+    /// The other end of the range (greater than --from).
+    #[arg(long, allow_negative_numbers = true)]
+    pub to: f64,
+    /// Values of PARAM at which every curve spanning them gets a point computed exactly,
+    /// comma-separated.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub at: Vec<f64>,
+    /// The curves to compute, comma-separated labels as `continue` names its special points
+    /// (`G2,G3,fold,period-doubling`); default every G_n, fold and period doubling.
+    #[arg(long, value_delimiter = ',')]
+    pub labels: Vec<String>,
+    /// Points per curve over the whole range, at least (sets the largest step in PARAM).
+    #[arg(long, default_value_t = 100)]
+    pub points: usize,
+    /// Lowest separation of the seed approach and of every curve, nm (default 0.05 A0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub floor: Option<f64>,
+    /// The seed approach also stops when A/A0 falls below this ratio (default 0.3).
+    #[arg(long, default_value_t = 0.3)]
+    pub min_amplitude_ratio: f64,
+    /// Largest arclength step of the seed approach, nm (default A0/250).
+    #[arg(long)]
+    pub max_step: Option<f64>,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the curve points to this CSV file (one row per point).
+    #[arg(long, value_name = "FILE.csv")]
+    pub csv: Option<PathBuf>,
+    /// Draw the map in the (PARAM, Z) and (PARAM, A/A0) planes; the format follows the
+    /// extension (.svg, .png or .pdf).
+    #[arg(long, value_name = "FILE.svg|.png|.pdf")]
+    pub plot: Option<PathBuf>,
+    /// With --plot: draw this `drumroll grid` result (JSON Lines, the same PARAM) as cells
+    /// under the curves, coloured by impacts per period (grey: bistable).
+    #[arg(long, value_name = "FILE.jsonl", requires = "plot")]
+    pub grid_file: Option<PathBuf>,
+}
+
+/// The labels `--labels` accepts: `G<n>` (n >= 1), `fold`, `period-doubling`.
+fn valid_label(label: &str) -> bool {
+    label == "fold"
+        || label == "period-doubling"
+        || (label.len() > 1
+            && label.starts_with('G')
+            && label[1..].parse::<usize>().is_ok_and(|n| n >= 1))
+}
+
+/// Run `drumroll map`.
+pub fn run(args: &MapArgs) -> Result<()> {
+    let (case, model) = args.model.model()?;
+    let csv_path = args
+        .csv
+        .as_ref()
+        .map(|p| output_path(p, "csv", "--csv"))
+        .transpose()?;
+    let plot_path = args
+        .plot
+        .as_ref()
+        .map(|p| FigureFile::new(p, "--plot"))
+        .transpose()?;
+    let axis = ParameterAxis::parse(&args.vary, case.cantilever.modes.len())?;
+    let grid = args
+        .grid_file
+        .as_ref()
+        .map(|path| read_grid(path, &axis.name()))
+        .transpose()?;
+    for label in &args.labels {
+        if !valid_label(label) {
+            bail!("--labels {label}: allowed G<n> (n >= 1), fold, period-doubling");
+        }
+    }
+    if args.points < 2 || args.points > 100_000 {
+        bail!("--points {}: allowed 2 ..= 100000", args.points);
+    }
+    let diagram = approach_settings(&model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    let settings = RegimeMapSettings {
+        diagram,
+        from: args.from,
+        to: args.to,
+        at: args.at.clone(),
+        labels: (!args.labels.is_empty()).then(|| args.labels.clone()),
+        points_per_range: args.points,
+    };
+    let map = regime_map(&case, axis, &settings)
+        .with_context(|| format!("regime map of case `{}` failed", case.name))?;
+    if !args.labels.is_empty() {
+        for label in &args.labels {
+            if !map.curves.iter().any(|c| c.label == *label) {
+                let found: Vec<&str> = map
+                    .seed
+                    .special_points
+                    .iter()
+                    .map(|s| s.label.as_str())
+                    .collect();
+                bail!(
+                    "--labels {label}: the approach at the case's {} = {} has no such point (it has: {})",
+                    axis.name(),
+                    map.seed_parameter,
+                    found.join(", ")
+                );
+            }
+        }
+    }
+    if args.json {
+        let options = json!({
+            "vary": axis.name(),
+            "from": args.from,
+            "to": args.to,
+            "at": args.at,
+            "labels": args.labels,
+            "points": args.points,
+            "floor_nm": settings.diagram.z_limit_nm,
+            "min_amplitude_ratio": settings.diagram.min_amplitude_ratio,
+            "max_step_nm": settings.diagram.max_step,
+        });
+        let object = json!({
+            "case": case.name,
+            "inputs": orbit_inputs_json("map", options, &case, &model, &settings.diagram.orbit),
+            "parameter": {
+                "name": axis.name(),
+                "unit": axis.unit(),
+                "from": args.from,
+                "to": args.to,
+                "case_value": map.seed_parameter,
+            },
+            "curves": map.curves,
+            "codim2_points": map.codim2_points,
+        });
+        println!("{}", serde_json::to_string(&object)?);
+    } else {
+        print!("{}", table(&case.name, axis, &args.at, &map));
+    }
+    if let Some(path) = csv_path {
+        write_atomically(&path, csv_text(&map.curves)?.as_bytes())?;
+    }
+    if let Some(path) = plot_path {
+        path.write(&render_svg(
+            &map_panels(axis, &map, grid.as_ref()),
+            1,
+            2,
+            (620, 480),
+        )?)?;
+    }
+    Ok(())
+}
+
+/// The readable summary: per curve its ends and its points at the range ends, the `--at`
+/// values and the case's own value; then the codimension-two points.
+fn table(case: &str, axis: ParameterAxis, at: &[f64], map: &RegimeMap) -> String {
+    let mut s = String::new();
+    let unit = axis.unit();
+    let _ = writeln!(
+        s,
+        "case {case}: map over {} ({}), curves from the case's value {}",
+        axis.name(),
+        if unit.is_empty() { "-" } else { unit },
+        map.seed_parameter
+    );
+    for curve in &map.curves {
+        let ends: Vec<String> = curve
+            .ends
+            .iter()
+            .map(|e| {
+                let error = e
+                    .error
+                    .as_ref()
+                    .map_or(String::new(), |m| format!(" ({m})"));
+                format!(
+                    "{} at {} = {:.6}{error}",
+                    e.reason,
+                    axis.name(),
+                    e.parameter
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "{}: {} points; ends: {}",
+            curve.label,
+            curve.points.len(),
+            ends.join("; ")
+        );
+        let _ = writeln!(
+            s,
+            "  {:>14} {:>16} {:>10} {:>10} {:>8} {:>7}",
+            axis.name(),
+            "Z (nm)",
+            "A/A0",
+            "phase",
+            "impacts",
+            "stable"
+        );
+        for point in curve.points.iter().filter(|p| {
+            p.at_fixed_parameter
+                && (at.contains(&p.parameter)
+                    || p.parameter == map.seed_parameter
+                    || curve
+                        .points
+                        .first()
+                        .is_some_and(|f| f.parameter == p.parameter)
+                    || curve
+                        .points
+                        .last()
+                        .is_some_and(|l| l.parameter == p.parameter))
+        }) {
+            let _ = writeln!(
+                s,
+                "  {:>14.6} {:>16.10} {:>10.6} {:>10.4} {:>3} -> {:<2} {:>7}",
+                point.parameter,
+                point.z_nm,
+                point.amplitude_ratio,
+                point.phase_deg,
+                point.impacts_before,
+                point.impacts_after,
+                if point.stable { "yes" } else { "no" }
+            );
+        }
+    }
+    for point in &map.codim2_points {
+        let _ = writeln!(
+            s,
+            "codimension two: {} on {} at {} = {:.9}, Z = {:.9} nm (precision {:.1e}{})",
+            point.label,
+            point.curve,
+            axis.name(),
+            point.parameter,
+            point.z_nm,
+            point.precision,
+            if point.converged {
+                ""
+            } else {
+                ", NOT converged"
+            }
+        );
+    }
+    s
+}
+
+/// The CSV columns after `label`: the scalar keys of a JSON curve point, in this order
+/// (docs/output-schema.md).
+pub const CSV_COLUMNS: [&str; 10] = [
+    "parameter",
+    "z_nm",
+    "amplitude_ratio",
+    "phase_deg",
+    "impacts_before",
+    "impacts_after",
+    "stable",
+    "spectral_radius",
+    "residual",
+    "at_fixed_parameter",
+];
+
+/// The CSV of every curve's points: `label`, then [`CSV_COLUMNS`].
+fn csv_text(curves: &[MapCurve]) -> Result<String> {
+    let mut text = format!("label,{}\n", CSV_COLUMNS.join(","));
+    for curve in curves {
+        for point in &curve.points {
+            let value = serde_json::to_value(point)?;
+            text.push_str(&curve.label);
+            for column in CSV_COLUMNS {
+                text.push(',');
+                match &value[column] {
+                    serde_json::Value::Null => {}
+                    other => text.push_str(&other.to_string()),
+                }
+            }
+            text.push('\n');
+        }
+    }
+    Ok(text)
+}

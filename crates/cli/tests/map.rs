@@ -1,0 +1,235 @@
+//! `drumroll map`: the regime map's curves against independent `drumroll continue` runs, its
+//! figure, and its refusal of bad input.
+
+mod common;
+use common::{drumroll, json_of, number};
+
+use serde_json::Value;
+
+/// The special point `label` of `continue --a0 A0` (Biolever on mica).
+fn continue_point(a0: f64, label: &str) -> Value {
+    let diagram = json_of(&[
+        "continue",
+        "--case",
+        "biolever-mica",
+        "--a0",
+        &a0.to_string(),
+    ]);
+    diagram["special_points"]
+        .as_array()
+        .expect("special points")
+        .iter()
+        .find(|p| p["label"] == label)
+        .unwrap_or_else(|| panic!("{label} in continue at A0 = {a0}"))
+        .clone()
+}
+
+/// Over `A0 = 9 .. 11 nm` every curve (G1, G2, G3) holds a point at each range end, each
+/// `--at` value and the case's own `A0 = 10`; at those seven values an independent
+/// `continue --a0` locates the same grazing within 1e-9 nm in `Z` (plus the precision the
+/// diagram reports for its own location: its bracket). At the case's own value the map's points
+/// are `continue`'s special points: `Z` as above, `A/A0` and the phase within 1e-6 (the
+/// observables of two orbits 1e-9 nm apart; `dA/dZ ~ 1`).
+#[test]
+fn map_points_are_the_special_points_of_independent_continue_runs() {
+    let map = json_of(&[
+        "map",
+        "--case",
+        "biolever-mica",
+        "--vary",
+        "a0",
+        "--from",
+        "9",
+        "--to",
+        "11",
+        "--at",
+        "9.4,9.7,10.3,10.6",
+        "--points",
+        "8",
+    ]);
+    assert_eq!(map["parameter"]["name"], "a0");
+    assert_eq!(map["parameter"]["unit"], "nm");
+    let curves = map["curves"].as_array().expect("curves");
+    let labels: Vec<&str> = curves
+        .iter()
+        .map(|c| c["label"].as_str().unwrap_or(""))
+        .collect();
+    assert_eq!(labels, ["G1", "G2", "G3"]);
+    for curve in curves {
+        let label = curve["label"].as_str().expect("label");
+        for end in curve["ends"].as_array().expect("ends") {
+            assert_eq!(end["reason"], "range-end", "{label}: {end}");
+        }
+        for a0 in [9.0, 9.4, 9.7, 10.0, 10.3, 10.6, 11.0] {
+            let points: Vec<&Value> = curve["points"]
+                .as_array()
+                .expect("points")
+                .iter()
+                .filter(|p| number(p, "parameter") == a0)
+                .collect();
+            assert_eq!(points.len(), 1, "{label} at A0 = {a0}");
+            assert_eq!(points[0]["at_fixed_parameter"], true);
+            let special = continue_point(a0, label);
+            let error = (number(points[0], "z_nm") - number(&special, "z_nm")).abs();
+            assert!(
+                error <= 1e-9 + number(&special, "precision_nm"),
+                "{label} at A0 = {a0}: Z differs by {error:e}"
+            );
+            if a0 == 10.0 {
+                for key in ["amplitude_ratio", "phase_deg"] {
+                    let d = (number(points[0], key) - number(&special, key)).abs();
+                    assert!(d <= 1e-6, "{label} {key}: {d:e}");
+                }
+                assert_eq!(points[0]["impacts_before"], special["impacts_before"]);
+                assert_eq!(points[0]["impacts_after"], special["impacts_after"]);
+            }
+        }
+    }
+}
+
+/// The figure holds both planes, the region names, the curves' labels; the closed fold curve
+/// of the MAClever on mica over `Q_1` is shaded (bistable) and its two cusps are marked.
+#[test]
+fn the_plot_names_regions_shades_the_bistable_area_and_marks_cusps() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let plot = directory.path().join("map.svg");
+    let map = json_of(&[
+        "map",
+        "--case",
+        "maclever-mica",
+        "--vary",
+        "quality-factor-1",
+        "--from",
+        "1",
+        "--to",
+        "8",
+        "--points",
+        "10",
+        "--plot",
+        plot.to_str().expect("utf-8"),
+    ]);
+    let fold = map["curves"]
+        .as_array()
+        .expect("curves")
+        .iter()
+        .find(|c| c["label"] == "fold")
+        .expect("fold curve");
+    assert_eq!(fold["ends"][0]["reason"], "closed");
+    let cusps: Vec<f64> = map["codim2_points"]
+        .as_array()
+        .expect("codim-2 points")
+        .iter()
+        .filter(|p| p["label"] == "cusp")
+        .map(|p| number(p, "parameter"))
+        .collect();
+    assert_eq!(cusps.len(), 2, "{cusps:?}");
+    let svg = std::fs::read_to_string(&plot).expect("svg");
+    for text in [
+        "1 impact",
+        "no impact",
+        "cusp",
+        "fold",
+        "G1",
+        "A/A0",
+        "Z (nm)",
+        "<polygon",
+    ] {
+        assert!(svg.contains(text), "{text} missing from the figure");
+    }
+    assert!(!directory.path().join("map.svg.partial").exists());
+}
+
+#[test]
+fn bad_input_is_refused_with_a_message_naming_the_option() {
+    let cases: [(&[&str], &str); 8] = [
+        (
+            &["--vary", "mass", "--from", "5", "--to", "20"],
+            "a0, drive-frequency, sample-modulus, tip-radius, quality-factor-N, stiffness-N",
+        ),
+        (
+            &["--vary", "stiffness-4", "--from", "1", "--to", "2"],
+            "--vary",
+        ),
+        (&["--vary", "a0", "--from", "-1", "--to", "20"], "--from"),
+        (&["--vary", "a0", "--from", "5", "--to", "2e5"], "--to"),
+        (&["--vary", "a0", "--from", "20", "--to", "5"], "--to"),
+        (
+            &["--vary", "a0", "--from", "5", "--to", "20", "--at", "30"],
+            "--at",
+        ),
+        (
+            &["--vary", "a0", "--from", "12", "--to", "20"],
+            "contains the case's own a0 = 10",
+        ),
+        (
+            &[
+                "--vary", "a0", "--from", "5", "--to", "20", "--labels", "G9",
+            ],
+            "--labels G9",
+        ),
+    ];
+    for (args, message) in cases {
+        let output = drumroll().arg("map").args(args).output().expect("runs");
+        assert!(!output.status.success(), "{args:?} succeeded");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains(message), "{args:?}: stderr was {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    }
+}
+
+/// A grid file in `drumroll grid`'s format (docs/output-schema.md) is drawn as cells under
+/// the curves: one rectangle per cell, in the tint of its impact count, grey where bistable;
+/// a grid over another parameter is refused naming `--grid-file`.
+#[test]
+fn grid_file_cells_are_drawn_under_the_curves() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let grid = directory.path().join("grid.jsonl");
+    let header = r#"{"case":"biolever-mica","parameter":{"name":"a0","unit":"nm","from":9.9,"to":10.1,"values":[9.9,10.1]},"z_nm":[10.5,8.0]}"#;
+    let row = |r: usize, p: f64| {
+        format!(
+            r#"{{"row":{r},"parameter_value":{p},"first_contact_z_nm":10.0,"cells":[{{"z_nm":10.5,"approach":{{"amplitude_ratio":1.0,"phase_deg":92.0,"multiplicity":1,"impacts_per_orbit":0,"impacts_per_period":0.0,"stable":true,"converged":true}}}},{{"z_nm":8.0,"approach":{{"amplitude_ratio":0.8,"phase_deg":84.0,"multiplicity":1,"impacts_per_orbit":2,"impacts_per_period":2.0,"stable":true,"converged":true}},"bistable":true}}]}}"#
+        )
+    };
+    std::fs::write(
+        &grid,
+        format!("{header}\n{}\n{}\n", row(0, 9.9), row(1, 10.1)),
+    )
+    .expect("grid");
+    let plot = directory.path().join("map.svg");
+    let args = [
+        "map", "--vary", "a0", "--from", "9.9", "--to", "10.1", "--points", "4", "--labels", "G2",
+    ];
+    let output = drumroll()
+        .args(args)
+        .args(["--plot", plot.to_str().expect("utf-8")])
+        .args(["--grid-file", grid.to_str().expect("utf-8")])
+        .output()
+        .expect("runs");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let svg = std::fs::read_to_string(&plot).expect("svg");
+    // Four cells in each of the two planes: two tinted by their impacts, two grey.
+    assert_eq!(svg.matches("opacity=\"0.25\"").count(), 4, "tinted cells");
+    assert_eq!(
+        svg.matches("fill=\"#969696\"").count(),
+        4,
+        "bistable cells in grey"
+    );
+    let other = directory.path().join("other.jsonl");
+    std::fs::write(&other, header.replace("\"a0\"", "\"tip-radius\"")).expect("grid");
+    let output = drumroll()
+        .args(args)
+        .args(["--plot", plot.to_str().expect("utf-8")])
+        .args(["--grid-file", other.to_str().expect("utf-8")])
+        .output()
+        .expect("runs");
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--grid-file") && stderr.contains("tip-radius"),
+        "{stderr}"
+    );
+}
