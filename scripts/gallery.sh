@@ -7,7 +7,9 @@
 #       A/A0 = 0.5 (three impacts per period);
 # fig2: the paper's Fig. 2 layout, phase vs A/A0 for its four cases, (a)-(d);
 # fig2-overlay: the four cases on shared axes with their retract branches;
-# approach: a time-domain approach and retract of the Biolever on mica at 4 nm/s.
+# approach: a time-domain approach and retract of the Biolever on mica at 4 nm/s;
+# map: the regime map of the Biolever on mica over the free amplitude A0 = 5..20 nm (G1-G3
+#      in the (A0, Z) and (A0, A/A0) planes, regions named by impacts per period).
 # Uses DRUMROLL=/path/to/drumroll when set instead of building. Each figure is SVG (the
 # README shows these); change the extension to .png or .pdf for the other formats.
 set -euo pipefail
@@ -25,4 +27,5 @@ mkdir -p "$out"
     --case maclever-soft --retract --overlay --plot "$out/fig2-overlay.svg" > /dev/null
 "$DRUMROLL" --quiet approach --case biolever-mica --from 10.2 --to 0 --rate 4 --retract \
     --plot "$out/approach.svg" > /dev/null
+"$DRUMROLL" --quiet map --case biolever-mica --vary a0 --from 5 --to 20 --plot "$out/map.svg" > /dev/null
 ls -l "$out"
