@@ -1,6 +1,10 @@
-//! The Taylor series of Eq. 1 in Hertz contact, by the recurrences of automatic
+//! The Taylor series of Eq. 1 in Hertz contact (and DMT's shifted Hertz contact and van der
+//! Waals free flight, [`SeriesForce`]; MODEL.md section 9), by the recurrences of automatic
 //! differentiation, in the clock offset `s` of a solver step (`t = t(s)`, a quadratic
 //! [`ClockPolynomial`]).
+//!
+//! For van der Waals, `F_ts = -A u^2` with `u = 1/d`, whose coefficients follow from
+//! `u d = 1`.
 //!
 //! With `tau = dt/ds` and the indentation `delta = -d`, each mode obeys
 //! `dq_i/ds = tau v_i`, `dv_i/ds = tau R_i`, `R_i = (w_i^2 F_i / k_i) cos(w t) + (w_i^2/k_i)
@@ -27,6 +31,27 @@ use crate::Separation;
 /// intermediate series on the stack).
 pub const MAX_ORDER: usize = 40;
 
+/// The tip-sample force a series expands Eq. 1 with (MODEL.md sections 1 and 9).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum SeriesForce {
+    /// `c s^{3/2} - constant` (nN), `s = d_c - d` the indentation below the contact surface
+    /// `d = d_c`: the Hertz sphere (`d_c = 0`, no constant) or DMT in contact (`d_c = a0`,
+    /// `constant = H R / (6 a0^2)`).
+    Hertz {
+        /// `c = (4/3) E* sqrt(R)`, nN/nm^{3/2}.
+        coefficient: f64,
+        /// `d_c`, nm.
+        contact_gap: f64,
+        /// The constant subtracted, nN.
+        constant: f64,
+    },
+    /// `-A / d^2` (nN) with `A = H R / 6` (nN nm): DMT's van der Waals force outside contact.
+    VanDerWaals {
+        /// `A`, nN nm.
+        scale: f64,
+    },
+}
+
 /// The separation `Z(t(s))`'s coefficients `0..=2` (`Z` constant or a linear ramp in `t`, `t`
 /// quadratic in `s`: the higher ones vanish).
 #[inline]
@@ -37,6 +62,35 @@ fn separation_coefficients(separation: &Separation, clock: &ClockPolynomial) -> 
         rate * clock.rate,
         rate * clock.curvature,
     ]
+}
+
+/// `Z(t(s)) - d_c`'s coefficients: the indentation below the contact surface is then
+/// `-(Z - d_c + sum_i q_i)` (`d_c = 0`, no shift, for every force but DMT's contact).
+#[inline]
+fn shifted_separation(
+    separation: &Separation,
+    clock: &ClockPolynomial,
+    force: SeriesForce,
+) -> [f64; 3] {
+    let mut coefficients = separation_coefficients(separation, clock);
+    if let SeriesForce::Hertz { contact_gap, .. } = force {
+        if contact_gap != 0.0 {
+            coefficients[0] -= contact_gap;
+        }
+    }
+    coefficients
+}
+
+/// Coefficient `k` of `u = 1/g` from `g`'s coefficients to `k` and `u`'s to `k - 1`:
+/// `u_0 = 1/g_0`, `u_k = -(sum_{j=1}^{k} g_j u_{k-j}) / g_0`; here from the indentation
+/// `delta = -g`.
+#[inline]
+fn update_reciprocal_gap(reciprocal: &mut [f64], delta: &[f64], k: usize) {
+    reciprocal[k] = if k == 0 {
+        -1.0 / delta[0]
+    } else {
+        -convolution(&delta[1..=k], &reciprocal[..k]) / delta[0]
+    };
 }
 
 /// Coefficient `m` of the product of two series from their coefficients `0..=m`, `a` and `b`
@@ -90,11 +144,12 @@ fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
     }
 }
 
-/// The Taylor coefficients of the contact flow of Eq. 1 (`N` modes `modes`, Hertz coefficient
-/// `hertz` in nN/nm^{3/2}, drive `w` rad/us, separation `separation`) in the clock offset `s` of
-/// `clock`, through the state held in the constant terms of `series` (`2N` components, `q_i`,
-/// `q_i'` in nm, nm/us); `false` (series unusable) if the order exceeds [`MAX_ORDER`], the
-/// state is outside the sample (`d >= 0`) where the clock runs at a finite rate, the
+/// The Taylor coefficients of the flow of Eq. 1 with the force `force` (`N` modes `modes`,
+/// drive `w` rad/us, separation `separation`) in the clock offset `s` of `clock`, through the
+/// state held in the constant terms of `series` (`2N` components, `q_i`, `q_i'` in nm, nm/us);
+/// `false` (series unusable) if the order exceeds [`MAX_ORDER`], the state is on the wrong
+/// side of the force's surface (Hertz: `d >= d_c` where the clock runs at a finite rate; van
+/// der Waals: `d <= 0` or a square-root clock), the
 /// indentation does not grow from the surface at an onset (a grazing touch, not analytic in
 /// `s`), or a coefficient is not finite. A clock whose rate is zero at the start (`tau(0) = 0`)
 /// is the square-root clock centred on the crossing that entered contact (the only place a step
@@ -102,7 +157,7 @@ fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
 /// rounding).
 pub(crate) fn contact_state_series(
     modes: &[ModalConstants],
-    hertz: f64,
+    force: SeriesForce,
     drive_frequency: f64,
     separation: &Separation,
     clock: &ClockPolynomial,
@@ -111,10 +166,10 @@ pub(crate) fn contact_state_series(
     if series.order() > MAX_ORDER || series.dim() != 2 * modes.len() {
         return false;
     }
-    let separation = separation_coefficients(separation, clock);
+    let separation = shifted_separation(separation, clock, force);
     // The common mode counts as constants, so that the loops over modes unroll.
     let mut run =
-        |modes| state_recurrence(modes, hertz, drive_frequency, &separation, clock, series);
+        |modes| state_recurrence(modes, force, drive_frequency, &separation, clock, series);
     match modes.len() {
         1 => run(&modes[..1]),
         2 => run(&modes[..2]),
@@ -123,12 +178,59 @@ pub(crate) fn contact_state_series(
     }
 }
 
+/// Coefficient `k` of the force series from the indentation's coefficients to `k` (to
+/// `k + 1` at an onset) and the auxiliary series `root` (the indentation's square root for
+/// Hertz, the reciprocal gap `1/d` for van der Waals) below `k`, which it extends; `None` where
+/// the series does not exist (van der Waals on or inside the surface, or at an onset).
+#[inline(always)]
+fn force_coefficient(
+    law: SeriesForce,
+    root: &mut [f64],
+    delta: &[f64],
+    k: usize,
+    onset: bool,
+) -> Option<f64> {
+    match law {
+        SeriesForce::Hertz {
+            coefficient,
+            constant,
+            ..
+        } => {
+            let mut value = if onset {
+                // delta_0 = delta_1 = 0: delta = s^2 g (g_j = delta_{j+2}), r = s sqrt(g),
+                // F = c s^3 g sqrt(g); coefficient k needs g and sqrt(g) = r_{.+1} to k - 3.
+                if k >= 3 {
+                    indentation_root(root, delta, k - 2, true);
+                    coefficient * convolution(&delta[2..k], &root[1..k - 1])
+                } else {
+                    0.0
+                }
+            } else {
+                indentation_root(root, delta, k, false);
+                coefficient * convolution(&delta[..=k], &root[..=k])
+            };
+            if k == 0 && constant != 0.0 {
+                value -= constant;
+            }
+            Some(value)
+        }
+        SeriesForce::VanDerWaals { scale } => {
+            // -A / d^2 = -A u^2, u = 1/d, only off the surface on the time clock.
+            if onset || delta[0] >= 0.0 {
+                return None;
+            }
+            update_reciprocal_gap(root, delta, k);
+            Some(-scale * convolution(&root[..=k], &root[..=k]))
+        }
+    }
+}
+
 /// The recurrence of [`contact_state_series`] (`Z(t(s))`'s coefficients `separation`), inlined
 /// into each call so that a constant mode count unrolls its loops over modes.
 #[inline(always)]
 fn state_recurrence(
     modes: &[ModalConstants],
-    hertz: f64,
+    law: SeriesForce,
     drive_frequency: f64,
     separation: &[f64; 3],
     clock: &ClockPolynomial,
@@ -153,19 +255,10 @@ fn state_recurrence(
         let (earlier, row) = done.split_at(k * n);
         let next = &mut rest[..n];
         delta[k] = indentation_coefficient(separation, row, k);
-        force[k] = if onset {
-            // delta_0 = delta_1 = 0: delta = s^2 g (g_j = delta_{j+2}), r = s sqrt(g),
-            // F = c s^3 g sqrt(g); coefficient k needs g and sqrt(g) = r_{.+1} to k - 3 only.
-            if k >= 3 {
-                indentation_root(&mut root, &delta, k - 2, true);
-                hertz * convolution(&delta[2..k], &root[1..k - 1])
-            } else {
-                0.0
-            }
-        } else {
-            indentation_root(&mut root, &delta, k, false);
-            hertz * convolution(&delta[..=k], &root[..=k])
-        };
+        match force_coefficient(law, &mut root, &delta, k, onset) {
+            Some(value) => force[k] = value,
+            None => return false,
+        }
         total += force[k];
         // y' = tau z: y_{k+1} = (a z_k + b2 z_{k-1}) / (k + 1), z_{-1} = 0 (the coefficient
         // below k is row k itself at k = 0, times zero).
@@ -203,13 +296,13 @@ fn state_recurrence(
 /// columns, then, with `parameter_column`, `dx/dZ`) along the contact flow whose state series is
 /// `state` (from [`contact_state_series`] with the same arguments): `dV/ds = tau J(t(s), x(s))
 /// V` (`+ tau df/dZ` on the parameter column), `J`'s contact part being `(w_i^2/k_i) F_ts'(d)`
-/// on every `q_j` with `F_ts' = -(3/2) c r`. Each coefficient of `tangents` is `V`'s row-major
+/// on every `q_j` with `F_ts' = -(3/2) c r` (Hertz) or `2 A / d^3` (van der Waals). Each coefficient of `tangents` is `V`'s row-major
 /// matrix (component `row * columns + column`); the constant terms hold `V` at the step start.
 /// `gaps` is scratch space (resized here).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn contact_tangent_series(
     modes: &[ModalConstants],
-    hertz: f64,
+    force: SeriesForce,
     separation: &Separation,
     clock: &ClockPolynomial,
     state: &TaylorSeries,
@@ -220,9 +313,10 @@ pub(crate) fn contact_tangent_series(
     let p = tangents.order().min(state.order());
     let n = state.dim();
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
-    let separation = separation_coefficients(separation, clock);
-    // The indentation's square root to order p - 1 (all the recurrence below uses; on an onset
-    // it needs the indentation to order p).
+    let separation = shifted_separation(separation, clock, force);
+    // The series of F_ts'(d) / slope to order p - 1 (all the recurrence below uses; on an
+    // onset it needs the indentation to order p): the indentation's square root for Hertz
+    // (`F' = -(3/2) c r`), `u^3 = 1/d^3` for van der Waals (`F' = 2 A u^3`).
     let mut delta = [0.0; MAX_ORDER + 1];
     let mut root = [0.0; MAX_ORDER + 1];
     for (k, (d, row)) in delta[..=p]
@@ -232,15 +326,29 @@ pub(crate) fn contact_tangent_series(
     {
         *d = indentation_coefficient(&separation, row, k);
     }
-    for m in 0..p {
-        indentation_root(&mut root, &delta, m, a == 0.0);
-    }
+    let slope = match force {
+        SeriesForce::Hertz { coefficient, .. } => {
+            for m in 0..p {
+                indentation_root(&mut root, &delta, m, a == 0.0);
+            }
+            -1.5 * coefficient
+        }
+        SeriesForce::VanDerWaals { scale } => {
+            let mut reciprocal = [0.0; MAX_ORDER + 1];
+            let mut square = [0.0; MAX_ORDER + 1];
+            for m in 0..p {
+                update_reciprocal_gap(&mut reciprocal, &delta, m);
+                square[m] = convolution(&reciprocal[..=m], &reciprocal[..=m]);
+                root[m] = convolution(&square[..=m], &reciprocal[..=m]);
+            }
+            2.0 * scale
+        }
+    };
     // Highest power first, so that the convolutions below run forward through both series.
     let mut root_reversed = [0.0; MAX_ORDER];
     for (reversed, r) in root_reversed.iter_mut().zip(root[..p].iter().rev()) {
         *reversed = *r;
     }
-    let slope = -1.5 * hertz;
     let columns = tangents.dim() / n;
     let recurrence = TangentRecurrence {
         modes,
@@ -265,10 +373,10 @@ pub(crate) fn contact_tangent_series(
 /// The coefficients of the tangent recurrence of [`contact_tangent_series`].
 struct TangentRecurrence<'a> {
     modes: &'a [ModalConstants],
-    /// The indentation's square root to order `p - 1`, highest power first (`r_{p-1-i}` at
-    /// `i`).
+    /// The series of `F_ts'(d) / slope` to order `p - 1` (the indentation's square root for
+    /// Hertz), highest power first (`r_{p-1-i}` at `i`).
     root_reversed: &'a [f64],
-    /// `-(3/2) c`.
+    /// `-(3/2) c` (Hertz) or `2 A` (van der Waals).
     slope: f64,
     /// `tau = rate + curvature s` (`curvature` is twice the clock's).
     rate: f64,
@@ -379,6 +487,3 @@ impl TangentRecurrence<'_> {
 /// The widest block of tangent columns [`TangentRecurrence::run`] handles at once (`2N + 1`
 /// columns for `N` up to 3 in one).
 const COLUMN_BLOCK: usize = 8;
-
-#[cfg(test)]
-mod tests;

@@ -37,6 +37,7 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "mica"),
     embedded!("samples", "soft"),
     embedded!("samples", "purple-membrane"),
+    embedded!("samples", "purple-membrane-film"),
 ];
 
 const CASES: &[Embedded] = &[
@@ -46,6 +47,7 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "maclever-soft"),
     embedded!("cases", "maclever-mica-experiment"),
     embedded!("cases", "maclever-membrane-experiment"),
+    embedded!("cases", "maclever-membrane-film"),
 ];
 
 fn names(table: &[Embedded]) -> Vec<&'static str> {
@@ -57,13 +59,15 @@ pub fn cantilever_names() -> Vec<&'static str> {
     names(CANTILEVERS)
 }
 
-/// The names of the built-in samples (`mica`, `soft`, `purple-membrane`).
+/// The names of the built-in samples (`mica`, `soft`, `purple-membrane`,
+/// `purple-membrane-film`).
 pub fn sample_names() -> Vec<&'static str> {
     names(SAMPLES)
 }
 
 /// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
-/// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`).
+/// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
+/// `maclever-membrane-film`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }

@@ -21,10 +21,12 @@ pub mod amplitude_ratio;
 pub mod bifurcation_diagram;
 pub mod cantilever;
 pub mod case;
+pub mod contact;
 mod contact_series;
 pub mod drive;
 pub mod eigenmode;
 pub mod error;
+pub mod film_validity;
 pub mod fixtures;
 pub mod free_flight;
 pub mod free_flight_fourier;
@@ -61,6 +63,7 @@ pub use case::{Case, CaseFile};
 pub use drive::Drive;
 pub use eigenmode::Eigenmode;
 pub use error::AfmError;
+pub use film_validity::film_range_warning;
 pub use fixtures::{
     builtin_cantilever, builtin_case, builtin_sample, cantilever_names, case_names, find_case,
     load_cantilever, load_case, load_sample, sample_names,

@@ -130,7 +130,9 @@ impl CycleLockIn {
                 && extremum.kind == ExtremumKind::Minimum
                 && extremum.value < 0.0
             {
-                self.peak_force = self.peak_force.max(model.hertz().force(extremum.value));
+                self.peak_force = self
+                    .peak_force
+                    .max(model.force_at_gap_minimum(extremum.value + model.contact_gap_nm()));
             }
         }
         if let StepOutcome::Event(event) = outcome {

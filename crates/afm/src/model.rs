@@ -1,39 +1,59 @@
-//! The tapping cantilever of Eq. 1 as a hybrid system: free flight (exact flow) and Hertz
-//! contact (integrated), separated by the surface `d = 0`.
+//! The tapping cantilever of Eq. 1 as a hybrid system: free flight (exact flow where no force
+//! acts outside contact) and contact (integrated), separated by the contact surface `d = d_c`
+//! of the sample's contact law (MODEL.md sections 1 and 9).
 
 use std::f64::consts::PI;
 
 use hybrid::{HybridSystem, Mode};
 
 mod accelerations;
+#[cfg(test)]
+mod contact_series_tests;
 mod hybrid_system;
 #[cfg(test)]
 mod tests;
 
 use crate::case::check_case_numbers;
+use crate::contact::spec::tip_sample_force;
+use crate::contact::{ContactLaw, ForceSlopes, HertzShape, HertzTip, TipSampleForce};
 use crate::modal_constants::{grid_spacing, ModalConstants, KEPT_GRIDS};
 use crate::phase;
 use crate::validation::invalid;
-use crate::{AfmError, Cantilever, Case, Drive, FreeResponse, HertzContact, Sample, Separation};
+use crate::{
+    effective_modulus_gpa, AfmError, Cantilever, Case, Drive, FreeResponse, HertzContact, Sample,
+    Separation,
+};
 
-/// The mode in which the tip is free (`d >= 0`): exact flow.
+/// The mode in which the tip is free (`d >= d_c`): exact flow where no force acts outside
+/// contact.
 pub const FREE_FLIGHT: Mode = 0;
-/// The mode in which the tip indents the sample (`d < 0`): Hertz force, integrated.
+/// The mode bit set while the tip indents the sample (`d < d_c`): contact force, integrated.
 pub const CONTACT: Mode = 1;
-/// The index of the contact switching surface `h_0 = d`.
+/// The mode bit set on the side `h_1 < 0` of a clipped Kelvin-Voigt law's release surface,
+/// where the contact force is clipped to zero (MODEL.md section 9).
+pub const CLIPPED: Mode = 2;
+/// The index of the contact switching surface `h_0 = d - d_c`.
 pub const GAP_SURFACE: usize = 0;
+/// The index of a clipped Kelvin-Voigt law's release surface `h_1 = -d - tau d'`.
+pub const RELEASE_SURFACE: usize = 1;
 
 /// The N-mode tapping cantilever of Eq. 1 (MODEL.md section 1) as a [`HybridSystem`].
 ///
 /// State `x = [q_1, q_1', ..., q_N, q_N']` (nm, nm/us), time in us, `t = 0` at a zero of the
-/// drive phase. One switching surface `h_0 = d = Z(t) + sum_i q_i` (the gap, nm); mode
-/// [`FREE_FLIGHT`] (`d >= 0`, exact flow) and [`CONTACT`] (`d < 0`, Hertz force
-/// `F_ts = c max(-d, 0)^{3/2}`, integrated). The system's parameter is the separation `Z`.
+/// drive phase. The contact switching surface `h_0 = d - d_c` (`d = Z(t) + sum_i q_i` the gap,
+/// nm; `d_c` the law's contact gap, 0 except DMT's `a0`); mode [`FREE_FLIGHT`] (`d >= d_c`)
+/// and [`CONTACT`] (`d < d_c`, the contact force, integrated); a clipped Kelvin-Voigt law adds
+/// the release surface `h_1` ([`RELEASE_SURFACE`], mode bit [`CLIPPED`]). With the paper's
+/// Hertz sphere, `F_ts = c max(-d, 0)^{3/2}`. The system's parameter is the separation `Z`.
 #[derive(Debug, Clone)]
 pub struct TappingModel {
     cantilever: Cantilever,
     sample: Sample,
     hertz: HertzContact,
+    force: TipSampleForce,
+    /// Whether the force is the paper's Hertz sphere with nothing added (its fast paths:
+    /// Taylor series, half-power surface, exact free flight).
+    plain_hertz: bool,
     drive: Drive,
     free_amplitude_nm: f64,
     free_response: FreeResponse,
@@ -78,7 +98,7 @@ impl TappingModel {
         }
         let drive = Drive::for_free_amplitude(&cantilever, free_amplitude_nm, frequency_khz)?;
         let free_response = FreeResponse::new(&cantilever, &drive);
-        let grazing_separation_nm = free_response.grazing_separation_nm();
+
         // A quarter of the shortest period present: the undamped modal periods (each no longer
         // than the damped one) and the drive period.
         let shortest_period = cantilever
@@ -95,8 +115,31 @@ impl TappingModel {
         let grid_rotations = std::array::from_fn(|i| {
             phase::sin_cos(drive.angular_frequency * grid_spacing(exact_step_limit, i + 1))
         });
+        let force = tip_sample_force(
+            sample.contact.as_ref(),
+            sample.electrostatic.as_ref(),
+            effective_modulus_gpa(
+                sample.youngs_modulus_gpa,
+                sample.poisson_ratio,
+                cantilever.tip_youngs_modulus_gpa,
+                cantilever.tip_poisson_ratio,
+            ),
+            cantilever.tip_radius_nm,
+            sample.poisson_ratio,
+        );
+        // The free orbit's lowest gap reaches the contact surface `d = d_c`.
+        let grazing_separation_nm = free_response.grazing_separation_nm() + force.contact_gap_nm();
+        let plain_hertz = matches!(
+            force.law,
+            ContactLaw::Hertz(HertzShape {
+                tip: HertzTip::Sphere { .. },
+                ..
+            })
+        ) && force.double_layer.is_none();
         Ok(Self {
             hertz: HertzContact::new(&cantilever, &sample),
+            force,
+            plain_hertz,
             cantilever,
             sample,
             drive,
@@ -134,9 +177,26 @@ impl TappingModel {
         &self.sample
     }
 
-    /// The Hertz contact law (MODEL.md section 1).
+    /// The spherical Hertz law of the sample's modulus and the tip's radius (MODEL.md
+    /// section 1), whatever the sample's contact law.
     pub fn hertz(&self) -> &HertzContact {
         &self.hertz
+    }
+
+    /// The sample's tip-sample force: its contact law and double layer (MODEL.md section 9).
+    pub fn contact_force(&self) -> &TipSampleForce {
+        &self.force
+    }
+
+    /// Whether the force is the paper's Hertz sphere with nothing added (the law with the
+    /// Taylor-series path; MODEL.md section 9).
+    pub fn is_plain_hertz(&self) -> bool {
+        self.plain_hertz
+    }
+
+    /// The contact surface's gap `d_c`, nm: `a0` for DMT, 0 otherwise.
+    pub fn contact_gap_nm(&self) -> f64 {
+        self.force.contact_gap_nm()
     }
 
     /// The drive (frequency, `w`, `F_1`).
@@ -174,7 +234,10 @@ impl TappingModel {
         self.drive.force_nn
     }
 
-    /// The separation of first contact `Z_G1` (the free orbit's lowest gap is zero), nm.
+    /// The separation of first contact `Z_G1` (the free orbit's lowest gap reaches the contact
+    /// surface `d_c`, 0 except for DMT), nm. Where a force acts outside contact (DMT, a double
+    /// layer) the free orbit is not force-free and this is the force-free estimate; the
+    /// diagram's `G1` locates the true grazing.
     pub fn grazing_separation_nm(&self) -> f64 {
         self.grazing_separation_nm
     }
@@ -227,10 +290,11 @@ impl TappingModel {
         }
     }
 
-    /// The field's Jacobian `df/dx` given the Hertz force's slope `F_ts'(d)` (nN/nm; 0 in free
-    /// flight), into the column-major `2N x 2N` `matrix` (entry `(r, c)` at `r + 2N c`).
+    /// The field's Jacobian `df/dx` given the force's slopes `dF_ts/dd` (nN/nm) and
+    /// `dF_ts/dd'` (nN us/nm; 0 but for a viscous law), into the column-major `2N x 2N`
+    /// `matrix` (entry `(r, c)` at `r + 2N c`).
     #[inline]
-    fn modal_jacobian(&self, slope: f64, matrix: &mut [f64]) {
+    fn modal_jacobian(&self, slope: f64, rate_slope: f64, matrix: &mut [f64]) {
         let n = 2 * self.modes.len();
         matrix.fill(0.0);
         for (i, m) in self.modes.iter().enumerate() {
@@ -243,13 +307,40 @@ impl TappingModel {
                     matrix[2 * i + 1 + n * (2 * j)] += coupling;
                 }
             }
+            if rate_slope != 0.0 {
+                let coupling = m.omega_squared_over_stiffness * rate_slope;
+                for j in 0..self.modes.len() {
+                    matrix[2 * i + 1 + n * (2 * j + 1)] += coupling;
+                }
+            }
         }
     }
 
-    /// The Hertz force `F_ts = c s^{3/2}` (nN) and its slope `F_ts'(d) = -1.5 c s^{1/2}`
-    /// (nN/nm), `s = max(-d, 0)`, from one square root; both 0 in free flight.
+    /// The force of mode `mode` at `(t, x)` with its slopes: for the plain Hertz sphere
+    /// `F_ts = c s^{3/2}` (nN) and `F_ts'(d) = -1.5 c s^{1/2}` (nN/nm), `s = max(-d, 0)`, from
+    /// one square root, both 0 in free flight; for another law [`TipSampleForce::in_region`]
+    /// on the mode's side of each surface.
     #[inline]
-    fn force_and_slope(&self, mode: Mode, t: f64, x: &[f64]) -> (f64, f64) {
+    fn force_slopes(&self, mode: Mode, t: f64, x: &[f64]) -> ForceSlopes {
+        if !self.plain_hertz {
+            return self.force.in_region(
+                Self::in_contact(mode),
+                mode & CLIPPED != 0,
+                self.gap(t, x),
+                self.gap_rate(x),
+            );
+        }
+        let (force, gap_slope) = self.hertz_force_and_slope(mode, t, x);
+        ForceSlopes {
+            force,
+            gap_slope,
+            rate_slope: 0.0,
+        }
+    }
+
+    /// The plain Hertz sphere's force and slope of [`Self::force_slopes`].
+    #[inline]
+    fn hertz_force_and_slope(&self, mode: Mode, t: f64, x: &[f64]) -> (f64, f64) {
         if Self::in_contact(mode) {
             let indentation = (-self.gap(t, x)).max(0.0);
             let root = indentation.sqrt();
@@ -352,10 +443,40 @@ impl TappingModel {
                 .sum::<f64>()
     }
 
-    /// The tip-sample force `F_ts(d)`, nN (repulsive positive).
+    /// The tip-sample force `F_ts(d, d')`, nN (repulsive positive), on the side of each
+    /// surface where the state lies.
     #[inline]
     pub fn tip_sample_force(&self, t: f64, x: &[f64]) -> f64 {
-        self.hertz.force(self.gap(t, x))
+        if self.plain_hertz {
+            self.hertz.force(self.gap(t, x))
+        } else {
+            self.force.force(self.gap(t, x), self.gap_rate(x))
+        }
+    }
+
+    /// The tip-sample force (nN) at a gap minimum (gap rate 0) of gap `d` (nm).
+    #[inline]
+    pub fn force_at_gap_minimum(&self, gap_nm: f64) -> f64 {
+        if self.plain_hertz {
+            self.hertz.force(gap_nm)
+        } else {
+            self.force.force(gap_nm, 0.0)
+        }
+    }
+
+    /// The sum of the modal accelerations `d'' - Z'' = sum_i q_i''` of mode `mode` (nm/us^2).
+    pub(crate) fn gap_acceleration(&self, mode: Mode, t: f64, x: &[f64]) -> f64 {
+        let drive = phase::cos(self.drive.angular_frequency * t);
+        let force = self.force_slopes(mode, t, x).force;
+        self.modes
+            .iter()
+            .zip(x.chunks_exact(2))
+            .map(|(m, state)| {
+                m.drive_acceleration * drive + m.omega_squared_over_stiffness * force
+                    - m.omega_squared * state[0]
+                    - m.damping * state[1]
+            })
+            .sum()
     }
 
     /// The photodiode signal `u = sum_i chi_i q_i`, nm.

@@ -62,7 +62,8 @@ pub enum GapMinimumKind {
 }
 
 impl GapMinimumKind {
-    /// The kind of a gap minimum `gap_nm` deep for a free amplitude `free_amplitude_nm`.
+    /// The kind of a gap minimum `gap_nm` above the contact surface (`d - d_c`; the gap itself
+    /// for every law but DMT) for a free amplitude `free_amplitude_nm`.
     pub fn of(gap_nm: f64, free_amplitude_nm: f64) -> Self {
         if gap_nm < 0.0 {
             Self::Impact
@@ -89,9 +90,9 @@ impl GapMinimumKind {
 pub struct GapMinimum {
     /// Time, in drive periods from the window start (in `[0, k)` for a window of `k` periods).
     pub t_periods: f64,
-    /// The gap there, nm.
+    /// The gap `d` there, nm.
     pub gap_nm: f64,
-    /// Impact, near impact or clear, by [`GapMinimumKind::of`] with the model's `A0`.
+    /// Impact, near impact or clear (from `d - d_c`, MODEL.md section 9), by [`GapMinimumKind::of`] with the model's `A0`.
     pub kind: GapMinimumKind,
 }
 
@@ -170,6 +171,8 @@ pub struct PeriodObserver {
     window_periods: usize,
     angular_frequency: f64,
     free_amplitude: f64,
+    /// The contact surface's gap `d_c`, nm (the minima are recorded as `d - d_c`).
+    contact_gap: f64,
     starts_in_contact: bool,
     gap_at_start: f64,
     gap_at_end: f64,
@@ -219,6 +222,7 @@ impl PeriodObserver {
             window_periods,
             angular_frequency: model.drive_angular_frequency(),
             free_amplitude: model.free_amplitude_nm(),
+            contact_gap: model.contact_gap_nm(),
             starts_in_contact: model.mode_of(t0, x0) & CONTACT != 0,
             gap_at_start: model.gap(t0, x0),
             gap_at_end: f64::NAN,
@@ -312,7 +316,7 @@ impl PeriodObserver {
             ..
         } = *node;
         let u = model.photodiode(state);
-        self.impulse += weight * model.hertz().force(model.gap(t, state));
+        self.impulse += weight * model.tip_sample_force(t, state);
         let (mut sin_k, mut cos_k) = (sin, cos);
         for coefficient in self.fourier.iter_mut() {
             coefficient[0] += weight * u * cos_k;
@@ -368,10 +372,10 @@ impl PeriodObserver {
         minima.dedup_by(|later, earlier| (later.0 - earlier.0) < DUPLICATE_FRACTION * self.period);
         minima
             .iter()
-            .map(|&(t, gap)| GapMinimum {
+            .map(|&(t, height)| GapMinimum {
                 t_periods: self.periods(t),
-                gap_nm: gap,
-                kind: GapMinimumKind::of(gap, self.free_amplitude),
+                gap_nm: height + self.contact_gap,
+                kind: GapMinimumKind::of(height, self.free_amplitude),
             })
             .collect()
     }
@@ -394,16 +398,15 @@ impl PeriodObserver {
         }
         let tail = open;
         let head_fragment = self.starts_in_contact && !intervals.is_empty();
-        let hertz = model.hertz();
         let peak_in = |from: f64, to: f64| {
             minima
                 .iter()
                 .filter(|minimum| minimum.t_periods >= from && minimum.t_periods <= to)
-                .map(|minimum| hertz.force(minimum.gap_nm))
+                .map(|minimum| model.force_at_gap_minimum(minimum.gap_nm))
                 .fold(0.0, f64::max)
         };
-        let boundary_start = hertz.force(self.gap_at_start);
-        let boundary_end = hertz.force(self.gap_at_end);
+        let boundary_start = model.force_at_gap_minimum(self.gap_at_start);
+        let boundary_end = model.force_at_gap_minimum(self.gap_at_end);
         let mut impacts = Vec::with_capacity(intervals.len() + 1);
         let mut head: Option<(f64, f64)> = None; // (end, peak) of the head fragment
         for (index, &(start, end, velocity)) in intervals.iter().enumerate() {

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::cantilever::DEFAULT_POISSON_RATIO;
+use crate::contact::{ContactSpec, ElectrostaticSpec};
 use crate::validation::{check_all, check_name, ranges, warnings_of, NumericField};
 use crate::AfmError;
 
@@ -24,6 +25,13 @@ pub struct Sample {
     /// Poisson ratio `nu_s`; range (-1, 0.5]; default 0.3 (the paper's note 15).
     #[serde(default = "default_poisson_ratio")]
     pub poisson_ratio: f64,
+    /// The contact law (MODEL.md section 9); absent: Hertz with a spherical tip.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSpec>,
+    /// An electrostatic double layer added to the contact law (MODEL.md section 9); absent:
+    /// none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub electrostatic: Option<ElectrostaticSpec>,
 }
 
 impl Sample {
@@ -50,6 +58,13 @@ impl Sample {
     /// Check every field's range (errors name `file`, the field and the allowed range).
     pub fn validate(&self, file: &str) -> Result<(), AfmError> {
         check_name(file, "name", &self.name)?;
-        check_all(file, &self.numeric_fields())
+        check_all(file, &self.numeric_fields())?;
+        if let Some(contact) = &self.contact {
+            contact.validate(file)?;
+        }
+        if let Some(electrostatic) = &self.electrostatic {
+            electrostatic.validate(file)?;
+        }
+        Ok(())
     }
 }

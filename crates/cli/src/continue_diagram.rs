@@ -236,6 +236,14 @@ fn continue_case(args: &ContinueArgs, case: &Case, model: &TappingModel) -> Resu
     } else {
         None
     };
+    let orbits = approach
+        .points
+        .iter()
+        .chain(retract.iter().flat_map(|r| r.points.iter()))
+        .map(|point| (point.z_nm, point.min_gap_nm));
+    if let Some(warning) = afm::film_range_warning(model, orbits) {
+        eprintln!("warning: {warning}");
+    }
     let bistable = retract.as_ref().map(|retract| {
         let mut ranges = approach.bistable_ranges();
         ranges.extend(retract.bistable_ranges());

@@ -128,6 +128,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
         _ => bail!("give exactly one of --z and --amplitude-ratio"),
     };
+    let min_gap = orbit.observables().min_gap_nm();
+    let orbits = [(orbit.z_nm, min_gap.is_finite().then_some(min_gap))];
+    if let Some(warning) = afm::film_range_warning(&model, orbits) {
+        eprintln!("warning: {warning}");
+    }
     if args.json {
         let mut object = orbit_json(&case.name, &model, &orbit);
         object["start"] = json!(start.name());

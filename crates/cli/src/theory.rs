@@ -57,7 +57,7 @@ pub fn run(args: &TheoryArgs) -> Result<()> {
             orbit.z_nm
         )
     })?;
-    for warning in warnings(&comparison) {
+    for warning in warnings(&model, &comparison) {
         eprintln!("drumroll: warning: {warning}");
     }
     if args.json {
@@ -93,14 +93,24 @@ fn orbit(
 }
 
 /// The warnings of a comparison: every assumption of the theory that the orbit violates
-/// ([`afm::AssumptionFailure`], in words), printed on stderr, in the table and in the JSON's
-/// `warnings`.
-pub fn warnings(comparison: &TheoryComparison) -> Vec<String> {
-    comparison
+/// ([`afm::AssumptionFailure`], in words), and a contact law that acts outside contact (DMT, a
+/// double layer: Eqs. 3-4 assume force-free flight between impacts; MODEL.md section 9);
+/// printed on stderr, in the table and in the JSON's `warnings`.
+pub fn warnings(model: &TappingModel, comparison: &TheoryComparison) -> Vec<String> {
+    let mut warnings: Vec<String> = comparison
         .assumption_failures
         .iter()
         .map(ToString::to_string)
-        .collect()
+        .collect();
+    if model.contact_force().acts_outside_contact() {
+        warnings.push(
+            "the sample's contact law acts outside contact (van der Waals or double layer): \
+             Eqs. 3-4 assume short impacts and force-free flight between them and do not apply \
+             (MODEL.md section 9); computed anyway"
+                .to_string(),
+        );
+    }
+    warnings
 }
 
 /// The JSON object of `drumroll theory --json` (docs/output-schema.md; units in the key
@@ -128,7 +138,7 @@ pub fn comparison_json(
             .iter()
             .map(AssumptionFailure::kind)
             .collect::<Vec<_>>(),
-        "warnings": warnings(comparison),
+        "warnings": warnings(model, comparison),
         "lambda_1": theory.lambda_1,
         "lambda_2": theory.lambda_2,
         "lambda_3": theory.lambda_3,
@@ -241,7 +251,7 @@ pub fn summary(case: &str, model: &TappingModel, comparison: &TheoryComparison) 
         theory.free_q1_amplitude_nm,
         model.drive_frequency_khz()
     );
-    for warning in warnings(comparison) {
+    for warning in warnings(model, comparison) {
         let _ = writeln!(s, "WARNING: {warning}");
     }
     let _ = writeln!(s, "nondimensional numbers (the paper, below Eq. 4):");

@@ -180,6 +180,37 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
     ];
     printed.extend(check(&schema, "`drumroll simulate --json`", &simulate));
 
+    // simulate with each contact law's sample file (the inputs' `contact` and
+    // `electrostatic` objects, MODEL.md section 9).
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let laws = [
+        r#""contact": {"law": "dmt", "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}"#,
+        r#""contact": {"law": "kelvin-voigt", "viscosity_pa_s": 100, "clip": true}"#,
+        r#""contact": {"law": "film", "thickness_nm": 6, "correction": "garcia-2018"}"#,
+        r#""contact": {"law": "hertz", "tip_shape": "cone", "cone_half_angle_deg": 20}, "electrostatic": {"debye_length_nm": 1, "tip_charge_c_per_m2": 0.02, "sample_charge_c_per_m2": 0.02, "relative_permittivity": 80}"#,
+        r#""contact": {"law": "hertz", "tip_shape": "flat-punch", "punch_radius_nm": 2}"#,
+    ];
+    let mut with_laws = Vec::new();
+    for (i, law) in laws.iter().enumerate() {
+        let path = directory.path().join(format!("sample-{i}.json"));
+        let text = format!(r#"{{"name": "law-{i}", "youngs_modulus_gpa": 1, {law}}}"#);
+        std::fs::write(&path, text).expect("sample file");
+        let path = path.to_str().expect("utf-8 path").to_string();
+        with_laws.push(one(&[
+            "simulate",
+            "--cantilever",
+            "biolever",
+            "--sample",
+            &path,
+            "--a0",
+            "10",
+            "--z",
+            "8.5",
+            "--json",
+        ]));
+    }
+    printed.extend(check(&schema, "`drumroll simulate --json`", &with_laws));
+
     // continue: the MAClever on mica with its retract (folds, bistable range).
     let continued = [one(&[
         "continue",

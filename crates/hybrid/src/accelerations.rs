@@ -257,4 +257,28 @@ pub trait SwitchingStructure {
         let _ = mode;
         None
     }
+
+    /// For a field that grows as `|h|^{1/2}` from its half-power surface (a viscous contact
+    /// force `~ |h|^{1/2} dh/dt`), whose Jacobian therefore grows as `|h|^{-1/2}`: the limit at
+    /// the crossing (`sigma = 0` of the square-root clock centred on it, where
+    /// `dt/dsigma = 2 |sigma| = 0`) of `(dt/dsigma) J v` for every column `v` of `tangents`
+    /// (column-major, `n` rows), plus `(dt/dsigma) df/dp` on the last column when
+    /// `parameter_column`, written into `tangent_rates`; returns `true` when written. The
+    /// default returns `false`: the limit is zero, as for any Jacobian bounded next to the
+    /// surface (Hertz: `J ~ |h|^{1/2}`). Without it a step starting or ending on the crossing
+    /// would take its stage there as zero and carry an error of the order of its length into
+    /// the transition matrix.
+    #[allow(clippy::too_many_arguments)]
+    fn crossing_tangent_limit(
+        &self,
+        mode: Mode,
+        t: f64,
+        x: &[f64],
+        tangents: &[f64],
+        tangent_rates: &mut [f64],
+        parameter_column: bool,
+    ) -> bool {
+        let _ = (mode, t, x, tangents, tangent_rates, parameter_column);
+        false
+    }
 }

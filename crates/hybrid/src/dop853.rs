@@ -201,6 +201,21 @@ impl Dop853 {
         }
     }
 
+    /// Overwrite stage 0 on components `range` (within `0..dim`) with what `fill` writes into
+    /// a contiguous buffer of that length (the stage argument's, free between stages), when it
+    /// returns `true`.
+    pub fn refill_first_stage(
+        &mut self,
+        range: std::ops::Range<usize>,
+        fill: impl FnOnce(&mut [f64]) -> bool,
+    ) {
+        if range.end <= self.dim && fill(&mut self.argument[range.clone()]) {
+            for c in range {
+                self.stages[c * STAGES_EXTENDED] = self.argument[c];
+            }
+        }
+    }
+
     /// Copy stage 12 (the derivative at the end of the last accepted step) to stage 0: the
     /// first-same-as-last property.
     pub fn reuse_last_derivative(&mut self) {

@@ -67,6 +67,39 @@ impl VariationalField {
     }
 }
 
+impl VariationalField {
+    /// At the crossing a square-root clock is centred on (`dt/dsigma = 0`), the tangent part
+    /// of `dz` from [`crate::SwitchingStructure::crossing_tangent_limit`] where the system
+    /// gives that limit (a Jacobian growing as `|h|^{-1/2}`); else left zero.
+    fn crossing_limit<S: HybridSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        mode: Mode,
+        t: f64,
+        z: &[f64],
+        dz: &mut [f64],
+    ) {
+        let n = self.n;
+        if !self.sensitivity.transition() {
+            return;
+        }
+        let Some(structure) = system.accelerations().switching else {
+            return;
+        };
+        let parameter = self.sensitivity.parameter();
+        let columns = if parameter { n + 1 } else { n };
+        let (x, tangents) = z.split_at(n);
+        structure.crossing_tangent_limit(
+            mode,
+            t,
+            x,
+            &tangents[..columns * n],
+            &mut dz[n..n + columns * n],
+            parameter,
+        );
+    }
+}
+
 /// The field of `mode` on `clock`: `dz/dsigma = (dt/dsigma) f(t(sigma), z)`, augmented with
 /// the variational equations when `variational` (else only the state part is written).
 pub(crate) fn clocked_field<'b, S: HybridSystem + ?Sized>(
@@ -79,7 +112,8 @@ pub(crate) fn clocked_field<'b, S: HybridSystem + ?Sized>(
     move |sigma: f64, z: &[f64], dz: &mut [f64]| match clock {
         Clock::Time => field.eval(system, mode, sigma, z, dz, variational),
         Clock::SquareRoot { .. } => {
-            field.eval(system, mode, clock.time(sigma), z, dz, variational);
+            let t = clock.time(sigma);
+            field.eval(system, mode, t, z, dz, variational);
             let rate = clock.rate(sigma);
             let written = if variational {
                 dz.len()
@@ -88,6 +122,9 @@ pub(crate) fn clocked_field<'b, S: HybridSystem + ?Sized>(
             };
             for v in &mut dz[..written] {
                 *v *= rate;
+            }
+            if rate == 0.0 && variational {
+                field.crossing_limit(system, mode, t, z, dz);
             }
         }
     }

@@ -8,19 +8,23 @@ use hybrid::{
 };
 use nalgebra::DMatrix;
 
-use super::{TappingModel, FREE_FLIGHT};
-use crate::contact_series;
+use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
+use crate::contact::ContactLaw;
+use crate::contact_series::{self, SeriesForce};
 use crate::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::phase;
 
+/// Offered only when no force acts outside contact ([`HybridSystem::accelerations`]): then
+/// every mode outside contact (`FREE_FLIGHT`, and a clipped Kelvin-Voigt law's free mode on
+/// the clipped side of its release surface) is the force-free Eq. 1.
 impl ExactFlow for TappingModel {
     fn has_exact_flow(&self, mode: Mode) -> bool {
-        mode == FREE_FLIGHT
+        mode & CONTACT == FREE_FLIGHT
     }
 
     /// A quarter of the shortest of the drive period and the modal periods `2 pi / w_i`, us.
     fn exact_step_limit(&self, mode: Mode) -> f64 {
-        if mode == FREE_FLIGHT {
+        if mode & CONTACT == FREE_FLIGHT {
             self.exact_step_limit
         } else {
             f64::INFINITY
@@ -122,37 +126,73 @@ impl ExactFlow for TappingModel {
     }
 }
 
-impl TaylorExpansion for TappingModel {
-    /// In contact, 40: the contact flow's Taylor series come from the recurrences of automatic
-    /// differentiation (module `contact_series`), whose intermediate series live on the stack.
-    fn taylor_order_limit(&self, mode: Mode) -> usize {
+impl TappingModel {
+    /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
+    /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
+    /// outside it (van der Waals, when `H > 0`); `None` for every other law, mode, or with a
+    /// double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
+    pub(crate) fn series_force(&self, mode: Mode) -> Option<SeriesForce> {
+        if self.plain_hertz {
+            return Self::in_contact(mode).then_some(SeriesForce::Hertz {
+                coefficient: self.hertz.coefficient,
+                contact_gap: 0.0,
+                constant: 0.0,
+            });
+        }
+        let (ContactLaw::Dmt(dmt), None) = (self.force.law, self.force.double_layer) else {
+            return None;
+        };
         if Self::in_contact(mode) {
+            Some(SeriesForce::Hertz {
+                coefficient: dmt.hertz_coefficient(),
+                contact_gap: dmt.intermolecular_distance_nm,
+                constant: dmt.adhesion_force_nn(),
+            })
+        } else {
+            (dmt.hamaker_constant_j != 0.0).then_some(SeriesForce::VanDerWaals {
+                scale: dmt.adhesion_scale(),
+            })
+        }
+    }
+}
+
+/// Offered for the plain Hertz sphere (its contact) and DMT (its contact and, with `H > 0`,
+/// its free flight) ([`HybridSystem::accelerations`]): the series of module `contact_series`.
+/// Every other law integrates by the adaptive Runge-Kutta path.
+impl TaylorExpansion for TappingModel {
+    /// Where [`TappingModel::series_force`] has a force, 40: the Taylor series come from the
+    /// recurrences of automatic differentiation (module `contact_series`), whose intermediate
+    /// series live on the stack.
+    fn taylor_order_limit(&self, mode: Mode) -> usize {
+        if self.series_force(mode).is_some() {
             contact_series::MAX_ORDER
         } else {
             0
         }
     }
 
-    /// In contact, the series of Eq. 1 with the Hertz force in the step's clock (module
-    /// `contact_series`); `false` in free flight (which has its exact flow).
+    /// The series of Eq. 1 with the mode's force in the step's clock (module
+    /// `contact_series`); `false` where the mode has none (the Hertz free flight has its exact
+    /// flow).
     fn taylor_series(
         &self,
         mode: Mode,
         clock: &ClockPolynomial,
         series: &mut TaylorSeries,
     ) -> bool {
-        Self::in_contact(mode)
-            && contact_series::contact_state_series(
+        self.series_force(mode).is_some_and(|force| {
+            contact_series::contact_state_series(
                 &self.modes,
-                self.hertz.coefficient,
+                force,
                 self.drive.angular_frequency,
                 &self.separation,
                 clock,
                 series,
             )
+        })
     }
 
-    /// In contact, the series of the variational equations along the contact series (module
+    /// Where the mode has a series, the series of the variational equations along it (module
     /// `contact_series`).
     fn taylor_tangents(
         &self,
@@ -163,10 +203,10 @@ impl TaylorExpansion for TappingModel {
         parameter_column: bool,
         scratch: &mut Vec<f64>,
     ) {
-        if Self::in_contact(mode) {
+        if let Some(force) = self.series_force(mode) {
             contact_series::contact_tangent_series(
                 &self.modes,
-                self.hertz.coefficient,
+                force,
                 &self.separation,
                 clock,
                 state,
@@ -179,14 +219,63 @@ impl TaylorExpansion for TappingModel {
 }
 
 impl SwitchingStructure for TappingModel {
-    /// In contact the Hertz force is `c (-d)^{3/2}`: the gap is the half-power surface of
-    /// the contact mode, and the solver integrates next to contact onset and release in the
-    /// square root of the time from them.
+    /// In contact the Hertz sphere's force is `c (-d)^{3/2}` (DMT's, Kelvin-Voigt's and the
+    /// film's have half-integer powers of `d_c - d` too): the contact surface is the
+    /// half-power surface of the contact mode (not of a clipped mode, whose force is zero, nor
+    /// of the cone's or punch's integer powers), and the solver integrates next to contact
+    /// onset and release in the square root of the time from them.
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
-        Self::in_contact(mode).then_some(0)
+        (Self::in_contact(mode) && !Self::is_clipped(mode) && self.force.law.half_power_inside())
+            .then_some(GAP_SURFACE)
     }
 
-    /// The gap `Z(t) + sum_i q_i` is affine: `Z(t)` is a constant or a linear ramp.
+    /// Kelvin-Voigt in contact (unclipped side): `F = c s^{1/2} (s + tau s')` has
+    /// `dF/dd = -c s^{-1/2} (1.5 s + 0.5 tau s')`, whose part `-0.5 c tau s' s^{-1/2}` is
+    /// unbounded at the crossing; there `s = |s'| sigma^2` on the square-root clock, so
+    /// `(dt/dsigma) dF/dd -> K = -c tau sign(s') |s'|^{1/2}` (`s' = -d'`, nm/us), and the
+    /// limit of `(dt/dsigma) J v` is `(w_i^2/k_i) K sum_j v_{q_j}` on each `v_i` row (`+ K`
+    /// times `(w_i^2/k_i)` on the parameter column, `dd/dZ = 1`), zero on the `q_i` rows.
+    /// Every other law's Jacobian is bounded next to its surface: `false`.
+    fn crossing_tangent_limit(
+        &self,
+        mode: Mode,
+        _t: f64,
+        x: &[f64],
+        tangents: &[f64],
+        tangent_rates: &mut [f64],
+        parameter_column: bool,
+    ) -> bool {
+        let ContactLaw::KelvinVoigt(kv) = self.force.law else {
+            return false;
+        };
+        if !Self::in_contact(mode) || Self::is_clipped(mode) {
+            return false;
+        }
+        let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
+        let indentation_rate = -self.gap_rate(x);
+        let limit =
+            -c * kv.release_time_us() * indentation_rate.signum() * indentation_rate.abs().sqrt();
+        let n = self.dim();
+        let columns = tangents.len() / n;
+        for (column, (v, rate)) in tangents
+            .chunks_exact(n)
+            .zip(tangent_rates.chunks_exact_mut(n))
+            .enumerate()
+        {
+            let mut gap_change: f64 = v.iter().step_by(2).sum();
+            if parameter_column && column + 1 == columns {
+                gap_change += 1.0;
+            }
+            for (m, rows) in self.modes.iter().zip(rate.chunks_exact_mut(2)) {
+                rows[0] = 0.0;
+                rows[1] = m.omega_squared_over_stiffness * limit * gap_change;
+            }
+        }
+        true
+    }
+
+    /// The gap `Z(t) + sum_i q_i` is affine (`Z(t)` is a constant or a linear ramp), and so
+    /// are `h_0 = d - d_c` and `h_1 = -d - tau d'`.
     fn switching_is_affine(&self, _k: usize) -> bool {
         true
     }
@@ -197,16 +286,18 @@ impl SwitchingStructure for TappingModel {
     /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
     /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
     /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
-    /// (extrema inside the sample, the gap's minima, are always wanted).
+    /// (extrema inside the sample, the gap's minima, are always wanted), and `None` for the
+    /// release surface and wherever a force acts outside contact (the bound assumes
+    /// `F_ts = 0`).
     fn switching_curvature_bound(
         &self,
-        _k: usize,
+        k: usize,
         mode: Mode,
         t0: f64,
         x0: &[f64],
         _dt: f64,
     ) -> Option<f64> {
-        if Self::in_contact(mode) {
+        if Self::in_contact(mode) || k != GAP_SURFACE || self.force.acts_outside_contact() {
             return None;
         }
         let w = self.drive.angular_frequency;

@@ -2,9 +2,11 @@
 //! derivative and the gap as its one switching surface (MODEL.md section 1).
 
 use hybrid::{Accelerations, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials};
+
+use crate::contact::ForceSlopes;
 use nalgebra::DMatrix;
 
-use super::TappingModel;
+use super::{TappingModel, CLIPPED, GAP_SURFACE, RELEASE_SURFACE};
 use crate::phase;
 
 impl HybridSystem for TappingModel {
@@ -12,17 +14,25 @@ impl HybridSystem for TappingModel {
         2 * self.modes.len()
     }
 
+    /// The contact surface, and a clipped Kelvin-Voigt law's release surface.
     fn surface_count(&self) -> usize {
-        1
+        if self.force.law.release_time_us().is_some() {
+            2
+        } else {
+            1
+        }
     }
 
     /// Eq. 1 solved for the accelerations:
-    /// `q_i'' = w_i^2 [(F_i/k_i) cos(w t) + F_ts(d)/k_i - q_i] - (w_i/Q_i) q_i'`, with
-    /// `F_ts = 0` in free flight and the Hertz force (finite on both sides) in contact.
+    /// `q_i'' = w_i^2 [(F_i/k_i) cos(w t) + F_ts/k_i - q_i] - (w_i/Q_i) q_i'`, with the force
+    /// `F_ts(d, d')` of the mode's side of each surface (MODEL.md section 9; for the Hertz
+    /// sphere 0 in free flight and `c (-d)^{3/2}`, finite on both sides, in contact).
     #[inline(always)]
     fn vector_field(&self, mode: Mode, t: f64, x: &[f64], dxdt: &mut [f64]) {
         let drive = phase::cos(self.drive.angular_frequency * t);
-        let force = if Self::in_contact(mode) {
+        let force = if !self.plain_hertz {
+            self.force_slopes(mode, t, x).force
+        } else if Self::in_contact(mode) {
             self.hertz.force(self.gap(t, x))
         } else {
             0.0
@@ -30,25 +40,17 @@ impl HybridSystem for TappingModel {
         self.modal_field(drive, force, x, dxdt);
     }
 
-    /// `df/dx`: the modal blocks `[[0, 1], [-w_i^2, -w_i/Q_i]]`, plus in contact
-    /// `d q_i'' / d q_j = (w_i^2 / k_i) F_ts'(d)` for every `i, j`.
+    /// `df/dx`: the modal blocks `[[0, 1], [-w_i^2, -w_i/Q_i]]`, plus
+    /// `d q_i'' / d q_j = (w_i^2 / k_i) dF_ts/dd` and `d q_i'' / d q_j' = (w_i^2 / k_i)
+    /// dF_ts/dd'` for every `i, j`.
     fn jacobian(&self, mode: Mode, t: f64, x: &[f64], jacobian: &mut DMatrix<f64>) {
-        let slope = if Self::in_contact(mode) {
-            self.hertz.force_derivative(self.gap(t, x))
-        } else {
-            0.0
-        };
-        self.modal_jacobian(slope, jacobian.as_mut_slice());
+        let slopes = self.force_slopes(mode, t, x);
+        self.modal_jacobian(slopes.gap_slope, slopes.rate_slope, jacobian.as_mut_slice());
     }
 
-    /// `df/dZ`: `(w_i^2 / k_i) F_ts'(d)` on every acceleration component in contact, 0 in
-    /// free flight.
+    /// `df/dZ`: `(w_i^2 / k_i) dF_ts/dd` on every acceleration component (`dd/dZ = 1`).
     fn parameter_derivative(&self, mode: Mode, t: f64, x: &[f64], dfdp: &mut [f64]) {
-        let slope = if Self::in_contact(mode) {
-            self.hertz.force_derivative(self.gap(t, x))
-        } else {
-            0.0
-        };
+        let slope = self.force_slopes(mode, t, x).gap_slope;
         self.separation_derivative(slope, dfdp);
     }
 
@@ -65,11 +67,11 @@ impl HybridSystem for TappingModel {
         dfdp: Option<&mut [f64]>,
     ) {
         let drive = phase::cos(self.drive.angular_frequency * t);
-        let (force, slope) = self.force_and_slope(mode, t, x);
-        self.modal_field(drive, force, x, dxdt);
-        self.modal_jacobian(slope, jacobian.as_mut_slice());
+        let slopes = self.force_slopes(mode, t, x);
+        self.modal_field(drive, slopes.force, x, dxdt);
+        self.modal_jacobian(slopes.gap_slope, slopes.rate_slope, jacobian.as_mut_slice());
         if let Some(dfdp) = dfdp {
-            self.separation_derivative(slope, dfdp);
+            self.separation_derivative(slopes.gap_slope, dfdp);
         }
     }
 
@@ -91,45 +93,116 @@ impl HybridSystem for TappingModel {
         _buffers: &mut LinearisationBuffers,
     ) {
         let drive = phase::cos(self.drive.angular_frequency * t);
-        let (force, slope) = self.force_and_slope(mode, t, x);
-        self.modal_field(drive, force, x, dxdt);
-        self.modal_tangent_rates(slope, tangents, tangent_rates, parameter_column);
+        let slopes = self.force_slopes(mode, t, x);
+        self.modal_field(drive, slopes.force, x, dxdt);
+        if slopes.rate_slope == 0.0 {
+            self.modal_tangent_rates(slopes.gap_slope, tangents, tangent_rates, parameter_column);
+        } else {
+            self.viscous_tangent_rates(slopes, tangents, tangent_rates, parameter_column);
+        }
     }
 
-    /// `h_0 = d = Z(t) + sum_i q_i`, nm.
-    fn switching(&self, _k: usize, t: f64, x: &[f64]) -> f64 {
-        self.gap(t, x)
+    /// `h_0 = d - d_c = Z(t) + sum_i q_i - d_c`, nm; a clipped Kelvin-Voigt law's
+    /// `h_1 = -d - tau d'`, nm (MODEL.md section 9).
+    fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64 {
+        if k == GAP_SURFACE {
+            self.gap(t, x) - self.contact_gap_nm()
+        } else {
+            -self.gap(t, x) - self.release_time() * self.gap_rate(x)
+        }
     }
 
-    /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in both modes), nm/us.
-    fn switching_rate(&self, _k: usize, _mode: Mode, _t: f64, x: &[f64]) -> f64 {
-        self.gap_rate(x)
+    /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in every mode), nm/us;
+    /// `dh_1/dt = -d' - tau d''` with `d'' = sum_i q_i''` of mode `mode` (`Z'' = 0`).
+    fn switching_rate(&self, k: usize, mode: Mode, t: f64, x: &[f64]) -> f64 {
+        if k == GAP_SURFACE {
+            self.gap_rate(x)
+        } else {
+            -self.gap_rate(x) - self.release_time() * self.gap_acceleration(mode, t, x)
+        }
     }
 
-    /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'`; `dh/dt|_x = Z'(t)`; `dh/dZ = 1`.
+    /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'`; `dh_0/dt|_x = Z'(t)`; `dh_0/dZ = 1`.
+    /// `grad h_1` = -1 on every `q_i`, `-tau` on every `q_i'`; `dh_1/dt|_x = -Z'(t)`;
+    /// `dh_1/dZ = -1`.
     fn switching_gradient(
         &self,
-        _k: usize,
+        k: usize,
         _t: f64,
         _x: &[f64],
         gradient: &mut [f64],
     ) -> SwitchingPartials {
+        let (on_gap, on_rate, sign) = if k == RELEASE_SURFACE {
+            (-1.0, -self.release_time(), -1.0)
+        } else {
+            (1.0, 0.0, 1.0)
+        };
         for (i, g) in gradient.iter_mut().enumerate() {
-            *g = if i % 2 == 0 { 1.0 } else { 0.0 };
+            *g = if i % 2 == 0 { on_gap } else { on_rate };
         }
         SwitchingPartials {
-            t: self.separation.rate(),
-            p: 1.0,
+            t: sign * self.separation.rate(),
+            p: sign,
         }
     }
 
-    /// The free flight's closed-form flow, the contact's Taylor series, and the gap's shape
-    /// (affine; its curvature bounded in free flight; a half-power surface in contact).
+    /// The free flight's closed-form flow (where no force acts outside contact), the Taylor
+    /// series of the plain Hertz contact and of DMT (`TappingModel::series_force`), and the surfaces' shape (affine; the gap's curvature
+    /// bounded in force-free flight; a half-power surface in contact).
     fn accelerations(&self) -> Accelerations<'_> {
         Accelerations {
-            exact_flow: Some(self),
+            exact_flow: (!self.force.acts_outside_contact()).then_some(self as _),
             taylor: Some(self),
             switching: Some(self),
+        }
+    }
+}
+
+impl TappingModel {
+    /// A clipped Kelvin-Voigt law's `tau`, us (0 for another law, which has no surface 1).
+    fn release_time(&self) -> f64 {
+        self.force.law.release_time_us().unwrap_or(0.0)
+    }
+
+    /// Whether mode `mode` is on the clipped side of the release surface.
+    pub(crate) fn is_clipped(mode: Mode) -> bool {
+        mode & CLIPPED != 0
+    }
+
+    /// [`Self::modal_tangent_rates`] for a force with a slope in the gap rate: per column `v`
+    /// `(J v)_{v_i} = -w_i^2 v_{q_i} - (w_i/Q_i) v_{v_i} + (w_i^2/k_i) (F_d sum_j v_{q_j} +
+    /// F_{d'} sum_j v_{v_j})`, plus `(w_i^2/k_i) F_d` on the parameter column.
+    fn viscous_tangent_rates(
+        &self,
+        slopes: ForceSlopes,
+        tangents: &[f64],
+        rates: &mut [f64],
+        parameter_column: bool,
+    ) {
+        let n = 2 * self.modes.len();
+        let columns = tangents.len() / n;
+        for (c, (v, rate)) in tangents
+            .chunks_exact(n)
+            .zip(rates.chunks_exact_mut(n))
+            .enumerate()
+        {
+            let mut gap_change = if parameter_column && c + 1 == columns {
+                1.0
+            } else {
+                0.0
+            };
+            let mut rate_change = 0.0;
+            for i in 0..self.modes.len() {
+                gap_change += v[2 * i];
+                rate_change += v[2 * i + 1];
+            }
+            let coupling = slopes.gap_slope * gap_change + slopes.rate_slope * rate_change;
+            for (i, m) in self.modes.iter().enumerate() {
+                rate[2 * i] = v[2 * i + 1];
+                rate[2 * i + 1] = m.omega_squared_over_stiffness * coupling
+                    - m.omega_squared * v[2 * i]
+                    - m.damping * v[2 * i + 1];
+            }
         }
     }
 }

@@ -170,7 +170,7 @@ impl Accumulator {
                 let q1 = state[0];
                 self.q1_fourier[0] += w * q1 * cos;
                 self.q1_fourier[1] += w * q1 * sin;
-                let force = model.hertz().force(model.gap(t, state));
+                let force = model.tip_sample_force(t, state);
                 self.force[0] += w * force;
                 self.force[1] += w * force * cos;
                 self.force[2] += w * force * sin;

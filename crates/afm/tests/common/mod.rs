@@ -78,6 +78,8 @@ pub fn mica() -> Sample {
         description: String::new(),
         youngs_modulus_gpa: 60.0,
         poisson_ratio: 0.3,
+        contact: None,
+        electrostatic: None,
     }
 }
 

@@ -488,6 +488,38 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         Ok(t1)
     }
 
+    /// On the crossing a square-root clock is centred on, stage 0's tangent part from the
+    /// system's [`crate::SwitchingStructure::crossing_tangent_limit`] (the limit of
+    /// `(dt/dsigma) J v` for a Jacobian growing as `|h|^{-1/2}`), where it gives one, instead of
+    /// the zero the vanishing clock rate leaves.
+    fn first_stage_crossing_limit(&mut self, mode: Mode, t: f64) {
+        let Some(structure) = self.accelerations.switching else {
+            return;
+        };
+        if !self.sensitivity.transition() {
+            return;
+        }
+        let n = self.system.dim();
+        let parameter = self.sensitivity.parameter();
+        let columns = if parameter { n + 1 } else { n };
+        let (x, tangents) = self.buffers.z.split_at(n);
+        if tangents.len() < columns * n {
+            return;
+        }
+        self.buffers
+            .rk
+            .refill_first_stage(n..n + columns * n, |out| {
+                structure.crossing_tangent_limit(
+                    mode,
+                    t,
+                    x,
+                    &tangents[..columns * n],
+                    out,
+                    parameter,
+                )
+            });
+    }
+
     /// Make stage 0 hold the augmented derivative at the step start on `clock` (reading
     /// `sigma0`): rescale the one it holds (`stage0`, the rate it was computed with) or
     /// evaluate it. Returns the rate stage 0 now holds.
@@ -501,7 +533,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let rate = clock.rate(sigma0);
         match stage0 {
             Some(held) if held == rate => {}
-            Some(held) if held != 0.0 => self.buffers.rk.scale_first_stage(rate / held),
+            Some(held) if held != 0.0 => {
+                self.buffers.rk.scale_first_stage(rate / held);
+                if rate == 0.0 {
+                    self.first_stage_crossing_limit(mode, clock.time(sigma0));
+                }
+            }
             _ => {
                 let mut rhs =
                     clocked_field(&mut self.buffers.field, self.system, mode, clock, true);

@@ -2,6 +2,7 @@
 //! over it, and the event that truncates it.
 
 use crate::error::HybridError;
+use crate::event::ExtremumKind;
 use crate::extrema::Clearance;
 use crate::system::{HybridSystem, Mode, MAX_SURFACES};
 
@@ -78,7 +79,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
             Some((k, bracket)) => {
                 let event = self.fire(k, bracket, time_tolerance)?;
-                self.buffers.extrema.retain(|e| e.t <= event.t);
+                self.keep_extrema_until(event.t, time_tolerance);
                 self.buffers
                     .extrema
                     .sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.surface.cmp(&b.surface)));
@@ -201,5 +202,32 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             &mut self.buffers.extrema,
         );
         Ok(())
+    }
+}
+
+impl<S: HybridSystem + ?Sized> Solver<'_, S> {
+    /// Keep the step's extrema up to the event at `t_event`, which cut the step there. An
+    /// extremum located past it by at most `time_tolerance` (the two are located to that
+    /// precision each) that the state after the event has already passed (the rate of its
+    /// switching function there on the far side: `>= 0` after a minimum, `<= 0` after a
+    /// maximum) is kept too: the next step starts past it and would not report it (an extremum
+    /// of another surface's switching function right at an event, as at a double grazing).
+    fn keep_extrema_until(&mut self, t_event: f64, time_tolerance: f64) {
+        let (system, mode, t) = (self.system, self.mode, self.t);
+        let n = system.dim();
+        let x = &self.buffers.z[..n];
+        self.buffers.extrema.retain(|e| {
+            if e.t <= t_event {
+                return true;
+            }
+            if e.t - t_event > time_tolerance {
+                return false;
+            }
+            let rate = system.switching_rate(e.surface, mode, t, x);
+            match e.kind {
+                ExtremumKind::Minimum => rate >= 0.0,
+                ExtremumKind::Maximum => rate <= 0.0,
+            }
+        });
     }
 }

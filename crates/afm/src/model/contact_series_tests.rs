@@ -1,4 +1,5 @@
-//! The contact series against the plain vector field and finite differences.
+//! The contact series (module `contact_series`) against the plain vector field and finite
+//! differences, through the model's `TaylorExpansion`.
 
 use hybrid::{
     ClockPolynomial, Direction, HybridSystem, Sensitivity, Settings, Solver, StepOutcome,

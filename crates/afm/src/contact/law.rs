@@ -1,0 +1,171 @@
+//! The contact-law abstraction (MODEL.md section 9): a law's force and slopes on each side of
+//! its contact surface, and the [`TipSampleForce`] of a sample (a law plus an optional
+//! electrostatic double layer) that the tapping model evaluates per hybrid mode.
+
+use std::ops::AddAssign;
+
+use super::{DmtContact, DoubleLayer, FilmContact, HertzShape, KelvinVoigtContact};
+
+/// A force `F` (nN, repulsive positive) with its slopes `dF/dd` (nN/nm) and `dF/dd'`
+/// (nN us/nm) at one gap `d` and gap rate `d'`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ForceSlopes {
+    /// `F`, nN.
+    pub force: f64,
+    /// `dF/dd`, nN/nm.
+    pub gap_slope: f64,
+    /// `dF/dd'`, nN us/nm (non-zero only for a viscous law).
+    pub rate_slope: f64,
+}
+
+impl ForceSlopes {
+    /// No force.
+    pub const ZERO: Self = Self {
+        force: 0.0,
+        gap_slope: 0.0,
+        rate_slope: 0.0,
+    };
+}
+
+impl AddAssign for ForceSlopes {
+    fn add_assign(&mut self, other: Self) {
+        self.force += other.force;
+        self.gap_slope += other.gap_slope;
+        self.rate_slope += other.rate_slope;
+    }
+}
+
+/// A contact law: the force inside contact (`d` below the contact surface `d = d_c`) and
+/// outside it (MODEL.md section 9).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactLaw {
+    /// Hertz: sphere, cone or flat punch on an elastic half-space (no force outside contact).
+    Hertz(HertzShape),
+    /// DMT: Hertz shifted to `d = a0` with the van der Waals adhesion outside and inside.
+    Dmt(DmtContact),
+    /// Kelvin-Voigt: Hertz with a viscous term in the indentation rate.
+    KelvinVoigt(KelvinVoigtContact),
+    /// A film of thickness `h` on a rigid substrate: Hertz times a bottom-effect correction.
+    Film(FilmContact),
+}
+
+impl ContactLaw {
+    /// The contact surface's gap `d_c`, nm: `a0` for DMT, 0 for every other law.
+    pub fn contact_gap_nm(&self) -> f64 {
+        match self {
+            Self::Dmt(dmt) => dmt.intermolecular_distance_nm,
+            _ => 0.0,
+        }
+    }
+
+    /// The force and slopes inside contact (`d < d_c`), unclipped.
+    pub fn inside(&self, gap_nm: f64, gap_rate: f64) -> ForceSlopes {
+        match self {
+            Self::Hertz(shape) => shape.force_slopes(gap_nm),
+            Self::Dmt(dmt) => dmt.inside(gap_nm),
+            Self::KelvinVoigt(kv) => kv.force_slopes(gap_nm, gap_rate),
+            Self::Film(film) => film.force_slopes(gap_nm),
+        }
+    }
+
+    /// The force and slopes outside contact (`d >= d_c`): the van der Waals attraction for
+    /// DMT, zero otherwise.
+    pub fn outside(&self, gap_nm: f64) -> ForceSlopes {
+        match self {
+            Self::Dmt(dmt) => dmt.outside(gap_nm),
+            _ => ForceSlopes::ZERO,
+        }
+    }
+
+    /// Whether the law exerts a force outside contact (then free flight is not force-free).
+    pub fn acts_outside_contact(&self) -> bool {
+        matches!(self, Self::Dmt(dmt) if dmt.hamaker_constant_j != 0.0)
+    }
+
+    /// The release time constant `tau = 1.5 eta*/E*` (us) of a clipped Kelvin-Voigt law with
+    /// `eta > 0`, whose force-zero surface `h_1 = -d - tau d' = 0` is a second switching
+    /// surface; `None` for every other law.
+    pub fn release_time_us(&self) -> Option<f64> {
+        match self {
+            // With eta = 0 the force is Hertz's, never negative: no release surface.
+            Self::KelvinVoigt(kv) if kv.clip && kv.effective_viscosity_pa_s > 0.0 => {
+                Some(kv.release_time_us())
+            }
+            _ => None,
+        }
+    }
+
+    /// Whether the force inside contact grows with a half-integer power of the indentation
+    /// `d_c - d` from the contact surface (sphere Hertz, DMT, Kelvin-Voigt, film), so the
+    /// solution is smooth in the square root of the time from a crossing; `false` for the cone
+    /// and the flat punch (integer powers).
+    pub fn half_power_inside(&self) -> bool {
+        match self {
+            Self::Hertz(shape) => shape.has_half_powers(),
+            Self::Dmt(_) | Self::KelvinVoigt(_) | Self::Film(_) => true,
+        }
+    }
+}
+
+/// The tip-sample force of a sample: its contact law plus an optional electrostatic double
+/// layer (MODEL.md section 9). A clipped Kelvin-Voigt law's force inside contact is zero in
+/// the clipped mode (the side `h_1 < 0` of its release surface).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipSampleForce {
+    /// The contact law.
+    pub law: ContactLaw,
+    /// The double-layer term, if any.
+    pub double_layer: Option<DoubleLayer>,
+}
+
+impl TipSampleForce {
+    /// The contact surface's gap `d_c`, nm ([`ContactLaw::contact_gap_nm`]).
+    pub fn contact_gap_nm(&self) -> f64 {
+        self.law.contact_gap_nm()
+    }
+
+    /// Whether any force acts outside contact (DMT's van der Waals, a double layer).
+    pub fn acts_outside_contact(&self) -> bool {
+        self.law.acts_outside_contact() || self.double_layer.is_some()
+    }
+
+    /// The force and slopes on one side: inside contact (`inside`), with the contact law
+    /// zeroed when `clipped`, or outside. The double layer adds `F_dl(d)` outside and its
+    /// value on the contact surface, `F_dl(d_c)`, inside (held constant).
+    pub fn in_region(
+        &self,
+        inside: bool,
+        clipped: bool,
+        gap_nm: f64,
+        gap_rate: f64,
+    ) -> ForceSlopes {
+        let mut total = match (inside, clipped) {
+            (true, true) => ForceSlopes::ZERO,
+            (true, false) => self.law.inside(gap_nm, gap_rate),
+            (false, _) => self.law.outside(gap_nm),
+        };
+        if let Some(layer) = &self.double_layer {
+            total += if inside {
+                ForceSlopes {
+                    force: layer.force(self.contact_gap_nm()),
+                    ..ForceSlopes::ZERO
+                }
+            } else {
+                layer.force_slopes(gap_nm)
+            };
+        }
+        total
+    }
+
+    /// The force (nN) at gap `d` and rate `d'` with the region taken from the gap itself
+    /// (inside when `d < d_c`) and a clipped law clipped at zero: what a sampled state feels.
+    pub fn force(&self, gap_nm: f64, gap_rate: f64) -> f64 {
+        let inside = gap_nm < self.contact_gap_nm();
+        let clipped = inside
+            && self
+                .law
+                .release_time_us()
+                .is_some_and(|tau| -gap_nm - tau * gap_rate < 0.0);
+        self.in_region(inside, clipped, gap_nm, gap_rate).force
+    }
+}

@@ -1,0 +1,331 @@
+//! The sample file's optional `contact` and `electrostatic` objects (MODEL.md section 9,
+//! docs/output-schema.md): parsed, range-checked (errors name the file, the field and the
+//! allowed range) and turned into a [`TipSampleForce`].
+
+use serde::{Deserialize, Serialize};
+
+use super::{
+    ContactLaw, DmtContact, DoubleLayer, FilmContact, FilmCorrection, HertzShape, HertzTip,
+    KelvinVoigtContact, TipSampleForce,
+};
+use crate::validation::{check, invalid, Interval};
+use crate::AfmError;
+
+fn clip_by_default() -> bool {
+    true
+}
+
+/// The tip's shape for the Hertz law.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TipShapeSpec {
+    /// A sphere of the cantilever's tip radius (the default).
+    #[default]
+    Sphere,
+    /// A cone with `cone_half_angle_deg`.
+    Cone,
+    /// A flat punch with `punch_radius_nm`.
+    FlatPunch,
+}
+
+/// The film's bottom-effect correction ([`FilmCorrection`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FilmCorrectionSpec {
+    /// Garcia & Garcia 2018 (the default).
+    #[default]
+    #[serde(rename = "garcia-2018")]
+    Garcia2018,
+    /// Dimitriadis et al. 2002, bonded film.
+    #[serde(rename = "dimitriadis-2002-bonded")]
+    Dimitriadis2002Bonded,
+    /// Dimitriadis et al. 2002, non-bonded film.
+    #[serde(rename = "dimitriadis-2002-non-bonded")]
+    Dimitriadis2002NonBonded,
+}
+
+/// The `contact` object of a sample file; absent means `{"law": "hertz"}` with a sphere.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "law", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ContactSpec {
+    /// Hertz on a half-space; `tip_shape` `sphere` (default, the cantilever's tip radius),
+    /// `cone` (needs `cone_half_angle_deg`, range [1, 89] deg) or `flat-punch` (needs
+    /// `punch_radius_nm`, range (0, 1e4] nm).
+    Hertz {
+        /// The tip's shape.
+        #[serde(default)]
+        tip_shape: TipShapeSpec,
+        /// The cone's half-angle, degrees.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        cone_half_angle_deg: Option<f64>,
+        /// The punch's radius, nm.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        punch_radius_nm: Option<f64>,
+    },
+    /// DMT: Hamaker constant `H` in J, range [0, 1e-18]; intermolecular distance `a0` in nm,
+    /// range [0.05, 2].
+    Dmt {
+        /// `H`, J.
+        hamaker_constant_j: f64,
+        /// `a0`, nm.
+        intermolecular_distance_nm: f64,
+    },
+    /// Kelvin-Voigt: sample viscosity `eta` in Pa s, range [0, 1e6]; `clip` (default true).
+    KelvinVoigt {
+        /// `eta`, Pa s.
+        viscosity_pa_s: f64,
+        /// Whether the force is clipped at zero.
+        #[serde(default = "clip_by_default")]
+        clip: bool,
+    },
+    /// A film on a rigid substrate: thickness in nm, range (0, 1e5]; the correction.
+    Film {
+        /// `h`, nm.
+        thickness_nm: f64,
+        /// The bottom-effect correction.
+        #[serde(default)]
+        correction: FilmCorrectionSpec,
+    },
+}
+
+/// The `electrostatic` object of a sample file: a double layer added to the contact law.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElectrostaticSpec {
+    /// The Debye length `lambda_D`, nm; range (0, 1000].
+    pub debye_length_nm: f64,
+    /// The tip's surface charge `sigma_t`, C/m^2; range [-1, 1].
+    pub tip_charge_c_per_m2: f64,
+    /// The sample's surface charge `sigma_s`, C/m^2; range [-1, 1].
+    pub sample_charge_c_per_m2: f64,
+    /// The medium's relative permittivity `eps_r`; range [1, 200].
+    pub relative_permittivity: f64,
+}
+
+impl ContactSpec {
+    /// Check every parameter's range; errors name `file` and the field (`contact.<field>`).
+    pub fn validate(&self, file: &str) -> Result<(), AfmError> {
+        match self {
+            Self::Hertz {
+                tip_shape,
+                cone_half_angle_deg,
+                punch_radius_nm,
+            } => check_tip_shape(file, *tip_shape, *cone_half_angle_deg, *punch_radius_nm),
+            Self::Dmt {
+                hamaker_constant_j,
+                intermolecular_distance_nm,
+            } => {
+                check(
+                    file,
+                    "contact.hamaker_constant_j",
+                    *hamaker_constant_j,
+                    Interval::closed(0.0, 1e-18, "J"),
+                )?;
+                check(
+                    file,
+                    "contact.intermolecular_distance_nm",
+                    *intermolecular_distance_nm,
+                    Interval::closed(0.05, 2.0, "nm"),
+                )
+            }
+            Self::KelvinVoigt { viscosity_pa_s, .. } => check(
+                file,
+                "contact.viscosity_pa_s",
+                *viscosity_pa_s,
+                Interval::closed(0.0, 1e6, "Pa s"),
+            ),
+            Self::Film { thickness_nm, .. } => check(
+                file,
+                "contact.thickness_nm",
+                *thickness_nm,
+                Interval::positive(1e5, "nm"),
+            ),
+        }
+    }
+
+    /// The law for reduced modulus `E*` (GPa), tip radius `R` (nm) and sample Poisson ratio
+    /// `nu_s` (for `eta* = eta / (1 - nu_s^2)`). Call after [`ContactSpec::validate`].
+    pub fn law(&self, effective_modulus_gpa: f64, tip_radius_nm: f64, poisson: f64) -> ContactLaw {
+        let e = effective_modulus_gpa;
+        match *self {
+            Self::Hertz {
+                tip_shape,
+                cone_half_angle_deg,
+                punch_radius_nm,
+            } => {
+                let tip = match tip_shape {
+                    TipShapeSpec::Sphere => HertzTip::Sphere {
+                        radius_nm: tip_radius_nm,
+                    },
+                    TipShapeSpec::Cone => HertzTip::Cone {
+                        half_angle_deg: cone_half_angle_deg.unwrap_or(f64::NAN),
+                    },
+                    TipShapeSpec::FlatPunch => HertzTip::FlatPunch {
+                        radius_nm: punch_radius_nm.unwrap_or(f64::NAN),
+                    },
+                };
+                ContactLaw::Hertz(HertzShape {
+                    effective_modulus_gpa: e,
+                    tip,
+                })
+            }
+            Self::Dmt {
+                hamaker_constant_j,
+                intermolecular_distance_nm,
+            } => ContactLaw::Dmt(DmtContact {
+                effective_modulus_gpa: e,
+                tip_radius_nm,
+                hamaker_constant_j,
+                intermolecular_distance_nm,
+            }),
+            Self::KelvinVoigt {
+                viscosity_pa_s,
+                clip,
+            } => ContactLaw::KelvinVoigt(KelvinVoigtContact {
+                effective_modulus_gpa: e,
+                tip_radius_nm,
+                effective_viscosity_pa_s: viscosity_pa_s / (1.0 - poisson * poisson),
+                clip,
+            }),
+            Self::Film {
+                thickness_nm,
+                correction,
+            } => ContactLaw::Film(FilmContact {
+                effective_modulus_gpa: e,
+                tip_radius_nm,
+                thickness_nm,
+                correction: match correction {
+                    FilmCorrectionSpec::Garcia2018 => FilmCorrection::Garcia2018,
+                    FilmCorrectionSpec::Dimitriadis2002Bonded => {
+                        FilmCorrection::Dimitriadis2002Bonded
+                    }
+                    FilmCorrectionSpec::Dimitriadis2002NonBonded => {
+                        FilmCorrection::Dimitriadis2002NonBonded
+                    }
+                },
+            }),
+        }
+    }
+}
+
+fn check_tip_shape(
+    file: &str,
+    shape: TipShapeSpec,
+    half_angle: Option<f64>,
+    punch_radius: Option<f64>,
+) -> Result<(), AfmError> {
+    let (needed, given, unused, interval) = match shape {
+        TipShapeSpec::Sphere => {
+            for (field, value) in [
+                ("contact.cone_half_angle_deg", half_angle),
+                ("contact.punch_radius_nm", punch_radius),
+            ] {
+                if let Some(value) = value {
+                    return Err(invalid(
+                        file,
+                        field,
+                        value,
+                        "absent for tip_shape `sphere` (the cantilever's tip radius is used)"
+                            .to_string(),
+                    ));
+                }
+            }
+            return Ok(());
+        }
+        TipShapeSpec::Cone => (
+            "contact.cone_half_angle_deg",
+            half_angle,
+            ("contact.punch_radius_nm", punch_radius),
+            Interval::closed(1.0, 89.0, "deg"),
+        ),
+        TipShapeSpec::FlatPunch => (
+            "contact.punch_radius_nm",
+            punch_radius,
+            ("contact.cone_half_angle_deg", half_angle),
+            Interval::positive(1e4, "nm"),
+        ),
+    };
+    if let (field, Some(value)) = unused {
+        return Err(invalid(
+            file,
+            field,
+            value,
+            "absent for this tip_shape".to_string(),
+        ));
+    }
+    match given {
+        Some(value) => check(file, needed, value, interval),
+        None => Err(invalid(
+            file,
+            needed,
+            f64::NAN,
+            "a number, required for this tip_shape".to_string(),
+        )),
+    }
+}
+
+impl ElectrostaticSpec {
+    /// Check every parameter's range; errors name `file` and `electrostatic.<field>`.
+    pub fn validate(&self, file: &str) -> Result<(), AfmError> {
+        check(
+            file,
+            "electrostatic.debye_length_nm",
+            self.debye_length_nm,
+            Interval::positive(1000.0, "nm"),
+        )?;
+        check(
+            file,
+            "electrostatic.tip_charge_c_per_m2",
+            self.tip_charge_c_per_m2,
+            Interval::closed(-1.0, 1.0, "C/m^2"),
+        )?;
+        check(
+            file,
+            "electrostatic.sample_charge_c_per_m2",
+            self.sample_charge_c_per_m2,
+            Interval::closed(-1.0, 1.0, "C/m^2"),
+        )?;
+        check(
+            file,
+            "electrostatic.relative_permittivity",
+            self.relative_permittivity,
+            Interval::closed(1.0, 200.0, ""),
+        )
+    }
+
+    /// The double layer for a tip of radius `R` (nm).
+    pub fn double_layer(&self, tip_radius_nm: f64) -> DoubleLayer {
+        DoubleLayer::new(
+            tip_radius_nm,
+            self.tip_charge_c_per_m2,
+            self.sample_charge_c_per_m2,
+            self.relative_permittivity,
+            self.debye_length_nm,
+        )
+    }
+}
+
+/// The tip-sample force of a sample's `contact` (`None`: Hertz with a sphere) and
+/// `electrostatic` objects, for reduced modulus `E*` (GPa), tip radius `R` (nm) and sample
+/// Poisson ratio `nu_s`.
+pub fn tip_sample_force(
+    contact: Option<&ContactSpec>,
+    electrostatic: Option<&ElectrostaticSpec>,
+    effective_modulus_gpa: f64,
+    tip_radius_nm: f64,
+    poisson: f64,
+) -> TipSampleForce {
+    let law = match contact {
+        Some(spec) => spec.law(effective_modulus_gpa, tip_radius_nm, poisson),
+        None => ContactLaw::Hertz(HertzShape {
+            effective_modulus_gpa,
+            tip: HertzTip::Sphere {
+                radius_nm: tip_radius_nm,
+            },
+        }),
+    };
+    TipSampleForce {
+        law,
+        double_layer: electrostatic.map(|spec| spec.double_layer(tip_radius_nm)),
+    }
+}
