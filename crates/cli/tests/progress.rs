@@ -22,8 +22,9 @@ fn a_long_sweep_shows_a_bar_on_a_terminal_and_nothing_piped_or_quiet() {
     let directory = tempfile::tempdir().expect("temporary directory");
     let out = directory.path().join("sweep.csv");
     let out = out.to_str().expect("utf-8");
-    // 10.2 nm to 0 at 1 nm/s: about 95 000 drive cycles, several seconds.
-    let long = format!("approach --case biolever-mica --from 10.2 --to 0 --rate 1 --out {out}");
+    // 10.2 nm to 0 at 0.5 nm/s: about 190 000 drive cycles, about 4 s on an idle core (twice
+    // the 2 s after which a bar appears).
+    let long = format!("approach --case biolever-mica --from 10.2 --to 0 --rate 0.5 --out {out}");
     let screen = on_terminal(&long);
     assert!(
         screen.contains("cycles,") && screen.contains("left"),
