@@ -84,6 +84,11 @@ impl ModelArgs {
             (Some(name), None, None) => {
                 let case = fixtures::find_case(name)?;
                 warn_all(case.warnings(name));
+                if self.drive_frequency.is_none() {
+                    // The case's own drive against its cantilever's range, blamed on the case
+                    // (an override is checked below, on the command line's account).
+                    case.validate(name).context("invalid model parameters")?;
+                }
                 case
             }
             (None, Some(cantilever), Some(sample)) => {
