@@ -360,3 +360,77 @@ fn a_long_approach_sweep_draws_in_under_500_kb() {
         "the retract has its own (finer) dots"
     );
 }
+
+/// The regime map (Biolever on mica over A0 = 5..20 nm: G1, G2, G3 in both planes): every
+/// region name is written once per plane, and none covers a curve, another name, a label or
+/// the legend; the same figure is written as PNG and PDF by the extension.
+#[test]
+fn the_regime_map_names_its_regions_clear_of_curves_labels_and_legend() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let path = directory.path().join("map.svg");
+    let map = [
+        "map",
+        "--case",
+        "biolever-mica",
+        "--vary",
+        "a0",
+        "--from",
+        "5",
+        "--to",
+        "20",
+    ];
+    run(&[&map[..], &["--plot", path.to_str().expect("utf-8")]].concat());
+    let svg = std::fs::read_to_string(&path).expect("svg");
+    let tree = raster::parse(&svg).expect("the SVG parses");
+    for panel in 0..2 {
+        assert_labels_and_legend_clear(&svg, panel);
+        let names: Vec<(String, Box2)> = elements(&svg, "text", &format!("p{panel}-region-"))
+            .into_iter()
+            .map(|(id, _, text)| (text.to_string(), text_box(&tree, id)))
+            .collect();
+        let texts: Vec<&str> = names.iter().map(|(t, _)| t.as_str()).collect();
+        assert_eq!(
+            texts,
+            ["no impact", "1 impact", "2 impacts", "3 impacts"],
+            "panel {panel}"
+        );
+        let segments = curve_segments(&svg, panel);
+        let others = labels(&svg, &tree, panel);
+        for (i, (text, a)) in names.iter().enumerate() {
+            for (p, q) in &segments {
+                assert!(
+                    !segment_meets(*a, *p, *q),
+                    "panel {panel}: `{text}` {a:?} covers the curve at {p:?}-{q:?}"
+                );
+            }
+            for (other, b) in names[i + 1..].iter().chain(&others) {
+                assert!(
+                    !overlap(*a, *b),
+                    "panel {panel}: `{text}` overlaps `{other}`"
+                );
+            }
+            if let Some((_, element, _)) =
+                elements(&svg, "rect", &format!("p{panel}-legend")).first()
+            {
+                let number = |name| -> f64 {
+                    attribute(element, name)
+                        .expect(name)
+                        .parse()
+                        .expect("number")
+                };
+                let (x, y) = (number("x"), number("y"));
+                let legend = (x, y, x + number("width"), y + number("height"));
+                assert!(
+                    !overlap(*a, legend),
+                    "panel {panel}: `{text}` under the legend"
+                );
+            }
+        }
+    }
+    for (name, magic) in [("map.png", &b"\x89PNG"[..]), ("map.pdf", &b"%PDF-"[..])] {
+        let file = directory.path().join(name);
+        run(&[&map[..], &["--plot", file.to_str().expect("utf-8")]].concat());
+        let bytes = std::fs::read(&file).expect(name);
+        assert!(bytes.starts_with(magic) && bytes.len() > 1000, "{name}");
+    }
+}
