@@ -124,6 +124,24 @@ pub fn parse_case_file(file: &str, text: &str) -> Result<CaseFile, AfmError> {
     Ok(case)
 }
 
+/// A built-in fixture file as shipped: its kind (`case`, `cantilever` or `sample`), its path
+/// in the repository (`fixtures/cases/biolever-mica.json`, ...) and its JSON text, for a user
+/// to copy and edit. Cases are searched first, then cantilevers, then samples.
+pub fn builtin_file(name: &str) -> Option<(&'static str, &'static str, &'static str)> {
+    [
+        ("case", CASES),
+        ("cantilever", CANTILEVERS),
+        ("sample", SAMPLES),
+    ]
+    .into_iter()
+    .find_map(|(kind, table)| {
+        table
+            .iter()
+            .find(|entry| entry.name == name)
+            .map(|entry| (kind, entry.path, entry.text))
+    })
+}
+
 /// The built-in cantilever `name`.
 pub fn builtin_cantilever(name: &str) -> Result<Cantilever, AfmError> {
     let entry = find(CANTILEVERS, "cantilever", name)?;

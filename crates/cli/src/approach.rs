@@ -7,7 +7,6 @@ use afm::validation::Interval;
 use afm::{Sweep, SweepDirection, SweepRecord, SweepSettings, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -15,17 +14,15 @@ use std::path::{Path, PathBuf};
 
 use crate::exit_status::Incomplete;
 use crate::inputs::inputs_json;
-use crate::model_args::{output_path, ModelArgs};
+use crate::model_args::ModelArgs;
 use crate::option_ranges::{self, OptionRange};
-use crate::output::{check_writable, write_atomically};
-use crate::plot::{render_svg, Panel, Series, Stroke, PHASE_PERIOD_DEG};
+use crate::output::check_writable;
+use crate::plot::{render_svg, FigureFile, Panel, Series, Stroke, PHASE_PERIOD_DEG};
+use crate::progress::{note, Progress};
 
 /// The CSV header: the JSON Lines records' keys, in their order (docs/output-schema.md).
 pub const CSV_HEADER: &str =
     "cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,direction";
-
-/// The most points drawn per series in `--plot` (records are thinned evenly beyond this).
-const MAX_PLOT_POINTS: usize = 20_000;
 
 /// Progress bar updates: at most one per this many cycles (indicatif also limits redraws).
 const PROGRESS_STRIDE: u64 = 256;
@@ -109,9 +106,10 @@ pub struct ApproachArgs {
     /// record computed so far, and never half a record.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// Draw phase vs A/A0 and A/A0 vs Z (approach and retract in two colours) into this SVG
-    /// file when the sweep ends (written atomically).
-    #[arg(long, value_name = "FILE.svg")]
+    /// Draw phase vs A/A0 and A/A0 vs Z (approach and retract in two colours) into this file
+    /// when the sweep ends (written atomically; .svg, .png or .pdf by the extension; thinned to
+    /// one point per pixel, so the file stays small however long the sweep).
+    #[arg(long, value_name = "FILE.svg|png|pdf")]
     pub plot: Option<PathBuf>,
 }
 
@@ -220,7 +218,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
     let plot_path = args
         .plot
         .as_ref()
-        .map(|p| output_path(p, "svg", "--plot"))
+        .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
     if let Some(path) = &args.out {
         check_writable(path, "--out")?;
@@ -254,7 +252,10 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
     if !sink.write_line(&first_line)? {
         return Ok(());
     }
-    let progress = progress_bar(sweep.total_cycles());
+    let mut progress = Progress::new(
+        sweep.total_cycles(),
+        "Z = {msg} nm {wide_bar} {human_pos}/{human_len} cycles, {eta} left",
+    );
     let mut kept: Vec<SweepRecord> = Vec::new();
     let mut line = String::with_capacity(160);
     let mut shown = 0;
@@ -276,7 +277,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         };
         format_record(&record, args.jsonl, &mut line)?;
         if !sink.write_line(&line)? {
-            progress.finish_and_clear();
+            progress.finish();
             return Ok(());
         }
         if plot_path.is_some() {
@@ -284,49 +285,38 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         }
         if sweep.cycles_done() >= shown + PROGRESS_STRIDE {
             shown = sweep.cycles_done();
-            progress.set_position(shown);
-            progress.set_message(format!("{:8.4}", sweep.z_nm()));
+            progress.update(shown, || format!("{:8.4}", sweep.z_nm()));
         }
     }
-    progress.finish_and_clear();
+    progress.finish();
     if let Some(path) = plot_path {
         let panels = sweep_panels(&case.name, &kept);
-        let svg = render_svg(&panels, 1, 2, (640, 480))?;
-        write_atomically(&path, svg.as_bytes())?;
-        eprintln!("figure: {}", path.display());
+        path.write(&render_svg(&panels, 1, 2, (640, 480))?)?;
+        note(&format!("figure: {}", path.path.display()));
     }
     if let Some(path) = &args.out {
-        eprintln!("records: {}", Path::new(path).display());
+        note(&format!("records: {}", Path::new(path).display()));
     }
     Ok(())
 }
 
-/// A progress bar on standard error showing Z, cycles done and the time left; indicatif draws
-/// nothing when standard error is not a terminal.
-fn progress_bar(total_cycles: u64) -> ProgressBar {
-    let bar = ProgressBar::new(total_cycles);
-    if let Ok(style) = ProgressStyle::with_template(
-        "Z = {msg} nm {wide_bar} {human_pos}/{human_len} cycles, {eta} left",
-    ) {
-        bar.set_style(style);
-    }
-    bar
-}
-
 /// The two panels of `--plot`: phase vs A/A0, and A/A0 vs Z; approach and retract as dots of
-/// two colours.
+/// two colours, the retract's smaller and on top so that both show where they coincide.
 pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
     let series =
         |direction: SweepDirection, colour: usize, point: fn(&SweepRecord) -> (f64, f64)| {
+            let stroke = match direction {
+                SweepDirection::Approach => Stroke::Dots,
+                SweepDirection::Retract => Stroke::FineDots,
+            };
             let selected: Vec<&SweepRecord> = records
                 .iter()
                 .filter(|r| r.direction == direction)
                 .collect();
-            let stride = selected.len().div_ceil(MAX_PLOT_POINTS).max(1);
             Series {
                 label: direction.name().to_string(),
-                points: selected.iter().step_by(stride).map(|r| point(r)).collect(),
-                stroke: Stroke::Dots,
+                points: selected.iter().map(|r| point(r)).collect(),
+                stroke,
                 colour,
             }
         };
@@ -341,22 +331,24 @@ pub fn sweep_panels(case: &str, records: &[SweepRecord]) -> Vec<Panel> {
     vec![
         Panel {
             title: format!("{case}: phase vs amplitude ratio"),
-            x_label: String::from("A/A0"),
+            x_label: String::from("amplitude ratio A/A0"),
             y_label: String::from("phase (deg)"),
             series: both(|r| (r.amplitude_ratio, r.phase_deg)),
             markers: Vec::new(),
             y_period: Some(PHASE_PERIOD_DEG),
+            y_integer_ticks: false,
             regions: Vec::new(),
             shaded: Vec::new(),
             cells: Vec::new(),
         },
         Panel {
             title: format!("{case}: amplitude ratio vs separation"),
-            x_label: String::from("Z (nm)"),
-            y_label: String::from("A/A0"),
+            x_label: String::from("separation Z (nm)"),
+            y_label: String::from("amplitude ratio A/A0"),
             series: both(|r| (r.z_nm, r.amplitude_ratio)),
             markers: Vec::new(),
             y_period: None,
+            y_integer_ticks: false,
             regions: Vec::new(),
             shaded: Vec::new(),
             cells: Vec::new(),

@@ -4,8 +4,7 @@
 
 use afm::validation::Interval;
 use afm::{
-    approach_diagram_until, diagram_until, BifurcationDiagram, Case, DiagramPoint, DiagramSettings,
-    TappingModel,
+    approach_diagram_until, diagram_until, BifurcationDiagram, Case, DiagramSettings, TappingModel,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -13,12 +12,14 @@ use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use crate::continue_figure::{figure, CaseDiagrams};
 use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
-use crate::model_args::{output_path, ModelArgs};
+use crate::model_args::{model_of, output_path, ModelArgs};
 use crate::option_ranges::{self, OptionRange};
 use crate::output::{print_stdout, write_atomically};
-use crate::plot::{render_svg, Marker, Panel, Series, Stroke, PHASE_PERIOD_DEG};
+use crate::plot::FigureFile;
+use crate::progress::Progress;
 
 /// Options of `drumroll continue`.
 #[derive(Debug, Clone, Args)]
@@ -53,15 +54,39 @@ pub struct ContinueArgs {
     /// Write the branch points to this CSV file.
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
-    /// Draw phase vs A/A0 (the paper's Fig. 2) with the special points marked, stable parts
-    /// solid and unstable dashed, beside A/A0 vs Z and impacts per period vs Z.
-    #[arg(long, value_name = "FILE.svg")]
+    /// Draw phase vs A/A0 (the paper's Fig. 2) with the special points labelled, stable parts
+    /// solid and unstable dashed, beside A/A0 vs Z and impacts per period vs Z; with several
+    /// --case, one phase panel per case, (a), (b), ... The format follows the extension:
+    /// .svg, .png or .pdf.
+    #[arg(long, value_name = "FILE.svg|png|pdf")]
     pub plot: Option<PathBuf>,
+    /// With several --case and --plot: draw every case on one set of axes (the three panels,
+    /// a legend naming the cases) instead of one panel per case.
+    #[arg(long, requires = "plot")]
+    pub overlay: bool,
 }
 
-/// Run `drumroll continue`.
+/// One case's approach, its optional retract and their bistable ranges.
+#[derive(Debug, Clone)]
+pub struct Continued {
+    /// The approach's settings (the retract's are [`DiagramSettings::retract`] with the same
+    /// `max_step` and `max_points`).
+    pub settings: DiagramSettings,
+    /// The approach diagram (`Z` decreasing from above first contact).
+    pub approach: BifurcationDiagram,
+    /// The retract diagram (`Z` increasing from the approach's lowest point), if asked.
+    pub retract: Option<BifurcationDiagram>,
+    /// With a retract: the merged `[Z_low, Z_high]` ranges (nm) where two stable orbits
+    /// coexist.
+    pub bistable: Option<Vec<[f64; 2]>>,
+    /// The warning of [`afm::film_range_warning`] on the branches' orbits, if any.
+    pub warning: Option<String>,
+}
+
+/// Run `drumroll continue`: each `--case` in turn (tables or JSON lines printed as they are
+/// computed), then the CSV (one case) and the figure.
 pub fn run(args: &ContinueArgs) -> Result<()> {
-    // The options that need no model, checked before the output paths and the model.
+    // The options that need no model, checked before the output paths and the models.
     option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
     option_ranges::MAX_POINTS.count(args.max_points)?;
     let csv_path = args
@@ -69,73 +94,82 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .as_ref()
         .map(|p| output_path(p, "csv", "--csv"))
         .transpose()?;
-    let plot_path = args
+    let plot = args
         .plot
         .as_ref()
-        .map(|p| output_path(p, "svg", "--plot"))
+        .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
-    let (case, model) = args.model.model()?;
-    let settings = diagram_settings(args, &model)?;
-    let run = compute_diagrams(&case, &model, &settings, args.retract, &mut || false)?;
-    if let Some(warning) = film_warning(&model, &run) {
-        eprintln!("warning: {warning}");
+    let cases = args.model.cases()?;
+    if cases.len() > 1 && csv_path.is_some() {
+        bail!(
+            "--csv takes one case ({} given): run once per case",
+            cases.len()
+        );
     }
-    let DiagramRun {
-        approach,
-        retract,
-        bistable,
-    } = &run;
-    if args.json {
-        let object = continue_json(&case, &model, &settings, &run);
-        print_stdout(&format!("{}\n", serde_json::to_string(&object)?))?;
-    } else {
-        print_stdout(&table(&case.name, &model, "approach", approach))?;
-        if let Some(retract) = &retract {
-            print_stdout(&table(&case.name, &model, "retract", retract))?;
-            match bistable.as_deref() {
-                Some([]) | None => print_stdout(
-                    "no bistable range: approach and retract follow one stable orbit\n",
-                )?,
-                Some(ranges) => {
-                    for [low, high] in ranges {
-                        print_stdout(&format!(
-                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)\n"
-                        ))?;
-                    }
-                }
+    let several = cases.len() > 1;
+    let mut drawn = Vec::new();
+    let mut unfinished = Vec::new();
+    let mut progress = Progress::new(
+        cases.len() as u64,
+        "{wide_bar} {pos}/{len} cases, now {msg}, {eta} left",
+    );
+    for (done, case) in cases.into_iter().enumerate() {
+        progress.update(done as u64, || case.name.clone());
+        let (case, model) = model_of(case)?;
+        let continued = continue_case(args, &case, &model)?;
+        print_report(args, &case, &model, &continued)?;
+        if let Some(path) = &csv_path {
+            let mut text = csv_text(&continued.approach, "approach")?;
+            if let Some(retract) = &continued.retract {
+                text.push_str(
+                    csv_text(retract, "retract")?
+                        .split_once('\n')
+                        .map_or("", |(_, rows)| rows),
+                );
             }
+            write_atomically(path, text.as_bytes())?;
         }
-    }
-    if let Some(path) = csv_path {
-        let mut text = csv_text(approach, "approach")?;
-        if let Some(retract) = &retract {
-            text.push_str(
-                csv_text(retract, "retract")?
-                    .split_once('\n')
-                    .map_or("", |(_, rows)| rows),
-            );
+        if let Some(why) = unfinished_branches(&continued.approach, continued.retract.as_ref()) {
+            unfinished.push(if several {
+                format!("case `{}`: {why}", case.name)
+            } else {
+                why
+            });
         }
-        write_atomically(&path, text.as_bytes())?;
+        drawn.push(CaseDiagrams {
+            case,
+            model,
+            approach: continued.approach,
+            retract: continued.retract,
+        });
     }
-    if let Some(path) = plot_path {
-        let svg = render_svg(
-            &panels(&model, approach, retract.as_ref()),
-            1,
-            3,
-            (520, 440),
-        )?;
-        write_atomically(&path, svg.as_bytes())?;
+    progress.finish();
+    if let Some(plot) = plot {
+        plot.write(&figure(&drawn, args.overlay)?)?;
     }
-    reached_end(approach, retract.as_ref(), settings.max_points)
+    if unfinished.is_empty() {
+        return Ok(());
+    }
+    let hint = if unfinished
+        .iter()
+        .any(|u| u.contains("maximum number of points"))
+    {
+        format!(
+            "; raise --max-points (now {}) or --max-step",
+            args.max_points
+        )
+    } else {
+        String::new()
+    };
+    Err(Incomplete(format!("{}{hint}", unfinished.join("; "))).into())
 }
 
-/// `Ok` when every branch reached its requested end, else the [`Incomplete`] error that says
-/// which did not and why (`main` exits with status 3).
-fn reached_end(
+/// `None` when every branch reached its requested end, else which did not and why (the run
+/// then ends with an [`Incomplete`] error: `main` exits with status 3).
+fn unfinished_branches(
     approach: &BifurcationDiagram,
     retract: Option<&BifurcationDiagram>,
-    max_points: usize,
-) -> Result<()> {
+) -> Option<String> {
     let unfinished: Vec<String> = std::iter::once(("approach", approach))
         .chain(retract.map(|retract| ("retract", retract)))
         .filter(|(_, diagram)| !diagram.completed)
@@ -147,18 +181,7 @@ fn reached_end(
             format!("the {direction} ended because {}{error}", diagram.stop)
         })
         .collect();
-    if !unfinished.is_empty() {
-        let hint = if unfinished
-            .iter()
-            .any(|u| u.contains("maximum number of points"))
-        {
-            format!("; raise --max-points (now {}) or --max-step", max_points)
-        } else {
-            String::new()
-        };
-        return Err(Incomplete(format!("{}{hint}", unfinished.join("; "))).into());
-    }
-    Ok(())
+    (!unfinished.is_empty()).then(|| unfinished.join("; "))
 }
 
 /// The approach's settings for `model` from `continue`'s options, every option checked
@@ -199,31 +222,28 @@ pub fn approach_settings(
     Ok(settings)
 }
 
-/// The diagrams of one `continue` run: the approach, the retract when asked, and then the
-/// bistable ranges (nm) of the two together.
-#[derive(Debug, Clone)]
-pub struct DiagramRun {
-    /// The approach diagram (`Z` decreasing from above first contact).
-    pub approach: BifurcationDiagram,
-    /// The retract diagram (`Z` increasing from the approach's lowest point), if asked.
-    pub retract: Option<BifurcationDiagram>,
-    /// With a retract: the merged `[Z_low, Z_high]` ranges where two stable orbits coexist.
-    pub bistable: Option<Vec<[f64; 2]>>,
+/// The approach (and retract) of one case; the film-range warning, if any, printed on
+/// stderr.
+fn continue_case(args: &ContinueArgs, case: &Case, model: &TappingModel) -> Result<Continued> {
+    let continued = continue_case_until(args, case, model, &mut || false)?;
+    if let Some(warning) = &continued.warning {
+        eprintln!("warning: {warning}");
+    }
+    Ok(continued)
 }
 
-/// The approach diagram of `model` with `settings`, and with `retract` the retract from its
-/// lowest point; `interrupted` is asked after every branch point whether to give up
-/// ([`afm::diagram_until`]).
-pub fn compute_diagrams(
+/// The approach (and retract) of one case with `continue`'s options `args`; `interrupted` is
+/// asked after every branch point whether to give up ([`afm::diagram_until`]).
+pub fn continue_case_until(
+    args: &ContinueArgs,
     case: &Case,
     model: &TappingModel,
-    settings: &DiagramSettings,
-    retract: bool,
     interrupted: &mut dyn FnMut() -> bool,
-) -> Result<DiagramRun> {
-    let approach = approach_diagram_until(model, settings, interrupted)
+) -> Result<Continued> {
+    let settings = diagram_settings(args, model)?;
+    let approach = approach_diagram_until(model, &settings, interrupted)
         .with_context(|| format!("continuation of case `{}` failed", case.name))?;
-    let retract = if retract {
+    let retract = if args.retract {
         let Some(lowest) = approach
             .points
             .iter()
@@ -249,45 +269,47 @@ pub fn compute_diagrams(
     } else {
         None
     };
+    let orbits = approach
+        .points
+        .iter()
+        .chain(retract.iter().flat_map(|r| r.points.iter()))
+        .map(|point| (point.z_nm, point.min_gap_nm));
+    let warning = afm::film_range_warning(model, orbits);
     let bistable = retract.as_ref().map(|retract| {
         let mut ranges = approach.bistable_ranges();
         ranges.extend(retract.bistable_ranges());
         merge_ranges(ranges)
     });
-    Ok(DiagramRun {
+    Ok(Continued {
+        settings,
         approach,
         retract,
         bistable,
+        warning,
     })
 }
 
-/// The warning of [`afm::film_range_warning`] for the orbits of `run` (approach and retract):
-/// where a film law's correction is used beyond its range, if it is.
-pub fn film_warning(model: &TappingModel, run: &DiagramRun) -> Option<String> {
-    let orbits = run
-        .approach
-        .points
-        .iter()
-        .chain(run.retract.iter().flat_map(|r| r.points.iter()))
-        .map(|point| (point.z_nm, point.min_gap_nm));
-    afm::film_range_warning(model, orbits)
-}
-
-/// The `continue --json` object of `run`, computed with `settings` (docs/output-schema.md).
+/// The `continue --json` object of one case (docs/output-schema.md).
 pub fn continue_json(
+    args: &ContinueArgs,
     case: &Case,
     model: &TappingModel,
-    settings: &DiagramSettings,
-    run: &DiagramRun,
+    continued: &Continued,
 ) -> serde_json::Value {
+    let Continued {
+        settings,
+        approach,
+        retract,
+        bistable,
+        ..
+    } = continued;
     let options = json!({
         "floor_nm": settings.z_limit_nm,
         "min_amplitude_ratio": settings.min_amplitude_ratio,
         "max_step_nm": settings.max_step,
         "max_points": settings.max_points,
-        "retract": run.retract.is_some(),
+        "retract": args.retract,
     });
-    let approach = &run.approach;
     let mut object = json!({
         "inputs": orbit_inputs_json("continue", options, case, model, &settings.orbit),
         "case": case.name,
@@ -299,7 +321,7 @@ pub fn continue_json(
         "completed": approach.completed,
         "error": approach.error,
     });
-    if let Some(retract) = &run.retract {
+    if let Some(retract) = &retract {
         object["retract"] = json!({
             "points": retract.points,
             "special_points": retract.special_points,
@@ -307,9 +329,46 @@ pub fn continue_json(
             "completed": retract.completed,
             "error": retract.error,
         });
-        object["bistable_ranges_nm"] = json!(run.bistable);
+        object["bistable_ranges_nm"] = json!(bistable);
     }
     object
+}
+
+/// Print one case's table (or JSON object, one line).
+fn print_report(
+    args: &ContinueArgs,
+    case: &Case,
+    model: &TappingModel,
+    continued: &Continued,
+) -> Result<()> {
+    let Continued {
+        approach,
+        retract,
+        bistable,
+        ..
+    } = continued;
+    if args.json {
+        let object = continue_json(args, case, model, continued);
+        print_stdout(&format!("{}\n", serde_json::to_string(&object)?))?;
+    } else {
+        print_stdout(&table(&case.name, model, "approach", approach))?;
+        if let Some(retract) = &retract {
+            print_stdout(&table(&case.name, model, "retract", retract))?;
+            match bistable.as_deref() {
+                Some([]) | None => print_stdout(
+                    "no bistable range: approach and retract follow one stable orbit\n",
+                )?,
+                Some(ranges) => {
+                    for [low, high] in ranges {
+                        print_stdout(&format!(
+                            "bistable range: Z in [{low:.9}, {high:.9}] nm (two stable orbits: approach and retract differ)\n"
+                        ))?;
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The readable table of special points of one diagram.
@@ -410,123 +469,4 @@ fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
         text.push('\n');
     }
     Ok(text)
-}
-
-/// Split a diagram's points into runs of equal stability, as polylines of `(x, y)`.
-fn runs(
-    points: &[DiagramPoint],
-    xy: impl Fn(&DiagramPoint) -> (f64, f64),
-) -> Vec<(bool, Vec<(f64, f64)>)> {
-    let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
-    for p in points {
-        match runs.last_mut() {
-            Some((stable, line)) if *stable == p.stable => line.push(xy(p)),
-            Some((_, line)) => {
-                // Join the runs so the curve stays continuous.
-                let last = *line.last().unwrap_or(&xy(p));
-                runs.push((p.stable, vec![last, xy(p)]));
-            }
-            None => runs.push((p.stable, vec![xy(p)])),
-        }
-    }
-    runs
-}
-
-fn branch_series(
-    diagram: &BifurcationDiagram,
-    label: &str,
-    colour: usize,
-    xy: impl Fn(&DiagramPoint) -> (f64, f64) + Copy,
-) -> Vec<Series> {
-    runs(&diagram.points, xy)
-        .into_iter()
-        .enumerate()
-        .map(|(i, (stable, points))| Series {
-            label: if i == 0 {
-                label.to_string()
-            } else {
-                String::new()
-            },
-            points,
-            stroke: if stable {
-                Stroke::Solid
-            } else {
-                Stroke::Dashed
-            },
-            colour,
-        })
-        .collect()
-}
-
-/// The three panels of the figure.
-fn panels(
-    model: &TappingModel,
-    approach: &BifurcationDiagram,
-    retract: Option<&BifurcationDiagram>,
-) -> Vec<Panel> {
-    let diagrams: Vec<(&BifurcationDiagram, &str, usize)> =
-        std::iter::once((approach, "approach", 0))
-            .chain(retract.map(|r| (r, "retract", 1)))
-            .collect();
-    let phase_markers = approach
-        .special_points
-        .iter()
-        .map(|p| Marker {
-            label: p.label.clone(),
-            at: (p.amplitude_ratio, p.phase_deg),
-        })
-        .collect();
-    let z_markers = approach
-        .special_points
-        .iter()
-        .map(|p| Marker {
-            label: p.label.clone(),
-            at: (p.z_nm, p.amplitude_ratio),
-        })
-        .collect();
-    let title = format!("A0 = {} nm (dashed: unstable)", model.free_amplitude_nm());
-    vec![
-        Panel {
-            title: format!("phase vs A/A0, {title}"),
-            x_label: String::from("A/A0"),
-            y_label: String::from("phase (deg)"),
-            series: diagrams
-                .iter()
-                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.amplitude_ratio, p.phase_deg)))
-                .collect(),
-            markers: phase_markers,
-            y_period: Some(PHASE_PERIOD_DEG),
-            regions: Vec::new(),
-            shaded: Vec::new(),
-            cells: Vec::new(),
-        },
-        Panel {
-            title: String::from("A/A0 vs Z"),
-            x_label: String::from("Z (nm)"),
-            y_label: String::from("A/A0"),
-            series: diagrams
-                .iter()
-                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.amplitude_ratio)))
-                .collect(),
-            markers: z_markers,
-            y_period: None,
-            regions: Vec::new(),
-            shaded: Vec::new(),
-            cells: Vec::new(),
-        },
-        Panel {
-            title: String::from("impacts per period vs Z"),
-            x_label: String::from("Z (nm)"),
-            y_label: String::from("impacts per period"),
-            series: diagrams
-                .iter()
-                .flat_map(|(d, l, c)| branch_series(d, l, *c, |p| (p.z_nm, p.impacts_per_period)))
-                .collect(),
-            markers: Vec::new(),
-            y_period: None,
-            regions: Vec::new(),
-            shaded: Vec::new(),
-            cells: Vec::new(),
-        },
-    ]
 }

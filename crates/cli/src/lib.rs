@@ -4,7 +4,9 @@
 
 pub mod approach;
 pub mod cantilever;
+pub mod cases;
 pub mod continue_diagram;
+pub mod continue_figure;
 pub mod digits;
 pub mod exit_status;
 pub mod grid;
@@ -17,6 +19,8 @@ pub mod model_args;
 pub mod option_ranges;
 pub mod output;
 pub mod plot;
+pub mod progress;
+pub mod shell;
 pub mod simulate;
 pub mod theory;
 pub mod trajectory_plot;

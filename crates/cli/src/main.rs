@@ -1,7 +1,7 @@
 //! `drumroll`: non-smooth dynamics of AFM cantilevers tapping a sample (Melcher, Xu, Raman,
 //! APL 93, 093111 (2008)). Thin: parses arguments and hands each subcommand to its module.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Non-smooth dynamics of AFM cantilevers tapping a sample: steady orbits, impacts, grazing
@@ -16,6 +16,10 @@ use std::process::ExitCode;
                   output computed so far is written, and stderr says why)."
 )]
 struct Cli {
+    /// No progress bars and no notes on standard error (bars are drawn only on a terminal,
+    /// and only for runs longer than about 2 s).
+    #[arg(long, short, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -44,10 +48,18 @@ enum Command {
     /// The Euler-Bernoulli modal table of a cantilever with a point tip mass, and a cantilever
     /// file built from measured k_1, frequencies and quality factors.
     Cantilever(drumroll::cantilever::CantileverArgs),
+    /// The built-in cases, cantilevers and samples with their key parameters; `cases show NAME`
+    /// prints one file to copy and edit.
+    Cases(drumroll::cases::CasesArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(drumroll::shell::CompletionsArgs),
+    /// Print the manual page (roff), or write one per subcommand with --out-dir.
+    Man(drumroll::shell::ManArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    drumroll::progress::set_quiet(cli.quiet);
     let result = match &cli.command {
         Command::Simulate(args) => drumroll::simulate::run(args),
         Command::Continue(args) => drumroll::continue_diagram::run(args),
@@ -56,6 +68,9 @@ fn main() -> ExitCode {
         Command::Theory(args) => drumroll::theory::run(args),
         Command::Grid(args) => drumroll::grid::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),
+        Command::Cases(args) => drumroll::cases::run(args),
+        Command::Completions(args) => drumroll::shell::completions(args, Cli::command()),
+        Command::Man(args) => drumroll::shell::man(args, Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

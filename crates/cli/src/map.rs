@@ -15,7 +15,7 @@ use crate::inputs::orbit_inputs_json;
 use crate::map_plot::map_panels;
 use crate::model_args::{output_path, ModelArgs};
 use crate::output::write_atomically;
-use crate::plot::render_svg;
+use crate::plot::{render_svg, FigureFile};
 
 /// Options of `drumroll map`.
 #[derive(Debug, Clone, Args)]
@@ -60,8 +60,9 @@ pub struct MapArgs {
     /// Write the curve points to this CSV file (one row per point).
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
-    /// Draw the map in the (PARAM, Z) and (PARAM, A/A0) planes.
-    #[arg(long, value_name = "FILE.svg")]
+    /// Draw the map in the (PARAM, Z) and (PARAM, A/A0) planes; the format follows the
+    /// extension (.svg, .png or .pdf).
+    #[arg(long, value_name = "FILE.svg|.png|.pdf")]
     pub plot: Option<PathBuf>,
     /// With --plot: draw this `drumroll grid` result (JSON Lines, the same PARAM) as cells
     /// under the curves, coloured by impacts per period (grey: bistable).
@@ -89,7 +90,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     let plot_path = args
         .plot
         .as_ref()
-        .map(|p| output_path(p, "svg", "--plot"))
+        .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
     let axis = ParameterAxis::parse(&args.vary, case.cantilever.modes.len())?;
     let grid = args
@@ -109,8 +110,12 @@ pub fn run(args: &MapArgs) -> Result<()> {
         write_atomically(&path, csv_text(&map.curves)?.as_bytes())?;
     }
     if let Some(path) = plot_path {
-        let svg = render_svg(&map_panels(axis, &map, grid.as_ref()), 1, 2, (620, 480))?;
-        write_atomically(&path, svg.as_bytes())?;
+        path.write(&render_svg(
+            &map_panels(axis, &map, grid.as_ref()),
+            1,
+            2,
+            (620, 480),
+        )?)?;
     }
     Ok(())
 }

@@ -7,7 +7,7 @@
 use afm::{MapCurve, MapPoint, ParameterAxis, RegimeMap};
 
 use crate::grid_overlay::{grid_cells, Grid, GridCell};
-use crate::plot::{Marker, Panel, Series, Stroke};
+use crate::plot::{Marker, Panel, Region, Series, Stroke};
 
 /// The vertical coordinate of a panel, read from a curve point.
 type Ordinate = fn(&MapPoint) -> f64;
@@ -64,6 +64,7 @@ pub fn map_panels(axis: ParameterAxis, map: &RegimeMap, grid: Option<&Grid>) -> 
                 })
                 .collect(),
             y_period: None,
+            y_integer_ticks: false,
             regions: region_labels(&map.curves, *y),
             shaded: bistable_polygons(&map.curves, *y),
             cells: grid.map_or_else(Vec::new, |g| grid_cells(g, *grid_y)),
@@ -104,8 +105,18 @@ fn curve_series(curve: &MapCurve, colour: usize, y: fn(&MapPoint) -> f64) -> Vec
         .collect()
 }
 
-/// The value of `y` on `curve` at the point nearest the parameter `x`.
+/// The value of `y` on `curve` at the point nearest the parameter `x`, when the curve
+/// reaches `x` (its parameter range holds it).
 fn value_near(curve: &MapCurve, x: f64, y: fn(&MapPoint) -> f64) -> Option<f64> {
+    let (low, high) = curve
+        .points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.parameter), h.max(p.parameter))
+        });
+    if !(low <= x && x <= high) {
+        return None;
+    }
     curve
         .points
         .iter()
@@ -113,60 +124,68 @@ fn value_near(curve: &MapCurve, x: f64, y: fn(&MapPoint) -> f64) -> Option<f64> 
         .map(y)
 }
 
+/// Where region names are tried along the parameter range, in fractions of it, preferred
+/// first.
+const REGION_FRACTIONS: [f64; 9] = [0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9, 0.03, 0.97];
+
 /// `1 impact`, `2 impacts`, ... between consecutive grazing curves `G_n`, `G_{n+1}` (below
-/// `G_n` on approach the orbit has `n` impacts per period), `no impact` above `G1`, at the
-/// middle of the parameter range.
-fn region_labels(curves: &[MapCurve], y: fn(&MapPoint) -> f64) -> Vec<Marker> {
+/// `G_n` on approach the orbit has `n` impacts per period), `no impact` above `G1`; each
+/// anchored midway between its two curves (or a little beyond the first and last curve) at
+/// several parameter values, the middle of the range first.
+fn region_labels(curves: &[MapCurve], y: fn(&MapPoint) -> f64) -> Vec<Region> {
     let mut grazing: Vec<(usize, &MapCurve)> = curves
         .iter()
         .filter_map(|c| Some((c.label.strip_prefix('G')?.parse().ok()?, c)))
         .collect();
     grazing.sort_by_key(|(n, _)| *n);
-    let all: Vec<f64> = curves
+    let (low, high) = curves
         .iter()
         .flat_map(|c| c.points.iter().map(|p| p.parameter))
-        .collect();
-    let (low, high) = all
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
             (l.min(x), h.max(x))
         });
     if grazing.is_empty() || !low.is_finite() {
         return Vec::new();
     }
-    let x = 0.5 * (low + high);
-    let values: Vec<(usize, f64)> = grazing
+    let xs: Vec<f64> = REGION_FRACTIONS
         .iter()
-        .filter_map(|(n, c)| Some((*n, value_near(c, x, y)?)))
+        .map(|f| low + f * (high - low))
         .collect();
-    let span = values.iter().map(|v| v.1).fold(f64::NEG_INFINITY, f64::max)
-        - values.iter().map(|v| v.1).fold(f64::INFINITY, f64::min);
+    let values: Vec<Vec<Option<f64>>> = grazing
+        .iter()
+        .map(|(_, c)| xs.iter().map(|&x| value_near(c, x, y)).collect())
+        .collect();
+    let all = values.iter().flatten().flatten();
+    let span = all.clone().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+        - all.fold(f64::INFINITY, |a, &b| a.min(b));
     let offset = 0.08 * span.max(1e-9);
     let name = |n: usize| match n {
         0 => String::from("no impact"),
         1 => String::from("1 impact"),
         _ => format!("{n} impacts"),
     };
-    let mut labels = Vec::new();
-    if let Some(&(n, top)) = values.first() {
-        labels.push(Marker {
-            label: name(n - 1),
-            at: (x, top + offset),
+    let anchors = |at: &dyn Fn(usize) -> Option<f64>| -> Vec<(f64, f64)> {
+        xs.iter()
+            .enumerate()
+            .filter_map(|(i, &x)| Some((x, at(i)?)))
+            .collect()
+    };
+    let count = grazing.len();
+    let mut regions = vec![Region {
+        label: name(grazing[0].0 - 1),
+        anchors: anchors(&|i| Some(values[0][i]? + offset)),
+    }];
+    for k in 0..count - 1 {
+        regions.push(Region {
+            label: name(grazing[k].0),
+            anchors: anchors(&|i| Some(0.5 * (values[k][i]? + values[k + 1][i]?))),
         });
     }
-    for pair in values.windows(2) {
-        labels.push(Marker {
-            label: name(pair[0].0),
-            at: (x, 0.5 * (pair[0].1 + pair[1].1)),
-        });
-    }
-    if let Some(&(n, bottom)) = values.last() {
-        labels.push(Marker {
-            label: name(n),
-            at: (x, bottom - offset),
-        });
-    }
-    labels
+    regions.push(Region {
+        label: name(grazing[count - 1].0),
+        anchors: anchors(&|i| Some(values[count - 1][i]? - offset)),
+    });
+    regions
 }
 
 /// The bistable area: inside the fold curves (between the first two fold curves, or inside a

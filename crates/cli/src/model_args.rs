@@ -12,9 +12,10 @@ use crate::option_ranges;
 #[derive(Debug, Clone, Args)]
 pub struct ModelArgs {
     /// A built-in case (`biolever-mica`, `biolever-soft`, `maclever-mica`, `maclever-soft`,
-    /// `maclever-mica-experiment`, ...) or the path of a case file (JSON).
-    #[arg(long, conflicts_with_all = ["cantilever", "sample"])]
-    pub case: Option<String>,
+    /// `maclever-mica-experiment`, ...) or the path of a case file (JSON); `drumroll cases`
+    /// lists them. `continue` takes several (`--case A --case B`, one panel each).
+    #[arg(long, conflicts_with_all = ["cantilever", "sample"], action = clap::ArgAction::Append)]
+    pub case: Vec<String>,
     /// A cantilever file (JSON) or built-in cantilever name, used with `--sample` and `--a0`
     /// instead of `--case`.
     #[arg(long, requires_all = ["sample", "a0"])]
@@ -37,19 +38,57 @@ pub struct ModelArgs {
 impl ModelArgs {
     /// The resolved case (`biolever-mica` when nothing is given), every option and file
     /// checked (errors name the option or the file and field, and the allowed range; valid but
-    /// implausible values are warned about on stderr).
+    /// implausible values are warned about on stderr); an error when `--case` is given more
+    /// than once.
     pub fn case(&self) -> Result<Case> {
+        if self.case.len() > 1 {
+            bail!(
+                "--case given {} times: only `drumroll continue` draws several cases",
+                self.case.len()
+            );
+        }
+        self.check_overrides()?;
+        self.resolve(self.case.first().map(String::as_str))
+    }
+
+    /// Every case given (`--case` repeated), in order, each with the `--a0` and
+    /// `--drive-frequency` overrides and checked as [`ModelArgs::case`]; the single resolved
+    /// case otherwise.
+    pub fn cases(&self) -> Result<Vec<Case>> {
+        if self.case.len() <= 1 {
+            return Ok(vec![self.case()?]);
+        }
+        self.check_overrides()?;
+        self.case
+            .iter()
+            .map(|name| self.resolve(Some(name)))
+            .collect()
+    }
+
+    /// Check `--a0` and `--drive-frequency` against the option range table.
+    fn check_overrides(&self) -> Result<()> {
         if let Some(a0) = self.a0 {
             option_ranges::A0.check(a0)?;
         }
         if let Some(frequency) = self.drive_frequency {
-            // The warning, if any, comes with the cantilever's range below.
+            // The warning, if any, comes with the cantilever's range in `resolve`.
             option_ranges::DRIVE_FREQUENCY.warning(frequency)?;
         }
-        let mut case = match (&self.case, &self.cantilever, &self.sample) {
+        Ok(())
+    }
+
+    /// The case named `name` (or built from `--cantilever` and `--sample`), overrides applied
+    /// and checked.
+    fn resolve(&self, name: Option<&str>) -> Result<Case> {
+        let mut case = match (name, &self.cantilever, &self.sample) {
             (Some(name), None, None) => {
                 let case = fixtures::find_case(name)?;
                 warn_all(case.warnings(name));
+                if self.drive_frequency.is_none() {
+                    // The case's own drive against its cantilever's range, blamed on the case
+                    // (an override is checked below, on the command line's account).
+                    case.validate(name).context("invalid model parameters")?;
+                }
                 case
             }
             (None, Some(cantilever), Some(sample)) => {
@@ -97,11 +136,15 @@ impl ModelArgs {
 
     /// The tapping model of the resolved case, at first contact `Z = Z_G1`.
     pub fn model(&self) -> Result<(Case, TappingModel)> {
-        let case = self.case()?;
-        let model = TappingModel::from_case(&case)
-            .with_context(|| format!("cannot build the model of case `{}`", case.name))?;
-        Ok((case, model))
+        model_of(self.case()?)
     }
+}
+
+/// The tapping model of `case`, at first contact `Z = Z_G1`.
+pub fn model_of(case: Case) -> Result<(Case, TappingModel)> {
+    let model = TappingModel::from_case(&case)
+        .with_context(|| format!("cannot build the model of case `{}`", case.name))?;
+    Ok((case, model))
 }
 
 /// Print each warning on stderr.

@@ -12,10 +12,10 @@ use std::path::PathBuf;
 
 use crate::digits;
 use crate::inputs::orbit_inputs_json;
-use crate::model_args::{output_path, ModelArgs};
+use crate::model_args::ModelArgs;
 use crate::option_ranges;
-use crate::output::{print_stdout, write_atomically};
-use crate::plot::render_svg;
+use crate::output::print_stdout;
+use crate::plot::{render_svg, FigureFile};
 use crate::trajectory_plot::trajectory_panels;
 
 /// Options of `drumroll simulate`.
@@ -47,8 +47,9 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of the readable summary.
     #[arg(long)]
     pub json: bool,
-    /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) into this SVG file.
-    #[arg(long, value_name = "FILE.svg")]
+    /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) into this file
+    /// (.svg, .png or .pdf by the extension).
+    #[arg(long, value_name = "FILE.svg|png|pdf")]
     pub plot: Option<PathBuf>,
 }
 
@@ -107,7 +108,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let plot_path = args
         .plot
         .as_ref()
-        .map(|p| output_path(p, "svg", "--plot"))
+        .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
     let (case, model) = args.model.model()?;
     let settings = SteadyOrbitSettings::default();
@@ -147,11 +148,13 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     if let Some(path) = plot_path {
-        let panels = trajectory_panels(&model, &orbit, 2)?;
-        let svg = render_svg(&panels, 2, 1, (800, 320))?;
-        write_atomically(&path, svg.as_bytes())?;
+        let mut panels = trajectory_panels(&model, &orbit, 2)?;
+        if let Some(first) = panels.first_mut() {
+            first.title = format!("{}: {}", case.name, first.title);
+        }
+        path.write(&render_svg(&panels, 2, 1, (800, 320))?)?;
         if !args.json {
-            print_stdout(&format!("figure: {}\n", path.display()))?;
+            print_stdout(&format!("figure: {}\n", path.path.display()))?;
         }
     }
     Ok(())

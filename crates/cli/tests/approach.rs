@@ -211,7 +211,7 @@ fn bad_options_are_refused_with_the_option_named() {
         (vec!["--tolerance", "1"], "--tolerance"),
         (vec!["--from", "10", "--to", "9.9999"], "drive cycle"),
         (vec!["--from", "9", "--to", "8", "--rate", "1e-9"], "--rate"),
-        (vec!["--plot", "figure.png"], ".svg"),
+        (vec!["--plot", "figure.jpg"], ".svg, .png or .pdf"),
         (
             vec!["--from", "9", "--to", "8.99", "--lockin-cycles", "1000"],
             "lockin_cycles",

@@ -137,6 +137,38 @@ fn the_drive_frequency_range_is_the_same_in_every_command() {
     );
 }
 
+/// A case file whose own drive lies outside its cantilever's range (the MAClever: f_1/100 to
+/// 100 f_2 = [0.035, 2800] kHz) is refused naming the file and the field, not the command line;
+/// a `--drive-frequency` inside the range replaces it.
+#[test]
+fn a_case_files_drive_beyond_its_cantilever_is_blamed_on_the_file() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let case = write(
+        directory.path(),
+        "fast.json",
+        r#"{"name": "fast", "cantilever": "maclever", "sample": "mica",
+            "free_amplitude_nm": 20, "drive_frequency_khz": 5789}"#,
+    );
+    let stderr = refused(
+        &["simulate", "--case", &case, "--z", "19"],
+        &[
+            &format!("{case}: field `drive_frequency_khz` = 5789"),
+            "allowed: [0.035000, 2800.000000] kHz",
+        ],
+    );
+    assert!(!stderr.contains("the command line"), "{stderr}");
+    let (code, _, stderr) = run(&[
+        "simulate",
+        "--case",
+        &case,
+        "--drive-frequency",
+        "3.5",
+        "--z",
+        "19",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
 #[test]
 fn an_implausible_value_is_warned_about_with_its_likely_unit() {
     // 0.01 nm is allowed, but 0.01 um = 10 nm is the usual amplitude.

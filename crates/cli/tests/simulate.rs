@@ -140,7 +140,7 @@ fn plot_is_written_whole_or_not_at_all() {
         .success();
     let text = std::fs::read_to_string(&svg).expect("written");
     assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
-    let bad = dir.path().join("orbit.png");
+    let bad = dir.path().join("orbit.jpg");
     drumroll()
         .args([
             "simulate",

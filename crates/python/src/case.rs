@@ -153,7 +153,7 @@ impl Case {
                 _ => None,
             };
             let args = ModelArgs {
-                case: name_or_path,
+                case: name_or_path.into_iter().collect(),
                 cantilever: name(cantilever),
                 sample: name(sample),
                 a0,

@@ -1,9 +1,7 @@
 //! `drumroll.Diagram`: the bifurcation diagram in Z (the paper's Fig. 2; MODEL.md section 5)
 //! as `drumroll continue --json` gives it, with the branch points as a table.
 
-use drumroll::continue_diagram::{
-    compute_diagrams, continue_json, diagram_settings, film_warning, ContinueArgs, CSV_COLUMNS,
-};
+use drumroll::continue_diagram::{continue_case_until, continue_json, ContinueArgs, CSV_COLUMNS};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -171,20 +169,15 @@ pub fn compute_diagram(
         json: true,
         csv: None,
         plot: None,
+        overlay: false,
     };
     let (json, warning) = without_gil(
         py,
         |interrupted| -> anyhow::Result<(Value, Option<String>)> {
-            let settings = diagram_settings(&args, &resolved.model)?;
-            let run = compute_diagrams(
-                &resolved.case,
-                &resolved.model,
-                &settings,
-                args.retract,
-                interrupted,
-            )?;
-            let warning = film_warning(&resolved.model, &run);
-            let json = continue_json(&resolved.case, &resolved.model, &settings, &run);
+            let continued =
+                continue_case_until(&args, &resolved.case, &resolved.model, interrupted)?;
+            let json = continue_json(&args, &resolved.case, &resolved.model, &continued);
+            let warning = continued.warning;
             Ok((json, warning))
         },
     )?

@@ -89,7 +89,7 @@ pub fn from_value<T: serde::de::DeserializeOwned>(
 /// Python API reuses) when the case is already resolved.
 pub fn resolved_model_args() -> drumroll::model_args::ModelArgs {
     drumroll::model_args::ModelArgs {
-        case: None,
+        case: Vec::new(),
         cantilever: None,
         sample: None,
         a0: None,
