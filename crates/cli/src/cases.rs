@@ -7,6 +7,8 @@ use anyhow::{bail, Result};
 use clap::{Args, Subcommand};
 use std::fmt::Write as _;
 
+use crate::output::print_stdout;
+
 /// Options of `drumroll cases`.
 #[derive(Debug, Clone, Args)]
 pub struct CasesArgs {
@@ -29,8 +31,8 @@ pub enum CasesCommand {
 /// Run `drumroll cases`.
 pub fn run(args: &CasesArgs) -> Result<()> {
     match &args.command {
-        None => print!("{}", listing()?),
-        Some(CasesCommand::Show { name }) => print!("{}", show(name)?),
+        None => print_stdout(&listing()?)?,
+        Some(CasesCommand::Show { name }) => print_stdout(&show(name)?)?,
     }
     Ok(())
 }

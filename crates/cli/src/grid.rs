@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use crate::grid_file::{assemble, PartWriter};
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
+use crate::output::print_stdout;
 
 /// The most rows, and the most separations per row, a grid may have.
 pub const MAX_STEPS: usize = 100_000;
@@ -168,11 +169,11 @@ pub fn run(args: &GridArgs) -> Result<()> {
         Some(GridSubcommand::Merge(merge)) => {
             let output = output_path(&merge.output, "jsonl", "--output")?;
             assemble(&merge.parts, &output)?;
-            println!(
-                "merged {} part files into {}",
+            print_stdout(&format!(
+                "merged {} part files into {}\n",
                 merge.parts.len(),
                 output.display()
-            );
+            ))?;
             Ok(())
         }
         None => compute(&args.run),
@@ -348,15 +349,15 @@ fn compute(args: &GridRunArgs) -> Result<()> {
     match shard {
         Some(shard) => {
             fill_part(&grid, &header, output, shard, args.threads)?;
-            println!(
-                "shard {}/{}: rows {}, {}, ... of {} in {}",
+            print_stdout(&format!(
+                "shard {}/{}: rows {}, {}, ... of {} in {}\n",
                 shard.index,
                 shard.count,
                 shard.index,
                 shard.index + shard.count,
                 grid.parameters.len(),
                 output.display()
-            );
+            ))?;
         }
         None => {
             let output = output_path(output, "jsonl", "--output")?;
@@ -368,12 +369,12 @@ fn compute(args: &GridRunArgs) -> Result<()> {
             assemble(std::slice::from_ref(&part), &output)?;
             std::fs::remove_file(&part)
                 .with_context(|| format!("cannot remove {}", part.display()))?;
-            println!(
-                "{} rows x {} separations written to {}",
+            print_stdout(&format!(
+                "{} rows x {} separations written to {}\n",
                 grid.parameters.len(),
                 grid.separations.len(),
                 output.display()
-            );
+            ))?;
         }
     }
     Ok(())

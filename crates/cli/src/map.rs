@@ -14,6 +14,7 @@ use crate::grid_overlay::read_grid;
 use crate::inputs::orbit_inputs_json;
 use crate::map_plot::map_panels;
 use crate::model_args::{output_path, ModelArgs};
+use crate::output::print_stdout;
 use crate::output::write_atomically;
 use crate::plot::{render_svg, FigureFile};
 
@@ -102,9 +103,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
     let map = compute_map(&case, axis, &settings)?;
     if args.json {
         let object = map_json(args, &case, &model, axis, &settings, &map);
-        println!("{}", serde_json::to_string(&object)?);
+        print_stdout(&format!("{}\n", serde_json::to_string(&object)?))?;
     } else {
-        print!("{}", table(&case.name, axis, &args.at, &map));
+        print_stdout(&table(&case.name, axis, &args.at, &map))?;
     }
     if let Some(path) = csv_path {
         write_atomically(&path, csv_text(&map.curves)?.as_bytes())?;
