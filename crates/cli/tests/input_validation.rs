@@ -374,7 +374,9 @@ fn a_closed_pipe_ends_the_output_without_a_panic() {
         &["theory", "--z", "9.5", "--json"][..],
         &["simulate", "--z", "9.5"][..],
         &["continue", "--floor", "9.9", "--json"][..],
-        &["map", "--vary", "a0", "--from", "9.5", "--to", "10.5", "--json"][..],
+        &[
+            "map", "--vary", "a0", "--from", "9.5", "--to", "10.5", "--json",
+        ][..],
         &["map", "--vary", "a0", "--from", "9.5", "--to", "10.5"][..],
         &["cases"][..],
         &["cases", "show", "biolever-mica"][..],
