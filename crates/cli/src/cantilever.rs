@@ -255,30 +255,7 @@ fn build(
     let qualities = args.quality_inputs()?;
     // Every value given is checked first, so that a bad value is named even when others are
     // missing.
-    if let Some(k1) = args.k1 {
-        option_ranges::K1.check(k1)?;
-    }
-    if let Some(radius) = args.radius {
-        option_ranges::RADIUS.check(radius)?;
-    }
-    for (index, frequency) in frequencies.iter().enumerate() {
-        if let Some(frequency) = frequency {
-            check_option(
-                &format!("--f{}", index + 1),
-                ranges::FREQUENCY_KHZ,
-                *frequency,
-            )?;
-        }
-    }
-    for (index, quality) in qualities.iter().enumerate() {
-        if let Some(quality) = quality {
-            check_option(
-                &format!("--q{}", index + 1),
-                ranges::QUALITY_FACTOR,
-                *quality,
-            )?;
-        }
-    }
+    check_given(args, &frequencies, &qualities)?;
     let missing = missing_options(args, &frequencies, &qualities);
     let (Some(k1), Some(Some(f1)), Some(radius), true) = (
         args.k1,
@@ -368,6 +345,40 @@ fn build(
         .validate("the built cantilever")
         .context("the built cantilever is not valid")?;
     Ok((cantilever, sources))
+}
+
+/// Check every measured value given (`--k1`, `--radius`, `--fN`, `--qN`) against its range in
+/// [`option_ranges`] and the range table; the error names the option.
+fn check_given(
+    args: &CantileverArgs,
+    frequencies: &[Option<f64>],
+    qualities: &[Option<f64>],
+) -> Result<()> {
+    if let Some(k1) = args.k1 {
+        option_ranges::K1.check(k1)?;
+    }
+    if let Some(radius) = args.radius {
+        option_ranges::RADIUS.check(radius)?;
+    }
+    for (index, frequency) in frequencies.iter().enumerate() {
+        if let Some(frequency) = frequency {
+            check_option(
+                &format!("--f{}", index + 1),
+                ranges::FREQUENCY_KHZ,
+                *frequency,
+            )?;
+        }
+    }
+    for (index, quality) in qualities.iter().enumerate() {
+        if let Some(quality) = quality {
+            check_option(
+                &format!("--q{}", index + 1),
+                ranges::QUALITY_FACTOR,
+                *quality,
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// The options a build needs that are not given: `--k1`, `--f1`, `--radius` and a quality

@@ -219,22 +219,7 @@ pub fn measure_impacts(
     orbit: &SteadyOrbit,
     settings: &Settings,
 ) -> Result<ImpactMeasurement, AfmError> {
-    if orbit.multiplicity != 1 {
-        return Err(invalid(
-            "impact measurement",
-            "orbit.multiplicity",
-            orbit.multiplicity as f64,
-            String::from("1: the theory of Eqs. 2-4 describes a period-1 orbit"),
-        ));
-    }
-    if model.mode_count() < 2 {
-        return Err(invalid(
-            "impact measurement",
-            "mode_count",
-            model.mode_count() as f64,
-            String::from("at least 2 eigenmodes (the ringing of q_2 is measured)"),
-        ));
-    }
+    check_measurable(model, orbit)?;
     let mut model = model.clone();
     model.set_separation(Separation::Constant(orbit.z_nm))?;
     let period = model.period_us();
@@ -278,28 +263,7 @@ pub fn measure_impacts(
             - first.stiffness_n_per_m * q1_amplitude * (1.0 - ratio * ratio));
 
     let fragments = merge_wrapped(accumulator.fragments, period);
-    let theta_bar = |t: f64| wrap(PI - (w * t - phi));
-    let mut impacts = Vec::with_capacity(fragments.len());
-    for fragment in &fragments {
-        let start = fragment.start.as_ref().map_or(0.0, |(t, _)| *t);
-        let end = fragment.end.as_ref().map_or(start + period, |(t, _)| *t);
-        let centroid = if fragment.impulse > 0.0 {
-            fragment.moment / fragment.impulse
-        } else {
-            0.5 * (start + end)
-        };
-        impacts.push(ImpactImpulse {
-            start_periods: start / period,
-            end_periods: end / period,
-            impulse_nn_us: fragment.impulse,
-            centroid_periods: centroid / period,
-            largest_theta_bar_deg: theta_bar(start)
-                .abs()
-                .max(theta_bar(end).abs())
-                .to_degrees(),
-            centroid_theta_bar_deg: theta_bar(centroid).to_degrees(),
-        });
-    }
+    let impacts = impact_impulses(&fragments, period, w, phi);
     let main_impact = impacts
         .iter()
         .enumerate()
@@ -338,6 +302,59 @@ pub fn measure_impacts(
         main_impact,
         ringing,
     })
+}
+
+/// The theory of Eqs. 2-4 measures a period-1 orbit of a cantilever with at least 2 modes (the
+/// ringing of `q_2`): an [`AfmError::InvalidField`] for any other.
+fn check_measurable(model: &TappingModel, orbit: &SteadyOrbit) -> Result<(), AfmError> {
+    if orbit.multiplicity != 1 {
+        return Err(invalid(
+            "impact measurement",
+            "orbit.multiplicity",
+            orbit.multiplicity as f64,
+            String::from("1: the theory of Eqs. 2-4 describes a period-1 orbit"),
+        ));
+    }
+    if model.mode_count() < 2 {
+        return Err(invalid(
+            "impact measurement",
+            "mode_count",
+            model.mode_count() as f64,
+            String::from("at least 2 eigenmodes (the ringing of q_2 is measured)"),
+        ));
+    }
+    Ok(())
+}
+
+/// Each contact of the period as an [`ImpactImpulse`]: onset and release (periods), impulse
+/// (nN us), centroid, and the drive-relative angles `theta_bar = pi - (w t - phi)` of Eq. 3
+/// (degrees), for the drive angular frequency `w` (rad/us), period `period` (us) and the phase
+/// `phi` (rad) of `q_1`'s first harmonic.
+fn impact_impulses(fragments: &[Fragment], period: f64, w: f64, phi: f64) -> Vec<ImpactImpulse> {
+    let theta_bar = |t: f64| wrap(PI - (w * t - phi));
+    fragments
+        .iter()
+        .map(|fragment| {
+            let start = fragment.start.as_ref().map_or(0.0, |(t, _)| *t);
+            let end = fragment.end.as_ref().map_or(start + period, |(t, _)| *t);
+            let centroid = if fragment.impulse > 0.0 {
+                fragment.moment / fragment.impulse
+            } else {
+                0.5 * (start + end)
+            };
+            ImpactImpulse {
+                start_periods: start / period,
+                end_periods: end / period,
+                impulse_nn_us: fragment.impulse,
+                centroid_periods: centroid / period,
+                largest_theta_bar_deg: theta_bar(start)
+                    .abs()
+                    .max(theta_bar(end).abs())
+                    .to_degrees(),
+                centroid_theta_bar_deg: theta_bar(centroid).to_degrees(),
+            }
+        })
+        .collect()
 }
 
 /// A contact in progress at `t = 0` (open head fragment) and at `t = T` (open tail) is one
