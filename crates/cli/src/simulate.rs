@@ -265,11 +265,9 @@ pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serd
 }
 
 /// Distance from +1 within which a real Floquet multiplier of an orbit Newton did not converge
-/// to marks a fold: next to a saddle-node, the transients of a cold start linger at the ghost
-/// of the orbit that vanished there for longer than the periods a cold start integrates, and
-/// Newton has no fixed point to find (measured: the MAClever on mica from 1e-11 to 4e-8 nm
-/// below its fold at 19.9958410294 nm, best attempts with multipliers within 5e-6 of +1;
-/// from 5e-8 nm below, the cold start's transients pass the ghost and converge).
+/// to marks a fold: next to a saddle-node, transients linger at the ghost of the orbit that
+/// vanished there for longer than the periods a search integrates, and Newton has no fixed
+/// point to find; the best attempts there have a multiplier within a few 1e-6 of +1.
 const FOLD_MULTIPLIER_DISTANCE: f64 = 1e-2;
 
 /// The real Floquet multiplier within [`FOLD_MULTIPLIER_DISTANCE`] of +1 of an orbit that did
