@@ -49,21 +49,37 @@ pub(crate) fn tangent(
     reference: &DVector<f64>,
     p: f64,
 ) -> Result<DVector<f64>, ContinuationError> {
-    let n = map.image.len();
-    let a = bordered(map, reference);
-    let mut rhs = DVector::zeros(n + 1);
-    rhs[n] = 1.0;
+    unit_tangent(
+        bordered(map, reference),
+        reference,
+        p,
+        ("bordered Jacobian (tangent)", "branch tangent"),
+    )
+}
+
+/// The unit null vector `t` of a Jacobian `J` from the bordered matrix `a = [J; reference^T]`:
+/// the solution of `a t = e_last`, normalised and oriented so that `t . reference > 0`.
+/// `what` names the matrix and the tangent in errors (at parameter `p`).
+pub(crate) fn unit_tangent(
+    a: DMatrix<f64>,
+    reference: &DVector<f64>,
+    p: f64,
+    what: (&'static str, &'static str),
+) -> Result<DVector<f64>, ContinuationError> {
+    let m = a.ncols();
+    let mut rhs = DVector::zeros(m);
+    rhs[m - 1] = 1.0;
     let t = a
         .lu()
         .solve(&rhs)
         .ok_or(ContinuationError::SingularMatrix {
-            what: "bordered Jacobian (tangent)",
+            what: what.0,
             parameter: p,
         })?;
     let norm = t.norm();
     if !(norm.is_finite() && norm > 0.0) {
         return Err(ContinuationError::NonFinite {
-            what: "branch tangent",
+            what: what.1,
             parameter: p,
         });
     }

@@ -10,6 +10,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::codim_one::{Defining, Evaluation};
+use crate::corrector::unit_tangent;
 use crate::error::ContinuationError;
 use crate::shooting::NewtonSettings;
 use crate::two_parameter::SystemFamily;
@@ -185,26 +186,12 @@ pub(crate) fn tangent(
     reference: &DVector<f64>,
     p: f64,
 ) -> Result<DVector<f64>, ContinuationError> {
-    let a = closed(&evaluation.jacobian, reference);
-    let m = a.ncols();
-    let mut rhs = DVector::zeros(m);
-    rhs[m - 1] = 1.0;
-    let t = a
-        .lu()
-        .solve(&rhs)
-        .ok_or(ContinuationError::SingularMatrix {
-            what: "bordered Jacobian of the curve (tangent)",
-            parameter: p,
-        })?;
-    let norm = t.norm();
-    if !(norm.is_finite() && norm > 0.0) {
-        return Err(ContinuationError::NonFinite {
-            what: "curve tangent",
-            parameter: p,
-        });
-    }
-    let t = t / norm;
-    Ok(if t.dot(reference) < 0.0 { -t } else { t })
+    unit_tangent(
+        closed(&evaluation.jacobian, reference),
+        reference,
+        p,
+        ("bordered Jacobian of the curve (tangent)", "curve tangent"),
+    )
 }
 
 /// The state of a curve's continuation at an accepted point.

@@ -3,6 +3,7 @@
 //! corrector and the location of codimension-two points.
 
 use crate::error::ContinuationError;
+use crate::settings::{check, check_steps};
 use crate::shooting::NewtonSettings;
 
 /// Settings of [`crate::continue_curve`], checked by [`CurveSettings::validate`].
@@ -77,48 +78,13 @@ impl Default for CurveSettings {
     }
 }
 
-/// `Ok` if `ok`, else the invalid-settings error for `field`.
-fn check(
-    ok: bool,
-    field: &'static str,
-    value: f64,
-    allowed: &'static str,
-) -> Result<(), ContinuationError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(ContinuationError::InvalidSettings {
-            field,
-            value,
-            allowed,
-        })
-    }
-}
-
 impl CurveSettings {
     /// Check every field against its documented range.
     ///
     /// # Errors
     /// [`ContinuationError::InvalidSettings`] naming the first field out of range.
     pub fn validate(&self) -> Result<(), ContinuationError> {
-        check(
-            self.min_step.is_finite() && self.min_step > 0.0,
-            "min_step",
-            self.min_step,
-            "> 0, finite",
-        )?;
-        check(
-            self.max_step.is_finite() && self.max_step >= self.min_step,
-            "max_step",
-            self.max_step,
-            ">= min_step, finite",
-        )?;
-        check(
-            self.initial_step >= self.min_step && self.initial_step <= self.max_step,
-            "initial_step",
-            self.initial_step,
-            "min_step ..= max_step",
-        )?;
+        check_steps(self.initial_step, self.min_step, self.max_step)?;
         check(
             self.max_second_step > 0.0,
             "max_second_step",

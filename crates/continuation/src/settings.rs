@@ -96,7 +96,9 @@ impl Default for ContinuationSettings {
     }
 }
 
-fn check(
+/// `Ok` if `ok`, else the invalid-settings error for `field` with its `value` and the
+/// `allowed` range in words.
+pub(crate) fn check(
     ok: bool,
     field: &'static str,
     value: f64,
@@ -113,30 +115,40 @@ fn check(
     }
 }
 
+/// Check the step bounds of a pseudo-arclength continuation (branch or curve): `min_step > 0`,
+/// `max_step >= min_step`, both finite, and `initial_step` in `min_step ..= max_step`.
+pub(crate) fn check_steps(
+    initial_step: f64,
+    min_step: f64,
+    max_step: f64,
+) -> Result<(), ContinuationError> {
+    check(
+        min_step.is_finite() && min_step > 0.0,
+        "min_step",
+        min_step,
+        "> 0, finite",
+    )?;
+    check(
+        max_step.is_finite() && max_step >= min_step,
+        "max_step",
+        max_step,
+        ">= min_step, finite",
+    )?;
+    check(
+        initial_step >= min_step && initial_step <= max_step,
+        "initial_step",
+        initial_step,
+        "min_step ..= max_step",
+    )
+}
+
 impl ContinuationSettings {
     /// Check every field against its documented range.
     ///
     /// # Errors
     /// [`ContinuationError::InvalidSettings`] naming the first field out of range.
     pub fn validate(&self) -> Result<(), ContinuationError> {
-        check(
-            self.min_step.is_finite() && self.min_step > 0.0,
-            "min_step",
-            self.min_step,
-            "> 0, finite",
-        )?;
-        check(
-            self.max_step.is_finite() && self.max_step >= self.min_step,
-            "max_step",
-            self.max_step,
-            ">= min_step, finite",
-        )?;
-        check(
-            self.initial_step >= self.min_step && self.initial_step <= self.max_step,
-            "initial_step",
-            self.initial_step,
-            "min_step ..= max_step",
-        )?;
+        check_steps(self.initial_step, self.min_step, self.max_step)?;
         check(
             self.step_growth >= 1.0 && self.step_growth.is_finite(),
             "step_growth",
