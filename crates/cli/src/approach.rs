@@ -213,6 +213,25 @@ pub fn format_record(record: &SweepRecord, jsonl: bool, line: &mut String) -> Re
     Ok(())
 }
 
+/// The `inputs` object of an approach sweep (the first line of `--jsonl`): the sweep's
+/// settings as options, with the case, model and integration settings (docs/output-schema.md).
+pub fn approach_inputs_json(
+    case: &afm::Case,
+    model: &TappingModel,
+    settings: &SweepSettings,
+) -> serde_json::Value {
+    let options = json!({
+        "from_nm": settings.from_nm,
+        "to_nm": settings.to_nm,
+        "rate_nm_per_s": settings.rate_nm_per_s,
+        "retract": settings.retract,
+        "settle_cycles": settings.settle_cycles,
+        "lockin_cycles": settings.lockin_cycles,
+        "every": settings.every,
+    });
+    inputs_json("approach", options, case, model, &settings.integration)
+}
+
 /// Run `drumroll approach`.
 pub fn run(args: &ApproachArgs) -> Result<()> {
     let plot_path = args
@@ -226,16 +245,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
     let (case, model) = args.model.model()?;
     let settings = args.settings(&model)?;
     let first_line = if args.jsonl {
-        let options = json!({
-            "from_nm": settings.from_nm,
-            "to_nm": settings.to_nm,
-            "rate_nm_per_s": settings.rate_nm_per_s,
-            "retract": settings.retract,
-            "settle_cycles": settings.settle_cycles,
-            "lockin_cycles": settings.lockin_cycles,
-            "every": settings.every,
-        });
-        let inputs = inputs_json("approach", options, &case, &model, &settings.integration);
+        let inputs = approach_inputs_json(&case, &model, &settings);
         format!("{}\n", json!({ "inputs": inputs }))
     } else {
         format!("{CSV_HEADER}\n")

@@ -17,7 +17,7 @@ use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{model_of, output_path, ModelArgs};
 use crate::option_ranges::{self, OptionRange};
-use crate::output::{print_stdout, write_atomically};
+use crate::output::{print_stdout, push_csv_row, write_atomically};
 use crate::plot::FigureFile;
 use crate::progress::Progress;
 
@@ -457,16 +457,12 @@ pub const CSV_COLUMNS: [&str; 15] = [
 fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
     let mut text = format!("direction,{}\n", CSV_COLUMNS.join(","));
     for point in &diagram.points {
-        let value = serde_json::to_value(point)?;
-        text.push_str(direction);
-        for column in CSV_COLUMNS {
-            text.push(',');
-            match &value[column] {
-                serde_json::Value::Null => {}
-                other => text.push_str(&other.to_string()),
-            }
-        }
-        text.push('\n');
+        push_csv_row(
+            &mut text,
+            direction,
+            &serde_json::to_value(point)?,
+            &CSV_COLUMNS,
+        );
     }
     Ok(text)
 }

@@ -14,8 +14,8 @@ use crate::grid_overlay::read_grid;
 use crate::inputs::orbit_inputs_json;
 use crate::map_plot::map_panels;
 use crate::model_args::{output_path, ModelArgs};
-use crate::output::print_stdout;
 use crate::output::write_atomically;
+use crate::output::{print_stdout, push_csv_row};
 use crate::plot::{render_svg, FigureFile};
 
 /// Options of `drumroll map`.
@@ -319,16 +319,12 @@ fn csv_text(curves: &[MapCurve]) -> Result<String> {
     let mut text = format!("label,{}\n", CSV_COLUMNS.join(","));
     for curve in curves {
         for point in &curve.points {
-            let value = serde_json::to_value(point)?;
-            text.push_str(&curve.label);
-            for column in CSV_COLUMNS {
-                text.push(',');
-                match &value[column] {
-                    serde_json::Value::Null => {}
-                    other => text.push_str(&other.to_string()),
-                }
-            }
-            text.push('\n');
+            push_csv_row(
+                &mut text,
+                &curve.label,
+                &serde_json::to_value(point)?,
+                &CSV_COLUMNS,
+            );
         }
     }
     Ok(text)

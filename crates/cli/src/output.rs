@@ -94,3 +94,18 @@ pub fn write_atomically_with(
     }
     result
 }
+
+/// Append one CSV row to `text`: `first` (the row's label column), then the value of each of
+/// `columns` as a key of the JSON object `value` (numbers and strings as JSON prints them, empty
+/// for `null`), and a newline. The CSV columns are thus the JSON keys (docs/output-schema.md).
+pub fn push_csv_row(text: &mut String, first: &str, value: &serde_json::Value, columns: &[&str]) {
+    text.push_str(first);
+    for column in columns {
+        text.push(',');
+        match &value[*column] {
+            serde_json::Value::Null => {}
+            other => text.push_str(&other.to_string()),
+        }
+    }
+    text.push('\n');
+}
