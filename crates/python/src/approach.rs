@@ -1,10 +1,9 @@
 //! `Case.approach`: the time-domain approach (and retract) sweep of `drumroll approach`, read
 //! by a lock-in once per block of drive cycles, as a table of records.
 
-use drumroll::approach::{ApproachArgs, CSV_HEADER};
-use drumroll::inputs::inputs_json;
+use drumroll::approach::{approach_inputs_json, ApproachArgs, CSV_HEADER};
 use pyo3::prelude::*;
-use serde_json::{json, Value};
+use serde_json::Value;
 
 use crate::convert::{json_to_py, records_to_table};
 use crate::errors::to_py_err;
@@ -58,22 +57,7 @@ pub fn compute_approach<'py>(
         without_gil(py, |interrupted| -> anyhow::Result<(Vec<Value>, Value)> {
             let model = &resolved.model;
             let settings = args.settings(model)?;
-            let options = json!({
-                "from_nm": settings.from_nm,
-                "to_nm": settings.to_nm,
-                "rate_nm_per_s": settings.rate_nm_per_s,
-                "retract": settings.retract,
-                "settle_cycles": settings.settle_cycles,
-                "lockin_cycles": settings.lockin_cycles,
-                "every": settings.every,
-            });
-            let inputs = inputs_json(
-                "approach",
-                options,
-                &resolved.case,
-                model,
-                &settings.integration,
-            );
+            let inputs = approach_inputs_json(&resolved.case, model, &settings);
             let mut sweep = afm::Sweep::new(model, settings).map_err(anyhow::Error::new)?;
             let mut records = Vec::new();
             while let Some(record) = sweep.next_record().map_err(|error| {

@@ -9,7 +9,7 @@ use pyo3::types::PyTuple;
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::convert::{json_to_py, py_to_json};
+use crate::convert::{json_to_py, py_to_json, reduce_by_from_dict};
 use crate::errors::to_py_err;
 use crate::resolved::{from_value, Resolved};
 
@@ -347,10 +347,8 @@ impl Case {
 
     /// Pickling: the case travels as its dict (so it reaches Dask workers).
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let py = slf.py();
-        let rebuild = py.get_type::<Self>().getattr("from_dict")?;
-        let state = slf.get().to_dict(py)?;
-        PyTuple::new(py, [rebuild, PyTuple::new(py, [state])?.into_any()])
+        let state = slf.get().to_dict(slf.py())?;
+        reduce_by_from_dict::<Self>(slf.py(), state)
     }
 
     fn __repr__(&self) -> String {

@@ -154,3 +154,16 @@ pub fn float_array<'py>(py: Python<'py>, values: Vec<f64>) -> PyResult<Bound<'py
     py.import("numpy")?
         .call_method1("array", (values, "float64"))
 }
+
+/// The `__reduce__` value of a class that rebuilds itself from its dict: `(T.from_dict,
+/// (state,))`, so that pickling carries the object as `state` (its `to_dict()`).
+pub fn reduce_by_from_dict<'py, T: pyo3::PyTypeInfo>(
+    py: Python<'py>,
+    state: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    let rebuild = py.get_type::<T>().getattr("from_dict")?;
+    pyo3::types::PyTuple::new(
+        py,
+        [rebuild, pyo3::types::PyTuple::new(py, [state])?.into_any()],
+    )
+}

@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use serde_json::Value;
 
-use crate::convert::{json_to_py, py_to_json, records_to_table};
+use crate::convert::{json_to_py, py_to_json, records_to_table, reduce_by_from_dict};
 use crate::errors::{to_py_err, warn};
 use crate::interrupt::without_gil;
 use crate::resolved::{resolved_model_args, Resolved};
@@ -118,10 +118,8 @@ impl Diagram {
 
     /// Pickling: the diagram travels as its dict.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let py = slf.py();
-        let rebuild = py.get_type::<Self>().getattr("from_dict")?;
-        let state = slf.get().to_dict(py)?;
-        PyTuple::new(py, [rebuild, PyTuple::new(py, [state])?.into_any()])
+        let state = slf.get().to_dict(slf.py())?;
+        reduce_by_from_dict::<Self>(slf.py(), state)
     }
 
     fn __repr__(&self) -> String {
