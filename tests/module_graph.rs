@@ -3,11 +3,15 @@
 //! For each crate under `crates/`, every top-level module (`src/name.rs` or `src/name/`) is a
 //! node, and every path `crate::name...` in its code (a `use` or an inline path; comments, the
 //! `#[cfg(test)]` module at the end of a file and test modules in files of their own, named
-//! `tests.rs`, excluded) is an edge to module `name`, or to
+//! `tests.rs` or `*_tests.rs`, excluded) is an edge to module `name`, or to
 //! the module an item re-exported at the crate root (`pub use name::{Item}` in `lib.rs`) comes
 //! from. The test fails on any cycle among those edges, naming it, unless it is listed in
 //! [`KNOWN_CYCLES`]; it also fails when a listed cycle no longer exists, so that the list
 //! shrinks as the cycles are broken.
+//!
+//! Inside `afm`, a module names an item by the module that defines it: no path through the
+//! crate root's re-exports (`crate::TappingModel`), so that the imports show which concept
+//! builds on which.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -139,7 +143,10 @@ fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     let mut sources: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
     let mut root = String::new();
     for file in rust_files(src) {
-        if file.file_name().is_some_and(|name| name == "tests.rs") {
+        if file
+            .file_name()
+            .is_some_and(|name| name.to_string_lossy().ends_with("tests.rs"))
+        {
             continue;
         }
         let relative = file.strip_prefix(src).expect("under src");
@@ -293,5 +300,37 @@ fn every_crate_has_an_acyclic_module_graph() {
     assert!(
         gone.is_empty(),
         "these cycles are broken: remove them from KNOWN_CYCLES: {gone:?}"
+    );
+}
+
+#[test]
+fn afm_imports_no_name_through_the_crate_root() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/afm/src");
+    let root = fs::read_to_string(src.join("lib.rs")).expect("lib.rs");
+    let modules: BTreeSet<String> = fs::read_dir(&src)
+        .expect("afm/src")
+        .map(|entry| entry.expect("directory entry").path())
+        .filter_map(|path| {
+            let stem = path.file_stem()?.to_string_lossy().to_string();
+            (stem != "lib").then_some(stem)
+        })
+        .collect();
+    let exports = root_exports(&root, &modules);
+    assert!(!exports.is_empty(), "lib.rs re-exports the public API");
+    let mut through_root = Vec::new();
+    for file in rust_files(&src) {
+        if file.file_name().is_some_and(|name| name == "lib.rs") {
+            continue;
+        }
+        let text = fs::read_to_string(&file).expect("readable source");
+        for name in crate_paths(&code_of(&text)) {
+            if exports.contains_key(&name) && !modules.contains(&name) {
+                through_root.push(format!("{}: crate::{name}", file.display()));
+            }
+        }
+    }
+    assert!(
+        through_root.is_empty(),
+        "import these from the module that defines them: {through_root:#?}"
     );
 }

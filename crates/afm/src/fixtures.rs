@@ -8,8 +8,11 @@ use std::path::{Path, PathBuf};
 
 use serde::de::DeserializeOwned;
 
-use crate::case::CaseFile;
-use crate::{AfmError, Cantilever, Case, Sample};
+use crate::error::AfmError;
+use crate::model::cantilever::Cantilever;
+use crate::model::case::Case;
+use crate::model::case::CaseFile;
+use crate::model::sample::Sample;
 
 /// A built-in fixture: its name, the path it was embedded from, and its text.
 struct Embedded {

@@ -17,81 +17,57 @@
 //! phase (`cos(w t) = 1`).
 #![warn(missing_docs)]
 
-pub mod amplitude_ratio;
-pub mod bifurcation_diagram;
-pub mod cantilever;
-pub mod case;
 pub mod contact;
-mod contact_series;
-pub mod drive;
-pub mod eigenmode;
+pub mod diagram;
 pub mod error;
-pub mod film_validity;
 pub mod fixtures;
-pub mod free_flight;
-pub mod free_flight_fourier;
-pub mod free_response;
-pub mod gauss_legendre;
-pub mod hertz;
-pub mod impact_numbers;
 mod json_path;
-pub mod lockin;
-mod modal_constants;
+pub mod map;
 pub mod model;
-pub mod observables;
-pub mod orbit_prediction;
-pub mod parameter_axis;
-pub mod phase;
-pub mod quasi_static;
-pub mod regime_map;
-pub mod sample;
-pub mod separation;
-pub mod steady_orbit;
+pub mod orbit;
 pub mod sweep;
 pub mod theory;
-pub mod trajectory;
-pub mod trigonometric;
 pub mod validation;
 
-pub use amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
-pub use bifurcation_diagram::{
+pub use diagram::bifurcation_diagram::{
     approach_diagram, approach_diagram_until, diagram, diagram_until, BifurcationDiagram,
     DiagramPoint, DiagramSettings, DiagramSpecialPoint,
 };
-pub use cantilever::Cantilever;
-pub use case::{Case, CaseFile};
-pub use drive::Drive;
-pub use eigenmode::Eigenmode;
+pub use diagram::quasi_static::{quasi_static_row, QuasiStaticCell, QuasiStaticRow};
 pub use error::AfmError;
-pub use film_validity::film_range_warning;
 pub use fixtures::{
     builtin_cantilever, builtin_case, builtin_sample, cantilever_names, case_names, find_case,
     load_cantilever, load_case, load_sample, sample_names,
 };
-pub use free_flight::DrivenOscillator;
-pub use free_response::FreeResponse;
-pub use hertz::{effective_modulus_gpa, HertzContact};
-pub use impact_numbers::MultipleImpactNumbers;
+pub use map::parameter_axis::{CaseFamily, ParameterAxis, PARAMETER_NAMES};
+pub use map::regime_map::{
+    regime_map, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap, RegimeMapSettings,
+};
+pub use model::cantilever::Cantilever;
+pub use model::case::{Case, CaseFile};
+pub use model::drive::Drive;
+pub use model::eigenmode::Eigenmode;
+pub use model::film_validity::film_range_warning;
+pub use model::free_flight::DrivenOscillator;
+pub use model::free_response::FreeResponse;
+pub use model::hertz_contact::{effective_modulus_gpa, HertzContact};
+pub use model::sample::Sample;
+pub use model::separation::Separation;
 pub use model::TappingModel;
-pub use observables::{
+pub use orbit::observables::{
     observe_orbit_in, observe_period, observe_period_in, orbit_observables, GapMinimum,
     GapMinimumKind, Harmonic, Impact, OrbitObservables, PeriodObserver, NEAR_IMPACT_FRACTION,
 };
-pub use orbit_prediction::{hermite_state, tangent_state};
-pub use parameter_axis::{CaseFamily, ParameterAxis, PARAMETER_NAMES};
-pub use quasi_static::{quasi_static_row, QuasiStaticCell, QuasiStaticRow};
-pub use regime_map::{
-    regime_map, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap, RegimeMapSettings,
-};
-pub use sample::Sample;
-pub use separation::Separation;
-pub use steady_orbit::{
+pub use orbit::prediction::{hermite_state, tangent_state};
+pub use orbit::steady_orbit::{
     state_distance, steady_orbit, steady_orbit_in, OrbitStart, PeriodBreakdown, SteadyOrbit,
     SteadyOrbitSettings, SteadyOrbitWorkspace,
 };
+pub use orbit::trajectory::{sample_trajectory, TrajectorySample};
+pub use sweep::amplitude_ratio::{find_amplitude_ratio, AmplitudeRatioSearch};
 pub use sweep::{Sweep, SweepDirection, SweepRecord, SweepSettings};
+pub use theory::impact_numbers::MultipleImpactNumbers;
 pub use theory::{
     compare_theory, measure_impacts, AssumptionFailure, ImpactImpulse, ImpactMeasurement,
     ImpactPrediction, ImpactTheory, Ringing, TheoryComparison,
 };
-pub use trajectory::{sample_trajectory, TrajectorySample};

@@ -3,7 +3,7 @@
 //! [`AfmError::InvalidField`] naming the file (or option), the field and the allowed range, or
 //! a valid but implausible one into a warning with the likely unit mistake.
 
-use crate::AfmError;
+use crate::error::AfmError;
 
 /// An interval of allowed values with its unit, printed as e.g. `(0, 1e6] N/m`, and the
 /// narrower range typical of AFM: a value outside it is accepted with a warning, and a value

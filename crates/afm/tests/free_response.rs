@@ -5,7 +5,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use afm::trigonometric::TrigonometricPolynomial;
+use afm::model::trigonometric::TrigonometricPolynomial;
 use afm::{Drive, FreeResponse, Separation, TappingModel};
 use hybrid::{ExactFlow, HybridSystem};
 

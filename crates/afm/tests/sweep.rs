@@ -289,7 +289,7 @@ fn invalid_settings_name_the_field_and_range() {
 /// independent quadrature of the same integrals) on a steady cycle with two impacts.
 #[test]
 fn cycle_lockin_matches_the_period_observables() {
-    use afm::lockin::CycleLockIn;
+    use afm::orbit::lockin::CycleLockIn;
     use afm::{observe_period, steady_orbit, Separation, SteadyOrbitSettings};
     use hybrid::{Sensitivity, Solver, StepOutcome};
     let mut model = biolever_on_mica();
@@ -350,7 +350,7 @@ fn cycle_lockin_matches_the_period_observables() {
 /// matters.
 #[test]
 fn free_flight_fourier_matches_quadrature_of_the_exact_flow() {
-    use afm::free_flight_fourier::FreeFlightFourier;
+    use afm::model::free_flight_fourier::FreeFlightFourier;
     use afm::{Separation, TappingModel};
     use hybrid::ExactFlow;
     let nodes = [

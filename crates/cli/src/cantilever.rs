@@ -337,8 +337,8 @@ fn build(
         ),
         tip_radius_nm: radius,
         tip_mass_ratio: args.tip_mass_ratio,
-        tip_youngs_modulus_gpa: afm::cantilever::DEFAULT_TIP_YOUNGS_MODULUS_GPA,
-        tip_poisson_ratio: afm::cantilever::DEFAULT_POISSON_RATIO,
+        tip_youngs_modulus_gpa: afm::model::cantilever::DEFAULT_TIP_YOUNGS_MODULUS_GPA,
+        tip_poisson_ratio: afm::model::cantilever::DEFAULT_POISSON_RATIO,
         modes,
     };
     cantilever

@@ -1,6 +1,6 @@
 //! `drumroll map`: the impact-regime map of a case over a second parameter: the grazing `G_n`,
 //! fold and period-doubling points of the approach diagram continued from the case's own value
-//! over a range (`afm::regime_map`), as curves in the `(p, Z)` and `(p, A/A0)` planes.
+//! over a range (`afm::map::regime_map`), as curves in the `(p, Z)` and `(p, A/A0)` planes.
 
 use afm::{regime_map, Case, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings, TappingModel};
 use anyhow::{bail, Context, Result};
@@ -143,7 +143,7 @@ pub fn map_settings(args: &MapArgs, model: &TappingModel) -> Result<RegimeMapSet
     })
 }
 
-/// The regime map of `case` over `axis` with `settings` ([`afm::regime_map`]); an error when a
+/// The regime map of `case` over `axis` with `settings` ([`afm::map::regime_map`]); an error when a
 /// curve asked for by its label does not start at the case's own value.
 pub fn compute_map(
     case: &Case,

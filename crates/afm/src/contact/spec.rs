@@ -8,8 +8,8 @@ use super::{
     ContactLaw, DmtContact, DoubleLayer, FilmContact, FilmCorrection, HertzShape, HertzTip,
     KelvinVoigtContact, TipSampleForce,
 };
+use crate::error::AfmError;
 use crate::validation::{check, invalid, Interval};
-use crate::AfmError;
 
 fn clip_by_default() -> bool {
     true

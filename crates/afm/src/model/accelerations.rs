@@ -10,9 +10,9 @@ use nalgebra::DMatrix;
 
 use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
 use crate::contact::ContactLaw;
-use crate::contact_series::{self, SeriesForce};
-use crate::modal_constants::{grid_spacing, KEPT_GRIDS};
-use crate::phase;
+use crate::model::contact_series::{self, SeriesForce};
+use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
+use crate::model::phase;
 
 /// Offered only when no force acts outside contact ([`HybridSystem::accelerations`]): then
 /// every mode outside contact (`FREE_FLIGHT`, and a clipped Kelvin-Voigt law's free mode on

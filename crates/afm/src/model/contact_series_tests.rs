@@ -7,8 +7,10 @@ use hybrid::{
 };
 use nalgebra::DMatrix;
 
+use crate::fixtures::builtin_case;
+use crate::model::separation::Separation;
+use crate::model::TappingModel;
 use crate::model::CONTACT;
-use crate::{builtin_case, Separation, TappingModel};
 
 const ORDER: usize = 24;
 

@@ -7,7 +7,7 @@ use crate::contact::ForceSlopes;
 use nalgebra::DMatrix;
 
 use super::{TappingModel, CLIPPED, GAP_SURFACE, RELEASE_SURFACE};
-use crate::phase;
+use crate::model::phase;
 
 impl HybridSystem for TappingModel {
     fn dim(&self) -> usize {

@@ -1,7 +1,7 @@
 //! Tests of the model's performance overrides and accelerations against the plain definitions.
 
 use super::*;
-use crate::builtin_case;
+use crate::fixtures::builtin_case;
 use hybrid::{ExactFlow, SwitchingStructure};
 use nalgebra::DMatrix;
 

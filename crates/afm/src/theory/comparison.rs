@@ -8,7 +8,9 @@ use serde::Serialize;
 
 use super::validity::{AssumptionFailure, THEORY_MAX_CONTACT_PERIODS, THEORY_MIN_SEPARATION_NM};
 use super::{measure_impacts, ImpactMeasurement, ImpactPrediction, ImpactTheory};
-use crate::{AfmError, SteadyOrbit, TappingModel};
+use crate::error::AfmError;
+use crate::model::TappingModel;
+use crate::orbit::steady_orbit::SteadyOrbit;
 
 /// Predictions and measurements side by side for one orbit.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -8,7 +8,7 @@
 //!
 //! **What "the ringing of `q_2`" means here.** On the orbit, `q_2` is the sum of its free
 //! steady response to the drive (`F_2 = r_2 F_1 != 0`, known in closed form:
-//! [`crate::FreeResponse`]) and of the response to the tip-sample force. Eq. 4 sets `F_2 = 0`;
+//! [`crate::model::free_response::FreeResponse`]) and of the response to the tip-sample force. Eq. 4 sets `F_2 = 0`;
 //! since Eq. 1 is linear in free flight, the difference `h = q_2 - q_2^free` is, between
 //! impacts, exactly a free damped oscillation `h = C e^{-(t - t_0)/tau} sin(w_2d (t - t_0) + psi)`
 //! with `tau = 2 Q_2 / w_2`. Its envelope `C` and phase `psi` follow from `(h, h')` at any
@@ -24,10 +24,13 @@ use hybrid::{
 };
 use serde::Serialize;
 
-use crate::gauss_legendre::{ClockNode, GAUSS_LEGENDRE_8};
+use crate::error::AfmError;
+use crate::model::separation::Separation;
+use crate::model::TappingModel;
 use crate::model::GAP_SURFACE;
+use crate::orbit::gauss_legendre::{ClockNode, GAUSS_LEGENDRE_8};
+use crate::orbit::steady_orbit::SteadyOrbit;
 use crate::validation::invalid;
-use crate::{AfmError, Separation, SteadyOrbit, TappingModel};
 
 /// One impact of the orbit with its impulse (MODEL.md section 5).
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -6,7 +6,9 @@ use std::f64::consts::PI;
 
 use serde::Serialize;
 
-use crate::{AfmError, MultipleImpactNumbers, TappingModel};
+use crate::error::AfmError;
+use crate::model::TappingModel;
+use crate::theory::impact_numbers::MultipleImpactNumbers;
 
 /// Relative difference between the drive frequency and `f_1` below which the drive counts as
 /// "at `w_1`" (the paper's assumption `w = w_1`, under which Eq. 3 is derived).

@@ -1,0 +1,423 @@
+//! The bifurcation diagram of the tapping cantilever in the separation `Z`: the branch of
+//! periodic orbits continued by pseudo-arclength from the free orbit above first contact down to
+//! a floor (the paper's approach, Fig. 2), or back up (retract), with the observables of every
+//! branch point and every special point (grazing `G_n`, folds, period doubling, ...) located to
+//! `|dZ| < 1e-9 nm` (MODEL.md section 5).
+
+use continuation::{
+    BranchPoint, Continuation, ContinuationSettings, HybridPeriodicProblem, ParameterDirection,
+    Parametrised, SpecialPoint, SpecialPointKind, StopReason,
+};
+use nalgebra::Complex;
+use serde::Serialize;
+
+use crate::error::AfmError;
+use crate::model::separation::Separation;
+use crate::model::TappingModel;
+use crate::orbit::observables::{orbit_observables, GapMinimum, OrbitObservables};
+use crate::orbit::steady_orbit::SteadyOrbitSettings;
+
+/// How a diagram is computed. [`DiagramSettings::approach`] and [`DiagramSettings::retract`]
+/// give the defaults; every field is checked by [`DiagramSettings::validate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiagramSettings {
+    /// Integration and Newton settings of every orbit.
+    pub orbit: SteadyOrbitSettings,
+    /// Direction of `Z` at the start: decreasing for an approach, increasing for a retract.
+    pub direction: ParameterDirection,
+    /// The branch stops at this separation, nm (the floor of an approach or the ceiling of a
+    /// retract; a last point is computed exactly there).
+    pub z_limit_nm: f64,
+    /// An approach also stops once `A/A0` falls below this ratio (default 0.3). In `[0, 1)`.
+    pub min_amplitude_ratio: f64,
+    /// Largest arclength step in the `(x, Z)` space, nm and nm/us (default `A0 / 250`, so that
+    /// a diagram from first contact to `A/A0 = 0.3` has several hundred points). `> 0`.
+    pub max_step: f64,
+    /// Largest number of branch points (default 20000). `>= 2`.
+    pub max_points: usize,
+}
+
+impl DiagramSettings {
+    /// The approach of `model`: from `Z_G1 + 0.02 A0` down to `Z = 0.05 A0` or `A/A0 = 0.3`,
+    /// whichever comes first (the brief's floor: a small fraction of A0, or A/A0 = 0.3).
+    pub fn approach(model: &TappingModel) -> Self {
+        let a0 = model.free_amplitude_nm();
+        Self {
+            orbit: SteadyOrbitSettings::default(),
+            direction: ParameterDirection::Decreasing,
+            z_limit_nm: 0.05 * a0,
+            min_amplitude_ratio: 0.3,
+            max_step: a0 / 250.0,
+            max_points: 20_000,
+        }
+    }
+
+    /// The retract of `model`: from the lowest point of an approach up to above first contact.
+    pub fn retract(model: &TappingModel) -> Self {
+        let a0 = model.free_amplitude_nm();
+        Self {
+            direction: ParameterDirection::Increasing,
+            z_limit_nm: model.grazing_separation_nm() + 0.02 * a0,
+            min_amplitude_ratio: 0.0,
+            ..Self::approach(model)
+        }
+    }
+
+    /// Check every field against its documented range.
+    pub fn validate(&self) -> Result<(), AfmError> {
+        self.orbit.validate()?;
+        let invalid = |field: &str, value: String, allowed: &str| AfmError::InvalidField {
+            file: String::from("diagram settings"),
+            field: field.to_string(),
+            value,
+            allowed: allowed.to_string(),
+        };
+        if !self.z_limit_nm.is_finite() {
+            return Err(invalid(
+                "z_limit_nm",
+                self.z_limit_nm.to_string(),
+                "a finite separation, nm",
+            ));
+        }
+        if !(0.0..1.0).contains(&self.min_amplitude_ratio) {
+            return Err(invalid(
+                "min_amplitude_ratio",
+                self.min_amplitude_ratio.to_string(),
+                "0 <= ratio < 1",
+            ));
+        }
+        if !(self.max_step.is_finite() && self.max_step > 0.0) {
+            return Err(invalid(
+                "max_step",
+                self.max_step.to_string(),
+                "> 0, finite",
+            ));
+        }
+        if self.max_points < 2 {
+            return Err(invalid("max_points", self.max_points.to_string(), ">= 2"));
+        }
+        Ok(())
+    }
+}
+
+/// One point of the diagram: a periodic orbit at a separation, with its observables. The
+/// branch is one of period-1 orbits (the period map over one drive period), so its orbits have
+/// multiplicity 1 and an integer number of impacts per period.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagramPoint {
+    /// Separation `Z`, nm.
+    pub z_nm: f64,
+    /// `A / A0` of the photodiode signal's first harmonic.
+    pub amplitude_ratio: f64,
+    /// Phase lag `Phi` of that harmonic, degrees.
+    pub phase_deg: f64,
+    /// The orbit's period in drive periods (always 1 on the branch).
+    pub multiplicity: usize,
+    /// Impacts per drive period (impacts over the orbit over its multiplicity).
+    pub impacts_per_period: f64,
+    /// Impacts over the whole orbit.
+    pub impacts_per_orbit: usize,
+    /// Every local minimum of the gap over the period.
+    pub gap_minima: Vec<GapMinimum>,
+    /// The lowest of `gap_minima`, nm (`None` if there is none).
+    pub min_gap_nm: Option<f64>,
+    /// Largest tip-sample force, nN.
+    pub peak_force_nn: f64,
+    /// Mean tip-sample force over the period, nN.
+    pub mean_force_nn: f64,
+    /// Impulse `int F_ts dt` per drive period, nN us.
+    pub impulse_nn_us: f64,
+    /// Time in contact per drive period, in periods.
+    pub contact_time_periods: f64,
+    /// Floquet multipliers `[re, im]`, by decreasing modulus.
+    pub floquet_multipliers: Vec<[f64; 2]>,
+    /// The largest modulus of the Floquet multipliers.
+    pub spectral_radius: f64,
+    /// Whether every multiplier lies inside the unit circle.
+    pub stable: bool,
+    /// The orbit's state at `t = 0`, `[q_1, q_1', ..., q_N, q_N']` (nm, nm/us).
+    pub state: Vec<f64>,
+    /// Newton updates of the corrector at this point.
+    pub iterations: usize,
+    /// `|P(x) - x|` at this point (state units).
+    pub residual: f64,
+}
+
+/// A located special point with the observables of its orbit.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagramSpecialPoint {
+    /// `G1`, `G2`, ... (grazing onset of n impacts on approach; the same name when met on a
+    /// retract), `fold`, `period-doubling`,
+    /// `neimark-sacker`, `merge`, `split`, `impact-vanish`, `impact-appear`, ...
+    pub label: String,
+    /// Separation `Z` at the point, nm.
+    pub z_nm: f64,
+    /// `A / A0` there.
+    pub amplitude_ratio: f64,
+    /// Phase lag there, degrees.
+    pub phase_deg: f64,
+    /// Impacts per period on the side before the point (in the direction of continuation).
+    pub impacts_before: usize,
+    /// Impacts per period after it.
+    pub impacts_after: usize,
+    /// The Z range `[Z_low, Z_high]` of the final location bracket along the branch and of the
+    /// point, nm. At a fold `Z` is extremal: both ends of the branch bracket lie on one side of
+    /// the fold's `Z`, so one end of this range is the point itself.
+    pub bracket_nm: [f64; 2],
+    /// Achieved precision of `Z`, nm.
+    pub precision_nm: f64,
+    /// Whether the location reached its tolerance.
+    pub converged: bool,
+    /// The orbit's state at the point.
+    pub state: Vec<f64>,
+}
+
+/// A computed diagram.
+#[derive(Debug, Clone, Serialize)]
+pub struct BifurcationDiagram {
+    /// Branch points in branch order.
+    pub points: Vec<DiagramPoint>,
+    /// Special points in branch order.
+    pub special_points: Vec<DiagramSpecialPoint>,
+    /// Why the branch ended, in words.
+    pub stop: String,
+    /// Whether the branch reached its requested end (the separation limit, or an approach's
+    /// amplitude-ratio floor); false when the point cap, a failed corrector or an error ended
+    /// it first.
+    pub completed: bool,
+    /// The error that ended the branch early, if any, in words.
+    pub error: Option<String>,
+}
+
+impl BifurcationDiagram {
+    /// The separation ranges where the branch holds two or more stable orbits at the same `Z`
+    /// (hysteresis: an approach and a retract follow different ones there), as sorted
+    /// `[Z_low, Z_high]` intervals, nm. Computed from the branch's stable segments (consecutive
+    /// stable points): a `Z` covered by two or more of them is bistable.
+    pub fn bistable_ranges(&self) -> Vec<[f64; 2]> {
+        let segments: Vec<[f64; 2]> = self
+            .points
+            .windows(2)
+            .filter(|w| w[0].stable && w[1].stable)
+            .map(|w| [w[0].z_nm.min(w[1].z_nm), w[0].z_nm.max(w[1].z_nm)])
+            .collect();
+        let mut edges: Vec<f64> = self.points.iter().map(|p| p.z_nm).collect();
+        edges.sort_by(f64::total_cmp);
+        edges.dedup();
+        let mut ranges: Vec<[f64; 2]> = Vec::new();
+        for pair in edges.windows(2) {
+            let middle = 0.5 * (pair[0] + pair[1]);
+            let cover = segments
+                .iter()
+                .filter(|s| s[0] < middle && middle < s[1])
+                .count();
+            if cover < 2 {
+                continue;
+            }
+            match ranges.last_mut() {
+                Some(last) if last[1] == pair[0] => last[1] = pair[1],
+                _ => ranges.push([pair[0], pair[1]]),
+            }
+        }
+        ranges
+    }
+}
+
+/// The approach diagram of `model` (its separation is ignored): the branch from the free orbit
+/// at `Z_G1 + 0.02 A0` with `Z` decreasing, continued through every grazing and fold.
+pub fn approach_diagram(
+    model: &TappingModel,
+    settings: &DiagramSettings,
+) -> Result<BifurcationDiagram, AfmError> {
+    approach_diagram_until(model, settings, &mut || false)
+}
+
+/// As [`approach_diagram`], asking `interrupted` after every branch point whether to give up:
+/// when it answers `true` the computation ends with [`AfmError::Interrupted`] (a caller's
+/// Ctrl-C or cancel button).
+pub fn approach_diagram_until(
+    model: &TappingModel,
+    settings: &DiagramSettings,
+    interrupted: &mut dyn FnMut() -> bool,
+) -> Result<BifurcationDiagram, AfmError> {
+    let z_start = model.grazing_separation_nm() + 0.02 * model.free_amplitude_nm();
+    diagram_until(model, &model.free_state(), z_start, settings, interrupted)
+}
+
+/// The diagram of `model` continued from the periodic orbit near `x0` at `z_start` in the
+/// direction and to the limit of `settings`.
+pub fn diagram(
+    model: &TappingModel,
+    x0: &[f64],
+    z_start: f64,
+    settings: &DiagramSettings,
+) -> Result<BifurcationDiagram, AfmError> {
+    diagram_until(model, x0, z_start, settings, &mut || false)
+}
+
+/// As [`diagram`], asking `interrupted` after every branch point whether to give up: when it
+/// answers `true` the computation ends with [`AfmError::Interrupted`].
+pub fn diagram_until(
+    model: &TappingModel,
+    x0: &[f64],
+    z_start: f64,
+    settings: &DiagramSettings,
+    interrupted: &mut dyn FnMut() -> bool,
+) -> Result<BifurcationDiagram, AfmError> {
+    settings.validate()?;
+    let mut system = model.clone();
+    system.set_separation(Separation::Constant(z_start))?;
+    let problem =
+        HybridPeriodicProblem::new(system.clone(), 1, settings.orbit.integration.clone())?;
+    let (parameter_min, parameter_max) = match settings.direction {
+        ParameterDirection::Decreasing => (settings.z_limit_nm, f64::INFINITY),
+        ParameterDirection::Increasing => (f64::NEG_INFINITY, settings.z_limit_nm),
+    };
+    let continuation_settings = ContinuationSettings {
+        initial_step: settings.max_step * 0.1,
+        max_step: settings.max_step,
+        direction: settings.direction,
+        parameter_min,
+        parameter_max,
+        max_points: settings.max_points,
+        corrector: settings.orbit.newton.clone(),
+        ..ContinuationSettings::default()
+    };
+    let a0 = model.free_amplitude_nm();
+    let min_ratio = settings.min_amplitude_ratio;
+    let integration = settings.orbit.integration.clone();
+    // Observables are computed once per point, inside the stop predicate, and kept.
+    let mut observed: Vec<Result<OrbitObservables, AfmError>> = Vec::new();
+    let mut was_interrupted = false;
+    let branch = {
+        let observed = &mut observed;
+        let was_interrupted = &mut was_interrupted;
+        let mut at_point = system.clone();
+        Continuation::new(&problem, x0, z_start, continuation_settings)?
+            .stop_when(move |point: &BranchPoint| {
+                if interrupted() {
+                    *was_interrupted = true;
+                    return true;
+                }
+                at_point.set_parameter(point.parameter);
+                let observables =
+                    orbit_observables(&at_point, point.state.as_slice(), &integration);
+                let stop = match &observables {
+                    Ok(o) => o.amplitude_nm / a0 < min_ratio,
+                    Err(_) => true,
+                };
+                observed.push(observables);
+                stop
+            })
+            .run()
+    };
+    if was_interrupted {
+        return Err(AfmError::Interrupted);
+    }
+    let mut points = Vec::with_capacity(branch.points.len());
+    for (point, observables) in branch.points.iter().zip(observed) {
+        points.push(diagram_point(point, &observables?));
+    }
+    let mut special_points = Vec::with_capacity(branch.special_points.len());
+    for special in &branch.special_points {
+        special_points.push(diagram_special_point(
+            &system,
+            special,
+            &settings.orbit.integration,
+        )?);
+    }
+    Ok(BifurcationDiagram {
+        points,
+        special_points,
+        stop: stop_words(branch.stop),
+        completed: matches!(
+            branch.stop,
+            StopReason::ParameterBound | StopReason::UserStop
+        ),
+        error: branch.error.map(|e| e.to_string()),
+    })
+}
+
+fn stop_words(stop: StopReason) -> String {
+    match stop {
+        StopReason::MaxPoints => "the maximum number of points was reached",
+        StopReason::ParameterBound => "the separation limit was reached",
+        StopReason::UserStop => "the amplitude ratio fell below its floor",
+        StopReason::StepTooSmall => "the corrector failed at the smallest step",
+        StopReason::Error => "an error ended the branch",
+    }
+    .to_string()
+}
+
+fn multipliers_of(multipliers: &[Complex<f64>]) -> Vec<[f64; 2]> {
+    multipliers.iter().map(|m| [m.re, m.im]).collect()
+}
+
+fn diagram_point(point: &BranchPoint, observables: &OrbitObservables) -> DiagramPoint {
+    let min_gap = observables.min_gap_nm();
+    DiagramPoint {
+        z_nm: point.parameter,
+        amplitude_ratio: observables.amplitude_ratio,
+        phase_deg: observables.phase_deg,
+        multiplicity: observables.window_periods,
+        impacts_per_period: observables.impacts_per_period,
+        impacts_per_orbit: observables.impacts_per_window(),
+        gap_minima: observables.gap_minima.clone(),
+        min_gap_nm: min_gap.is_finite().then_some(min_gap),
+        peak_force_nn: observables.peak_force_nn,
+        mean_force_nn: observables.mean_force_nn,
+        impulse_nn_us: observables.impulse_nn_us,
+        contact_time_periods: observables.contact_time_periods,
+        floquet_multipliers: multipliers_of(&point.multipliers),
+        spectral_radius: continuation::spectral_radius(&point.multipliers),
+        stable: point.stable,
+        state: point.state.as_slice().to_vec(),
+        iterations: point.iterations,
+        residual: point.residual,
+    }
+}
+
+fn diagram_special_point(
+    system: &TappingModel,
+    special: &SpecialPoint,
+    integration: &hybrid::Settings,
+) -> Result<DiagramSpecialPoint, AfmError> {
+    let mut at_point = system.clone();
+    at_point.set_parameter(special.parameter);
+    let observables = orbit_observables(&at_point, special.state.as_slice(), integration)?;
+    // A grazing is named after the impact count on its impacting side, whichever way the
+    // branch runs: G_n is the onset of n impacts per period on approach (MODEL.md section 5),
+    // and the same point met on a retract (n -> n - 1) keeps its name.
+    let label = match special.kind {
+        SpecialPointKind::Grazing => {
+            format!("G{}", special.impacts_before.max(special.impacts_after))
+        }
+        _ => special.label.clone(),
+    };
+    Ok(DiagramSpecialPoint {
+        label,
+        z_nm: special.parameter,
+        amplitude_ratio: observables.amplitude_ratio,
+        phase_deg: observables.phase_deg,
+        impacts_before: special.impacts_before,
+        impacts_after: special.impacts_after,
+        // The location brackets the point along the branch; at a fold both ends of that
+        // bracket lie on one side of the fold's Z (Z is extremal there), so the Z range
+        // reported spans the ends and the point itself.
+        bracket_nm: [
+            special
+                .bracket
+                .0
+                .min(special.bracket.1)
+                .min(special.parameter),
+            special
+                .bracket
+                .0
+                .max(special.bracket.1)
+                .max(special.parameter),
+        ],
+        precision_nm: special.precision,
+        converged: special.converged,
+        state: special.state.as_slice().to_vec(),
+    })
+}

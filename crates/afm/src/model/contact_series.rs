@@ -1,0 +1,489 @@
+//! The Taylor series of Eq. 1 in Hertz contact (and DMT's shifted Hertz contact and van der
+//! Waals free flight, [`SeriesForce`]; MODEL.md section 9), by the recurrences of automatic
+//! differentiation, in the clock offset `s` of a solver step (`t = t(s)`, a quadratic
+//! [`ClockPolynomial`]).
+//!
+//! For van der Waals, `F_ts = -A u^2` with `u = 1/d`, whose coefficients follow from
+//! `u d = 1`.
+//!
+//! With `tau = dt/ds` and the indentation `delta = -d`, each mode obeys
+//! `dq_i/ds = tau v_i`, `dv_i/ds = tau R_i`, `R_i = (w_i^2 F_i / k_i) cos(w t) + (w_i^2/k_i)
+//! F_ts - w_i^2 q_i - (w_i/Q_i) v_i` (MODEL.md section 1), and `F_ts = c delta^{3/2} = c delta
+//! r`, `r = sqrt(delta)`. Coefficient `k` of every product is a convolution, `r_k` follows
+//! from `r^2 = delta` and `cos(w t(s))`, `sin(w t(s))` from their derivatives `-/+ w tau sin,
+//! cos`: `O(k)` work for coefficient `k` (Moore 1966; Jorba and Zou 2005). `tau = a + 2 b s`
+//! (`a` the clock's rate, `b` its curvature) has two coefficients, so coefficient `k` of `tau
+//! y` is `a y_k + 2 b y_{k-1}`; `R` being linear in `cos`, `F_ts`, `q_i`, `v_i`, the
+//! recurrences form `tau R` from those products rather than `R` at two powers.
+//!
+//! At the start of contact on the square-root clock centred there (`tau(0) = 0`), `delta` has a
+//! double zero, `delta = s^2 g(s)`: then `r = s sqrt(g)` and `F_ts = c s^3 g sqrt(g)`, whose
+//! coefficients follow from those of `g` (the recurrences never divide by `r_0 = 0`). That is
+//! the point of the square-root clock: the contact is analytic in `s` there, not in `t`.
+
+use hybrid::{ClockPolynomial, TaylorSeries};
+
+use crate::model::modal_constants::ModalConstants;
+use crate::model::phase;
+use crate::model::separation::Separation;
+
+/// The highest Taylor order the contact series is computed to (the recurrences keep their
+/// intermediate series on the stack).
+pub const MAX_ORDER: usize = 40;
+
+/// The tip-sample force a series expands Eq. 1 with (MODEL.md sections 1 and 9).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum SeriesForce {
+    /// `c s^{3/2} - constant` (nN), `s = d_c - d` the indentation below the contact surface
+    /// `d = d_c`: the Hertz sphere (`d_c = 0`, no constant) or DMT in contact (`d_c = a0`,
+    /// `constant = H R / (6 a0^2)`).
+    Hertz {
+        /// `c = (4/3) E* sqrt(R)`, nN/nm^{3/2}.
+        coefficient: f64,
+        /// `d_c`, nm.
+        contact_gap: f64,
+        /// The constant subtracted, nN.
+        constant: f64,
+    },
+    /// `-A / d^2` (nN) with `A = H R / 6` (nN nm): DMT's van der Waals force outside contact.
+    VanDerWaals {
+        /// `A`, nN nm.
+        scale: f64,
+    },
+}
+
+/// The separation `Z(t(s))`'s coefficients `0..=2` (`Z` constant or a linear ramp in `t`, `t`
+/// quadratic in `s`: the higher ones vanish).
+#[inline]
+fn separation_coefficients(separation: &Separation, clock: &ClockPolynomial) -> [f64; 3] {
+    let rate = separation.rate();
+    [
+        separation.at(clock.start),
+        rate * clock.rate,
+        rate * clock.curvature,
+    ]
+}
+
+/// `Z(t(s)) - d_c`'s coefficients: the indentation below the contact surface is then
+/// `-(Z - d_c + sum_i q_i)` (`d_c = 0`, no shift, for every force but DMT's contact).
+#[inline]
+fn shifted_separation(
+    separation: &Separation,
+    clock: &ClockPolynomial,
+    force: SeriesForce,
+) -> [f64; 3] {
+    let mut coefficients = separation_coefficients(separation, clock);
+    if let SeriesForce::Hertz { contact_gap, .. } = force {
+        if contact_gap != 0.0 {
+            coefficients[0] -= contact_gap;
+        }
+    }
+    coefficients
+}
+
+/// Coefficient `k` of `u = 1/g` from `g`'s coefficients to `k` and `u`'s to `k - 1`:
+/// `u_0 = 1/g_0`, `u_k = -(sum_{j=1}^{k} g_j u_{k-j}) / g_0`; here from the indentation
+/// `delta = -g`.
+#[inline]
+fn update_reciprocal_gap(reciprocal: &mut [f64], delta: &[f64], k: usize) {
+    reciprocal[k] = if k == 0 {
+        -1.0 / delta[0]
+    } else {
+        -convolution(&delta[1..=k], &reciprocal[..k]) / delta[0]
+    };
+}
+
+/// Coefficient `m` of the product of two series from their coefficients `0..=m`, `a` and `b`
+/// (`b` at least as long as `a`, of length `m + 1`): `sum_{j=0}^{m} a_j b_{m-j}`.
+#[inline]
+fn convolution(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b[..a.len()].iter().rev())
+        .map(|(x, y)| x * y)
+        .sum()
+}
+
+/// Coefficient `k` of `r = sqrt(y)` from `y`'s coefficients to `k` and `r`'s to `k - 1`
+/// (`r_0 = sqrt(y_0)` at `k = 0`): `2 r_0 r_k = y_k - sum_{j=1}^{k-1} r_j r_{k-j}`, the sum
+/// being symmetric in `j <-> k - j`: twice `sum_{j=1}^{h} r_j r_{k-j}` (`h = floor((k - 1)/2)`),
+/// plus `r_{k/2}^2` for even `k`.
+#[inline(always)]
+fn update_root(root: &mut [f64], y: &[f64], k: usize) {
+    root[k] = if k == 0 {
+        y[0].sqrt()
+    } else {
+        let h = (k - 1) / 2;
+        let mut middle = 2.0 * convolution(&root[1..=h], &root[k - h..k]);
+        if k.is_multiple_of(2) {
+            middle += root[k / 2] * root[k / 2];
+        }
+        (y[k] - middle) / (2.0 * root[0])
+    };
+}
+
+/// Coefficient `k` of the indentation `delta = -(Z(t(s)) + sum_i q_i)` from the state's
+/// coefficient row `k` (`[q_1, v_1, ...]`) and `Z(t(s))`'s coefficients `separation`.
+#[inline]
+fn indentation_coefficient(separation: &[f64; 3], row: &[f64], k: usize) -> f64 {
+    let gap: f64 = row.chunks_exact(2).map(|qv| qv[0]).sum();
+    -(separation.get(k).copied().unwrap_or(0.0) + gap)
+}
+
+/// Coefficient `m` of `r = sqrt(delta)` from `delta`'s coefficients and `r`'s below `m`. Off
+/// an onset, `delta_0 > 0` and [`update_root`] applies (it needs `delta` to `m`). On an onset
+/// (`delta = s^2 g`, `g_j = delta_{j+2}`), `r = s sqrt(g)`: `r_0 = 0` and `r_m = sqrt(g)_{m-1}`
+/// (it needs `delta` to `m + 1`).
+#[inline]
+fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
+    if !onset {
+        update_root(root, delta, m);
+    } else if m == 0 {
+        root[0] = 0.0;
+    } else {
+        update_root(&mut root[1..], &delta[2..], m - 1);
+    }
+}
+
+/// The Taylor coefficients of the flow of Eq. 1 with the force `force` (`N` modes `modes`,
+/// drive `w` rad/us, separation `separation`) in the clock offset `s` of `clock`, through the
+/// state held in the constant terms of `series` (`2N` components, `q_i`, `q_i'` in nm, nm/us);
+/// `false` (series unusable) if the order exceeds [`MAX_ORDER`], the state is on the wrong
+/// side of the force's surface (Hertz: `d >= d_c` where the clock runs at a finite rate; van
+/// der Waals: `d <= 0` or a square-root clock), the
+/// indentation does not grow from the surface at an onset (a grazing touch, not analytic in
+/// `s`), or a coefficient is not finite. A clock whose rate is zero at the start (`tau(0) = 0`)
+/// is the square-root clock centred on the crossing that entered contact (the only place a step
+/// starts from one): the state there is taken to be on the surface (`delta_0 = 0`, whatever its
+/// rounding).
+pub(crate) fn contact_state_series(
+    modes: &[ModalConstants],
+    force: SeriesForce,
+    drive_frequency: f64,
+    separation: &Separation,
+    clock: &ClockPolynomial,
+    series: &mut TaylorSeries,
+) -> bool {
+    if series.order() > MAX_ORDER || series.dim() != 2 * modes.len() {
+        return false;
+    }
+    let separation = shifted_separation(separation, clock, force);
+    // The common mode counts as constants, so that the loops over modes unroll.
+    let mut run =
+        |modes| state_recurrence(modes, force, drive_frequency, &separation, clock, series);
+    match modes.len() {
+        1 => run(&modes[..1]),
+        2 => run(&modes[..2]),
+        3 => run(&modes[..3]),
+        _ => run(modes),
+    }
+}
+
+/// Coefficient `k` of the force series from the indentation's coefficients to `k` (to
+/// `k + 1` at an onset) and the auxiliary series `root` (the indentation's square root for
+/// Hertz, the reciprocal gap `1/d` for van der Waals) below `k`, which it extends; `None` where
+/// the series does not exist (van der Waals on or inside the surface, or at an onset).
+#[inline(always)]
+fn force_coefficient(
+    law: SeriesForce,
+    root: &mut [f64],
+    delta: &[f64],
+    k: usize,
+    onset: bool,
+) -> Option<f64> {
+    match law {
+        SeriesForce::Hertz {
+            coefficient,
+            constant,
+            ..
+        } => {
+            let mut value = if onset {
+                // delta_0 = delta_1 = 0: delta = s^2 g (g_j = delta_{j+2}), r = s sqrt(g),
+                // F = c s^3 g sqrt(g); coefficient k needs g and sqrt(g) = r_{.+1} to k - 3.
+                if k >= 3 {
+                    indentation_root(root, delta, k - 2, true);
+                    coefficient * convolution(&delta[2..k], &root[1..k - 1])
+                } else {
+                    0.0
+                }
+            } else {
+                indentation_root(root, delta, k, false);
+                coefficient * convolution(&delta[..=k], &root[..=k])
+            };
+            if k == 0 && constant != 0.0 {
+                value -= constant;
+            }
+            Some(value)
+        }
+        SeriesForce::VanDerWaals { scale } => {
+            // -A / d^2 = -A u^2, u = 1/d, only off the surface on the time clock.
+            if onset || delta[0] >= 0.0 {
+                return None;
+            }
+            update_reciprocal_gap(root, delta, k);
+            Some(-scale * convolution(&root[..=k], &root[..=k]))
+        }
+    }
+}
+
+/// The recurrence of [`contact_state_series`] (`Z(t(s))`'s coefficients `separation`), inlined
+/// into each call so that a constant mode count unrolls its loops over modes.
+#[inline(always)]
+fn state_recurrence(
+    modes: &[ModalConstants],
+    law: SeriesForce,
+    drive_frequency: f64,
+    separation: &[f64; 3],
+    clock: &ClockPolynomial,
+    series: &mut TaylorSeries,
+) -> bool {
+    let p = series.order();
+    let n = 2 * modes.len();
+    let (a, b2) = (clock.rate, 2.0 * clock.curvature);
+    let onset = a == 0.0;
+    let mut cos = [0.0; MAX_ORDER + 1];
+    let mut sin = [0.0; MAX_ORDER + 1];
+    let mut delta = [0.0; MAX_ORDER + 1];
+    let mut root = [0.0; MAX_ORDER + 1];
+    let mut force = [0.0; MAX_ORDER + 1];
+    (sin[0], cos[0]) = phase::sin_cos(drive_frequency * clock.start);
+    let x = series.coefficients_mut();
+    // The sum of every coefficient and force, finite only if each of them is (or rejecting
+    // coefficients near f64::MAX, of no use either).
+    let mut total: f64 = x[..n].iter().sum();
+    for k in 0..p {
+        let (done, rest) = x.split_at_mut((k + 1) * n);
+        let (earlier, row) = done.split_at(k * n);
+        let next = &mut rest[..n];
+        delta[k] = indentation_coefficient(separation, row, k);
+        match force_coefficient(law, &mut root, &delta, k, onset) {
+            Some(value) => force[k] = value,
+            None => return false,
+        }
+        total += force[k];
+        // y' = tau z: y_{k+1} = (a z_k + b2 z_{k-1}) / (k + 1), z_{-1} = 0 (the coefficient
+        // below k is row k itself at k = 0, times zero).
+        let scale = 1.0 / (k + 1) as f64;
+        let rate = a * scale;
+        let (curvature, below, previous) = if k > 0 {
+            (b2 * scale, k - 1, &earlier[(k - 1) * n..])
+        } else {
+            (0.0, 0, row)
+        };
+        // The drive phase: (cos)' = -w tau sin, (sin)' = w tau cos.
+        let tau_cos = rate * cos[k] + curvature * cos[below];
+        let tau_sin = rate * sin[k] + curvature * sin[below];
+        let tau_force = rate * force[k] + curvature * force[below];
+        cos[k + 1] = -drive_frequency * tau_sin;
+        sin[k + 1] = drive_frequency * tau_cos;
+        for ((m, out), (qv, previous_qv)) in modes
+            .iter()
+            .zip(next.chunks_exact_mut(2))
+            .zip(row.chunks_exact(2).zip(previous.chunks_exact(2)))
+        {
+            let tau_q = rate * qv[0] + curvature * previous_qv[0];
+            let tau_v = rate * qv[1] + curvature * previous_qv[1];
+            out[0] = tau_v;
+            out[1] = m.drive_acceleration * tau_cos + m.omega_squared_over_stiffness * tau_force
+                - m.omega_squared * tau_q
+                - m.damping * tau_v;
+            total += out[0] + out[1];
+        }
+    }
+    total.is_finite()
+}
+
+/// The Taylor coefficients of the tangent matrix `V` (`2N` rows: the transition matrix's
+/// columns, then, with `parameter_column`, `dx/dZ`) along the contact flow whose state series is
+/// `state` (from [`contact_state_series`] with the same arguments): `dV/ds = tau J(t(s), x(s))
+/// V` (`+ tau df/dZ` on the parameter column), `J`'s contact part being `(w_i^2/k_i) F_ts'(d)`
+/// on every `q_j` with `F_ts' = -(3/2) c r` (Hertz) or `2 A / d^3` (van der Waals). Each coefficient of `tangents` is `V`'s row-major
+/// matrix (component `row * columns + column`); the constant terms hold `V` at the step start.
+/// `gaps` is scratch space (resized here).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn contact_tangent_series(
+    modes: &[ModalConstants],
+    force: SeriesForce,
+    separation: &Separation,
+    clock: &ClockPolynomial,
+    state: &TaylorSeries,
+    tangents: &mut TaylorSeries,
+    parameter_column: bool,
+    gaps: &mut Vec<f64>,
+) {
+    let p = tangents.order().min(state.order());
+    let n = state.dim();
+    let (a, b2) = (clock.rate, 2.0 * clock.curvature);
+    let separation = shifted_separation(separation, clock, force);
+    // The series of F_ts'(d) / slope to order p - 1 (all the recurrence below uses; on an
+    // onset it needs the indentation to order p): the indentation's square root for Hertz
+    // (`F' = -(3/2) c r`), `u^3 = 1/d^3` for van der Waals (`F' = 2 A u^3`).
+    let mut delta = [0.0; MAX_ORDER + 1];
+    let mut root = [0.0; MAX_ORDER + 1];
+    for (k, (d, row)) in delta[..=p]
+        .iter_mut()
+        .zip(state.coefficients().chunks_exact(n))
+        .enumerate()
+    {
+        *d = indentation_coefficient(&separation, row, k);
+    }
+    let slope = match force {
+        SeriesForce::Hertz { coefficient, .. } => {
+            for m in 0..p {
+                indentation_root(&mut root, &delta, m, a == 0.0);
+            }
+            -1.5 * coefficient
+        }
+        SeriesForce::VanDerWaals { scale } => {
+            let mut reciprocal = [0.0; MAX_ORDER + 1];
+            let mut square = [0.0; MAX_ORDER + 1];
+            for m in 0..p {
+                update_reciprocal_gap(&mut reciprocal, &delta, m);
+                square[m] = convolution(&reciprocal[..=m], &reciprocal[..=m]);
+                root[m] = convolution(&square[..=m], &reciprocal[..=m]);
+            }
+            2.0 * scale
+        }
+    };
+    // Highest power first, so that the convolutions below run forward through both series.
+    let mut root_reversed = [0.0; MAX_ORDER];
+    for (reversed, r) in root_reversed.iter_mut().zip(root[..p].iter().rev()) {
+        *reversed = *r;
+    }
+    let columns = tangents.dim() / n;
+    let recurrence = TangentRecurrence {
+        modes,
+        root_reversed: &root_reversed[..p],
+        slope,
+        rate: a,
+        curvature: b2,
+        parameter_column,
+    };
+    let v = tangents.coefficients_mut();
+    // The common column counts (N = 1, 2 with and without dZ) as constants, so that the
+    // loops over columns unroll.
+    match columns {
+        2 => recurrence.run(2, v, gaps),
+        3 => recurrence.run(3, v, gaps),
+        4 => recurrence.run(4, v, gaps),
+        5 => recurrence.run(5, v, gaps),
+        _ => recurrence.run(columns, v, gaps),
+    }
+}
+
+/// The coefficients of the tangent recurrence of [`contact_tangent_series`].
+struct TangentRecurrence<'a> {
+    modes: &'a [ModalConstants],
+    /// The series of `F_ts'(d) / slope` to order `p - 1` (the indentation's square root for
+    /// Hertz), highest power first (`r_{p-1-i}` at `i`).
+    root_reversed: &'a [f64],
+    /// `-(3/2) c` (Hertz) or `2 A` (van der Waals).
+    slope: f64,
+    /// `tau = rate + curvature s` (`curvature` is twice the clock's).
+    rate: f64,
+    curvature: f64,
+    parameter_column: bool,
+}
+
+impl TangentRecurrence<'_> {
+    /// Rows `1..=p` of `v` (row-major `2N x columns` matrices) from row 0: with the gap `g =
+    /// sum_j q_j` of each column (plus `dZ/dZ = 1` on the parameter column), `(k + 1) q_{i,k+1}
+    /// = (tau v_i)_k` and `(k + 1) v_{i,k+1} = (w_i^2/k_i) (-(3/2) c) (tau r g)_k - w_i^2 (tau
+    /// q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a convolution. The columns evolve
+    /// independently along the given state series, so the recurrence runs over them in blocks
+    /// of up to [`COLUMN_BLOCK`], each block's sums kept in registers.
+    #[inline(always)]
+    fn run(&self, columns: usize, v: &mut [f64], scratch: &mut Vec<f64>) {
+        let modes = self.modes;
+        let p = self.root_reversed.len();
+        let dim = 2 * modes.len() * columns;
+        let (a, b2) = (self.rate, self.curvature);
+        // Rows of the gap's coefficients (one per power, the gap `sum_i q_i` plus, on the
+        // parameter column, `dZ/dZ = 1`) and the coupling `r gap` at the previous power.
+        scratch.resize((p + 2) * columns, 0.0);
+        let (gaps, previous_coupling) = scratch.split_at_mut((p + 1) * columns);
+        previous_coupling.fill(0.0);
+        let gap = &mut gaps[..columns];
+        gap.fill(0.0);
+        for q in v[..dim].chunks_exact(2 * columns) {
+            for (g, q) in gap.iter_mut().zip(&q[..columns]) {
+                *g += q;
+            }
+        }
+        if self.parameter_column {
+            gap[columns - 1] += 1.0;
+        }
+        let mut power = 0.0;
+        for k in 0..p {
+            let (done, after) = v.split_at_mut((k + 1) * dim);
+            let (earlier, row) = done.split_at(k * dim);
+            let next = &mut after[..dim];
+            let (gaps, next_gap) = gaps.split_at_mut((k + 1) * columns);
+            let next_gap = &mut next_gap[..columns];
+            // y' = tau z: y_{k+1} = (a z_k + b2 z_{k-1}) / (k + 1), z_{-1} = 0 (the
+            // coefficient below k is row k itself at k = 0, times zero).
+            power += 1.0;
+            let rate = a / power;
+            let (curvature, previous) = if k > 0 {
+                (b2 / power, &earlier[(k - 1) * dim..])
+            } else {
+                (0.0, row)
+            };
+            for start in (0..columns).step_by(COLUMN_BLOCK) {
+                let width = COLUMN_BLOCK.min(columns - start);
+                let block = start..start + width;
+                // The coupling's coefficient k, sum_{j=0}^{k} r_{k-j} gap_j, and tau times it.
+                let mut coupling = [0.0; COLUMN_BLOCK];
+                for (gap, r) in gaps
+                    .chunks_exact(columns)
+                    .zip(&self.root_reversed[p - 1 - k..])
+                {
+                    for (c, g) in coupling[..width].iter_mut().zip(&gap[block.clone()]) {
+                        *c += r * g;
+                    }
+                }
+                let mut tau_coupling = [0.0; COLUMN_BLOCK];
+                for ((t, c), previous) in tau_coupling[..width]
+                    .iter_mut()
+                    .zip(&coupling[..width])
+                    .zip(&mut previous_coupling[block.clone()])
+                {
+                    *t = rate * c + curvature * *previous;
+                    *previous = *c;
+                }
+                // Every mode's new coefficients formed in registers, then stored, and the
+                // gap's next coefficient summed on the way.
+                let mut gap = [0.0; COLUMN_BLOCK];
+                for ((m, out), (qv, previous_qv)) in
+                    modes.iter().zip(next.chunks_exact_mut(2 * columns)).zip(
+                        row.chunks_exact(2 * columns)
+                            .zip(previous.chunks_exact(2 * columns)),
+                    )
+                {
+                    let coupling_gain = m.omega_squared_over_stiffness * self.slope;
+                    let (q, velocity) = qv.split_at(columns);
+                    let (previous_q, previous_velocity) = previous_qv.split_at(columns);
+                    let mut new_q = [0.0; COLUMN_BLOCK];
+                    let mut new_v = [0.0; COLUMN_BLOCK];
+                    for c in 0..width {
+                        let column = start + c;
+                        let tau_q = rate * q[column] + curvature * previous_q[column];
+                        let tau_v = rate * velocity[column] + curvature * previous_velocity[column];
+                        new_q[c] = tau_v;
+                        new_v[c] = coupling_gain * tau_coupling[c]
+                            - m.omega_squared * tau_q
+                            - m.damping * tau_v;
+                        gap[c] += tau_v;
+                    }
+                    let (next_q, next_v) = out.split_at_mut(columns);
+                    next_q[block.clone()].copy_from_slice(&new_q[..width]);
+                    next_v[block.clone()].copy_from_slice(&new_v[..width]);
+                }
+                next_gap[block].copy_from_slice(&gap[..width]);
+            }
+        }
+    }
+}
+
+/// The widest block of tangent columns [`TangentRecurrence::run`] handles at once (`2N + 1`
+/// columns for `N` up to 3 in one).
+const COLUMN_BLOCK: usize = 8;

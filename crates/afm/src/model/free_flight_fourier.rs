@@ -1,0 +1,152 @@
+//! The first-harmonic Fourier integrals of the photodiode signal over a free-flight interval,
+//! in closed form (MODEL.md section 4 restricted to `F_ts = 0`):
+//!
+//! ```text
+//! J = int_a^b u(t) e^{-i w t} dt,   int u cos(w t) dt = Re J,   int u sin(w t) dt = -Im J,
+//! ```
+//!
+//! with `u = sum_i chi_i q_i` and each `q_i` the exact free flight of Eq. 1 from its state at
+//! `a`: the steady part `p_i(t) = alpha_i cos(w t) + beta_i sin(w t)` plus the homogeneous part
+//! `y_i(s) = c_1 e^{lambda_1 s} + c_2 e^{lambda_2 s}` (`s = t - a`; `lambda` the roots of
+//! `lambda^2 + (w_i/Q_i) lambda + w_i^2 = 0`, complex conjugate when under-damped, real when
+//! over-damped), each of which integrates against `e^{-i w t}` in closed form:
+//!
+//! ```text
+//! int_a^b p e^{-iwt} dt = (alpha - i beta)(b - a)/2
+//!                         + (alpha + i beta)(e^{-2iwb} - e^{-2iwa}) / (-4 i w),
+//! int_0^L c e^{lambda s} e^{-iw(a+s)} ds = c e^{-iwa} (e^{(lambda - iw) L} - 1) / (lambda - iw).
+//! ```
+//!
+//! A sweep's lock-in uses this over whole free-flight intervals (between a release and the
+//! next contact), so its cost per cycle does not grow with the number of exact-flow steps.
+
+use nalgebra::Complex;
+
+use crate::model::free_flight::DrivenOscillator;
+use crate::model::TappingModel;
+
+/// Modes closer to critical damping than this (`|1 - 4 Q^2| <` it) have nearly equal roots, for
+/// which the two-exponential form loses accuracy: [`FreeFlightFourier::new`] declines them.
+const CRITICAL_DAMPING_MARGIN: f64 = 1e-3;
+
+/// One mode's constants for the closed form.
+#[derive(Debug, Clone)]
+struct ModeFourier {
+    /// `chi_i`.
+    optical_sensitivity: f64,
+    /// `[alpha_i, beta_i]`, nm: the steady free response `alpha cos(w t) + beta sin(w t)`.
+    steady: [f64; 2],
+    /// The characteristic roots `lambda_1`, `lambda_2`, 1/us.
+    roots: [Complex<f64>; 2],
+}
+
+/// The closed-form Fourier integrals of `u` over free flight of a [`TappingModel`].
+#[derive(Debug, Clone)]
+pub struct FreeFlightFourier {
+    /// Drive angular frequency `w`, rad/us.
+    angular_frequency: f64,
+    modes: Vec<ModeFourier>,
+}
+
+impl FreeFlightFourier {
+    /// The closed form for `model`'s free flight; `None` when a mode is within 0.1% of critical
+    /// damping (`Q_i` near 1/2), where the caller should integrate numerically instead.
+    pub fn new(model: &TappingModel) -> Option<Self> {
+        let drive = model.drive();
+        let w = drive.angular_frequency;
+        let mut modes = Vec::with_capacity(model.mode_count());
+        for mode in &model.cantilever().modes {
+            let q = mode.quality_factor;
+            if (1.0 - 4.0 * q * q).abs() < CRITICAL_DAMPING_MARGIN {
+                return None;
+            }
+            let natural = mode.angular_frequency();
+            let static_deflection = mode.force_ratio * drive.force_nn / mode.stiffness_n_per_m;
+            let steady =
+                DrivenOscillator::new(natural, q, static_deflection, w).steady_coefficients();
+            let mu = -natural / (2.0 * q);
+            let roots = if q > 0.5 {
+                let delta = natural * (1.0 - 1.0 / (4.0 * q * q)).sqrt();
+                [Complex::new(mu, delta), Complex::new(mu, -delta)]
+            } else {
+                // Over-damped: the fast root directly, the slow one from lambda_1 lambda_2 =
+                // w_i^2 (no cancellation).
+                let fast = mu - (mu * mu - natural * natural).sqrt();
+                [
+                    Complex::new(fast, 0.0),
+                    Complex::new(natural * natural / fast, 0.0),
+                ]
+            };
+            modes.push(ModeFourier {
+                optical_sensitivity: mode.optical_sensitivity,
+                steady,
+                roots,
+            });
+        }
+        Some(Self {
+            angular_frequency: w,
+            modes,
+        })
+    }
+
+    /// `[int_a^b u cos(w t) dt, int_a^b u sin(w t) dt]` (nm us) for free flight from state
+    /// `x_a = [q_1, q_1', ..., q_N, q_N']` at time `a` (us) to time `b >= a`.
+    pub fn integrate(&self, a: f64, x_a: &[f64], b: f64) -> [f64; 2] {
+        self.integrate_harmonic(1, a, x_a, b)
+    }
+
+    /// `[int_a^b u cos(k w t) dt, int_a^b u sin(k w t) dt]` (nm us) for harmonic `k >= 1`, for
+    /// free flight from state `x_a` at time `a` (us) to time `b >= a`: the closed form of the
+    /// module docs with `e^{-i k w t}`, where the steady part `p = Re((alpha - i beta)
+    /// e^{iwt})` integrates as `(alpha - i beta)/2 int e^{i(1-k)wt} dt + (alpha + i beta)/2 int
+    /// e^{-i(1+k)wt} dt` and the homogeneous part as `c e^{-ikwa} (e^{(lambda - ikw) L} - 1) /
+    /// (lambda - ikw)`.
+    pub fn integrate_harmonic(&self, k: usize, a: f64, x_a: &[f64], b: f64) -> [f64; 2] {
+        let w = self.angular_frequency;
+        let kw = k as f64 * w;
+        let length = b - a;
+        let (sin_a, cos_a) = (w * a).sin_cos();
+        let (sin_ka, cos_ka) = (kw * a).sin_cos();
+        // e^{-ikwa}, by which the homogeneous part is rotated.
+        let rotation_a = Complex::new(cos_ka, -sin_ka);
+        // The steady part's two exponentials against e^{-ikwt}: frequencies (1 - k) w and
+        // -(1 + k) w, each integrated over [a, b] without cancellation for short L.
+        let co_rotating = exponential_integral((1.0 - k as f64) * w, a, length);
+        let counter_rotating = exponential_integral(-(1.0 + k as f64) * w, a, length);
+        let minus_ikw = Complex::new(0.0, -kw);
+        let mut total = Complex::new(0.0, 0.0);
+        for (i, mode) in self.modes.iter().enumerate() {
+            let [alpha, beta] = mode.steady;
+            // The steady part.
+            let steady = Complex::new(alpha, -beta) * 0.5 * co_rotating
+                + Complex::new(alpha, beta) * 0.5 * counter_rotating;
+            // The homogeneous part's initial conditions.
+            let p = alpha * cos_a + beta * sin_a;
+            let dp = w * (beta * cos_a - alpha * sin_a);
+            let y = x_a[2 * i] - p;
+            let dy = x_a[2 * i + 1] - dp;
+            let [l1, l2] = mode.roots;
+            let c1 = (dy - l2 * y) / (l1 - l2);
+            let c2 = Complex::new(y, 0.0) - c1;
+            let mut homogeneous = Complex::new(0.0, 0.0);
+            for (c, l) in [(c1, l1), (c2, l2)] {
+                let z = l + minus_ikw;
+                homogeneous += c * ((z * length).exp() - 1.0) / z;
+            }
+            total += (steady + rotation_a * homogeneous) * mode.optical_sensitivity;
+        }
+        [total.re, -total.im]
+    }
+}
+
+/// `int_a^{a+L} e^{i nu t} dt = e^{i nu a} (e^{i nu L} - 1) / (i nu)` (`L` for `nu = 0`), with
+/// `e^{i nu L} - 1 = 2 i sin(nu L / 2) e^{i nu L / 2}`, free of cancellation for short `L`.
+fn exponential_integral(nu: f64, a: f64, length: f64) -> Complex<f64> {
+    if nu == 0.0 {
+        return Complex::new(length, 0.0);
+    }
+    let half = 0.5 * nu * length;
+    let (sin_start, cos_start) = (nu * a + half).sin_cos();
+    // e^{i nu (a + L/2)} 2 sin(nu L / 2) / nu.
+    Complex::new(cos_start, sin_start) * (2.0 * half.sin() / nu)
+}

@@ -1,0 +1,236 @@
+//! The start of a steady-orbit search without a previous orbit: the orbit of the quasi-static
+//! approach, the one `drumroll continue` and the paper report.
+//!
+//! Above the separation of first contact `Z_G1` the steady orbit is the free one, known in
+//! closed form ([`crate::model::free_response::FreeResponse`]). Below it, the approach branch is walked down from the
+//! free orbit at `Z_G1` in steps of `Z`: each step predicts the orbit from the last two with
+//! their slopes `dx/dZ` (the cubic Hermite extrapolation of [`crate::orbit::prediction`]; the
+//! free orbit's slope is zero, since it does not depend on `Z`), corrects it by Newton on the
+//! stroboscopic map at a loose tolerance, and keeps it if Newton converges within a few
+//! iterations to an orbit that attracts. Steps grow to at most [`MAX_WALK_STEP`] `A0`, so that a
+//! prediction stays within Newton's reach of its own branch's orbit. A step that fails is
+//! halved; where the step falls below
+//! [`MIN_WALK_STEP`] `A0`, the branch has ended (a fold, a period doubling) and the walk does
+//! what the quasi-static approach does there: it jumps, by transient periods from the last
+//! orbit, to the attractor that takes over, and walks on from it.
+//!
+//! The walk ends with the orbit at the requested `Z` converged at the walk's loose tolerance;
+//! [`crate::orbit::steady_orbit`] converges it at full tolerance.
+
+use continuation::{floquet_multipliers, hermite_basis, is_stable, newton_update};
+use hybrid::{Sensitivity, Settings};
+use nalgebra::DVector;
+
+use super::newton::{branch_tangent, newton_maps};
+use super::period_maps::period_map;
+use super::{steady_orbit_in, OrbitStart, SteadyOrbitSettings, SteadyOrbitWorkspace};
+use crate::error::AfmError;
+use crate::model::separation::Separation;
+use crate::model::TappingModel;
+
+/// The first step of the walk below `Z_G1`, in units of `A0`: the steps grow from it by
+/// [`STEP_GROWTH`]. The first one is taken from the free orbit, whatever its length: the orbit
+/// departs from the free one like the square root of the depth below the grazing at `Z_G1`,
+/// so that no shorter step would give a closer prediction.
+const INITIAL_WALK_STEP: f64 = 0.05;
+
+/// The longest step of the walk, in units of `A0`: long enough that a walk across the whole
+/// approach takes a handful of steps, short enough that a step does not straddle a regime.
+const MAX_WALK_STEP: f64 = 0.25;
+
+/// The shortest step, in units of `A0`, before the walk decides its branch has ended and jumps
+/// by transients (a fold or a period doubling lies within this distance).
+const MIN_WALK_STEP: f64 = 1e-3;
+
+/// The factor by which a step grows after a successful one, up to [`MAX_WALK_STEP`].
+const STEP_GROWTH: f64 = 2.0;
+
+/// Newton's tolerance on a walk step's residual `|P(x) - x|`, in units of `A0`: the walk's
+/// orbits only predict the next, so they need not be converged to the final tolerance.
+const WALK_TOLERANCE: f64 = 1e-6;
+
+/// The integration tolerance (relative and absolute) of the walk's period maps: well below
+/// [`WALK_TOLERANCE`] `A0` for any `A0` above 1 nm.
+const WALK_INTEGRATION_TOLERANCE: f64 = 1e-7;
+
+/// Newton iterations per walk step before the step is rejected.
+const WALK_ITERATIONS: usize = 4;
+
+/// Where the walk leaves the search for the orbit at the requested `Z`.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum WalkEnd {
+    /// The approach branch's period-1 orbit at `Z` converged at the walk's loose tolerance (or
+    /// the free orbit itself above `Z_G1`): Newton starts from it at full tolerance.
+    Predicted(Vec<f64>),
+    /// The state of an attractor at a `Z` above the requested one that is not a period-1
+    /// orbit (the approach jumped to it at the end of its period-1 branch): the search goes on
+    /// from it like from a neighbouring orbit.
+    Near(Vec<f64>),
+}
+
+/// One orbit of the walk: the separation (nm), the state at `t = 0` and its slope `dx/dZ`.
+#[derive(Debug, Clone)]
+struct WalkPoint {
+    z_nm: f64,
+    state: Vec<f64>,
+    slope: Vec<f64>,
+}
+
+/// Walk the approach branch of `model` from the free orbit at `Z_G1` down to `z_nm` and
+/// predict its orbit there (see the module documentation).
+pub(crate) fn walk_approach(
+    model: &TappingModel,
+    z_nm: f64,
+    settings: &SteadyOrbitSettings,
+    workspace: &mut SteadyOrbitWorkspace,
+) -> Result<WalkEnd, AfmError> {
+    let free = model.free_state();
+    let z_g1 = model.grazing_separation_nm();
+    if z_nm >= z_g1 {
+        return Ok(WalkEnd::Predicted(free));
+    }
+    let amplitude = model.free_amplitude_nm();
+    let mut last = WalkPoint {
+        z_nm: z_g1,
+        slope: vec![0.0; free.len()],
+        state: free,
+    };
+    let mut before: Option<WalkPoint> = None;
+    let mut step = INITIAL_WALK_STEP * amplitude;
+    while last.z_nm > z_nm {
+        let z_next = (last.z_nm - step).max(z_nm);
+        let mut at_next = model.clone();
+        at_next.set_separation(Separation::Constant(z_next))?;
+        let prediction = predict(z_next, &last, before.as_ref());
+        if let Some(point) = corrected(&at_next, &prediction, amplitude, workspace)? {
+            step = (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude);
+            // The free orbit's zero slope does not extend below the grazing at `Z_G1`: the
+            // cubic needs two orbits below it.
+            before = (last.z_nm < z_g1).then(|| last.clone());
+            last = point;
+        } else if step / 2.0 >= MIN_WALK_STEP * amplitude {
+            step /= 2.0;
+        } else {
+            // The branch ends within the shortest step: jump as the approach does.
+            let attractor = steady_orbit_in(
+                &at_next,
+                z_next,
+                OrbitStart::Near(&last.state),
+                settings,
+                workspace,
+            )?;
+            match attractor.tangent {
+                Some(slope)
+                    if attractor.converged && attractor.stable && attractor.multiplicity == 1 =>
+                {
+                    last = WalkPoint {
+                        z_nm: z_next,
+                        state: attractor.state,
+                        slope,
+                    };
+                    before = None;
+                    step = INITIAL_WALK_STEP * amplitude;
+                }
+                _ => return Ok(WalkEnd::Near(attractor.state)),
+            }
+        }
+    }
+    Ok(WalkEnd::Predicted(last.state))
+}
+
+/// The state at `z_nm` predicted from the walk's last orbit and, if there is one, the orbit
+/// before it: the cubic Hermite extrapolation of the two with their slopes, or the last one's
+/// tangent line.
+fn predict(z_nm: f64, last: &WalkPoint, before: Option<&WalkPoint>) -> Vec<f64> {
+    match before {
+        Some(before) => {
+            let h = last.z_nm - before.z_nm;
+            let [h00, h10, h01, h11] = hermite_basis((z_nm - before.z_nm) / h);
+            (0..last.state.len())
+                .map(|i| {
+                    h00 * before.state[i]
+                        + h10 * h * before.slope[i]
+                        + h01 * last.state[i]
+                        + h11 * h * last.slope[i]
+                })
+                .collect()
+        }
+        None => last
+            .state
+            .iter()
+            .zip(&last.slope)
+            .map(|(x, s)| x + (z_nm - last.z_nm) * s)
+            .collect(),
+    }
+}
+
+/// Newton from `prediction` on the period map of `model` (at its separation) to
+/// [`WALK_TOLERANCE`] `amplitude` (`A0`, nm), the maps integrated at
+/// [`WALK_INTEGRATION_TOLERANCE`]. Once two residuals measure Newton's constant `C`
+/// (`r_k = C r_{k-1}^2`), an iterate whose predicted residual `C r_k^2` is below the tolerance
+/// is taken without a map of its own; its slope and stability are those of the map before,
+/// which is as close to the orbit as a walk's prediction needs. The orbit with its slope, or
+/// `None` if Newton does not converge within [`WALK_ITERATIONS`] or the orbit repels.
+fn corrected(
+    model: &TappingModel,
+    prediction: &[f64],
+    amplitude: f64,
+    workspace: &mut SteadyOrbitWorkspace,
+) -> Result<Option<WalkPoint>, AfmError> {
+    let integration = newton_maps(&Settings {
+        relative_tolerance: WALK_INTEGRATION_TOLERANCE,
+        absolute_tolerance: WALK_INTEGRATION_TOLERANCE,
+        ..Settings::default()
+    });
+    let tolerance = WALK_TOLERANCE * amplitude;
+    let z_nm = model.separation().at(0.0);
+    let mut x = prediction.to_vec();
+    let mut previous_residual = f64::INFINITY;
+    for _ in 0..=WALK_ITERATIONS {
+        let Ok(map) = period_map(
+            model,
+            &x,
+            Sensitivity::TransitionAndParameter,
+            &integration,
+            workspace,
+        ) else {
+            return Ok(None);
+        };
+        let residual =
+            DVector::from_iterator(x.len(), map.state.iter().zip(&x).map(|(p, x)| p - x));
+        let size = residual.norm();
+        if !size.is_finite() || size >= previous_residual {
+            return Ok(None);
+        }
+        let converged = size <= tolerance;
+        // Newton's constant is measured only once there are two residuals.
+        let next_converged = previous_residual.is_finite()
+            && size / (previous_residual * previous_residual) * size * size <= tolerance;
+        if converged || next_converged {
+            if next_converged && !converged {
+                let Ok(update) = newton_update(&map.transition, &residual, z_nm) else {
+                    return Ok(None);
+                };
+                x.iter_mut().zip(update.iter()).for_each(|(x, u)| *x -= u);
+            }
+            if !is_stable(&floquet_multipliers(&map.transition)) {
+                return Ok(None);
+            }
+            return Ok(
+                branch_tangent(&map.transition, &map.parameter_sensitivity, z_nm).map(|slope| {
+                    WalkPoint {
+                        z_nm,
+                        state: x,
+                        slope,
+                    }
+                }),
+            );
+        }
+        previous_residual = size;
+        let Ok(update) = newton_update(&map.transition, &residual, z_nm) else {
+            return Ok(None);
+        };
+        x.iter_mut().zip(update.iter()).for_each(|(x, u)| *x -= u);
+    }
+    Ok(None)
+}
