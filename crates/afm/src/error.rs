@@ -76,7 +76,7 @@ pub enum AfmError {
         reason: String,
     },
     /// The caller asked a long computation to stop (a Ctrl-C), through the callback of
-    /// [`crate::diagram::bifurcation_diagram::diagram::bifurcation_diagram::diagram_until`].
+    /// [`crate::diagram::bifurcation_diagram::diagram_until`].
     #[error("the computation was interrupted")]
     Interrupted,
     /// Shooting or continuation of a periodic orbit failed.

@@ -5,7 +5,7 @@
 //! attractor down until it ends (a fold, a grazing that destroys it) and then lands on another;
 //! the retract back up from the lowest separation can follow another one, and where the two
 //! disagree the cantilever is bistable. This is the brute force behind `drumroll grid`,
-//! independent of the branch continuation ([`crate::diagram::bifurcation_diagram::diagram::bifurcation_diagram`]).
+//! independent of the branch continuation ([`crate::diagram::bifurcation_diagram`]).
 
 use serde::Serialize;
 

@@ -138,7 +138,7 @@ pub enum OrbitStart<'a> {
     /// `transient_periods` periods integrated from this state before Newton, as [`Self::Transient`]
     /// does from the free state: the attractor whose basin holds the state rather than the
     /// orbit nearest to it, as a quasi-static sweep of `Z` follows it (a neighbouring cell's
-    /// orbit, [`crate::diagram::bifurcation_diagram::diagram::quasi_static`]).
+    /// orbit, [`crate::diagram::quasi_static`]).
     AfterTransients(&'a [f64]),
 }
 
