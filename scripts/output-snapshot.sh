@@ -8,7 +8,8 @@
 #
 # Builds the release binary first (or uses DRUMROLL=/path/to/drumroll). Records: `continue
 # --json` (with --retract) for every built-in case, `simulate --json` at separations in each
-# impact regime of the four paper cases and at a period-4 orbit, `approach` CSV over G2 of the
+# impact regime of the four paper cases, at a period-4 orbit and inside the MAClever-on-mica
+# bistable window (a coexisting orbit), `approach` CSV over G2 of the
 # Biolever on mica, and `theory --json` at the paper's A/A0 = 0.95.
 set -euo pipefail
 out=${1:?usage: scripts/output-snapshot.sh DIR}
@@ -31,6 +32,7 @@ done
 for z in 12 8.5 5 2.7; do
     "$DRUMROLL" simulate --case biolever-mica --z "$z" --json > "$out/simulate-biolever-mica-z-$z.json"
 done
+"$DRUMROLL" simulate --case maclever-mica --z 19.997 --json > "$out/simulate-maclever-mica-bistable.json"
 "$DRUMROLL" simulate --case biolever-mica --drive-frequency 72 --z 0.5 --json \
     > "$out/simulate-biolever-mica-72khz-z-0.5.json"
 "$DRUMROLL" approach --case biolever-mica --from 8.8 --to 8.65 --rate 1 --every 10 \

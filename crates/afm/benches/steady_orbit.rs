@@ -10,7 +10,10 @@
 //! the neighbour without the workspace (`steady_orbit`, whose period maps each build a new
 //! solver), and without a previous orbit: by transients from the free orbit
 //! (`OrbitStart::Transient`) and by walking the approach branch from the free orbit
-//! (`OrbitStart::Approach`, the cold start); the Newton iterations
+//! (`OrbitStart::Approach`, the cold start); the cold start with the coexistence check that
+//! `simulate --z` and Python's `case.orbit(z=...)` add (`coexisting_orbit`: the transient start
+//! stopped once it enters the found orbit's basin), beside the check done in full (the
+//! transient start's whole orbit); the Newton iterations
 //! (neighbour/predicted) and the work of one period map with the monodromy: right-hand-side
 //! evaluations (DOP853 stages), steps (exact-flow, DOP853 and Taylor-series steps) and, of
 //! those, series steps.
@@ -24,6 +27,7 @@
 //! The same orbits by a plain scipy transient integration, for the speed ratio: the example
 //! `transient_reference` and `benches/scipy_transient.py` (see that script).
 
+use afm::orbit::steady_orbit::{coexisting_orbit, COEXISTING_DISTANCE};
 use afm::{
     builtin_case, find_amplitude_ratio, hermite_state, steady_orbit, steady_orbit_in,
     AmplitudeRatioSearch, OrbitStart, Separation, SteadyOrbitSettings, SteadyOrbitWorkspace,
@@ -77,7 +81,7 @@ fn main() {
     let settings = SteadyOrbitSettings::default();
     println!("steady orbit, Biolever on mica, A0 = 10 nm (median of repetitions)");
     println!(
-        "{:>6} {:>10} {:>8} {:>12} {:>9} {:>12} {:>9} {:>13} {:>12} {:>11} {:>7} {:>12} {:>8} {:>9}",
+        "{:>6} {:>10} {:>8} {:>12} {:>9} {:>12} {:>9} {:>13} {:>12} {:>11} {:>9} {:>12} {:>7} {:>12} {:>8} {:>9}",
         "A/A0",
         "Z (nm)",
         "impacts",
@@ -88,6 +92,8 @@ fn main() {
         "no workspace",
         "transient us",
         "approach us",
+        "cold us",
+        "(full check)",
         "iters",
         "RHS evals/T",
         "steps/T",
@@ -136,6 +142,21 @@ fn main() {
             let orbit = steady_orbit(&model, z, OrbitStart::Approach, &settings).expect("approach");
             std::hint::black_box(orbit);
         });
+        // What a cold `simulate --z` (and Python's `case.orbit(z=...)`) computes: the approach
+        // start's orbit and the coexistence check against the transient start; beside it the
+        // check done in full (the transient start's own orbit, then the comparison).
+        let cold_us = median_us(51, || {
+            let orbit = steady_orbit(&model, z, OrbitStart::Approach, &settings).expect("approach");
+            let other = coexisting_orbit(&model, &orbit, OrbitStart::Transient, &settings);
+            std::hint::black_box((orbit, other));
+        });
+        let full_check_us = median_us(51, || {
+            let orbit = steady_orbit(&model, z, OrbitStart::Approach, &settings).expect("approach");
+            let other =
+                steady_orbit(&model, z, OrbitStart::Transient, &settings).expect("transient");
+            let same = orbit.is_same_orbit(&other, COEXISTING_DISTANCE);
+            std::hint::black_box((orbit, other, same));
+        });
         let mut at_z = model.clone();
         at_z.set_separation(Separation::Constant(z))
             .expect("finite");
@@ -149,7 +170,7 @@ fn main() {
         )
         .expect("period map");
         println!(
-            "{:>6.2} {:>10.6} {:>8} {:>12.1} {:>9.1} {:>12.1} {:>9.1} {:>13.1} {:>12.1} {:>11.1} {:>7} {:>12} {:>8} {:>9}",
+            "{:>6.2} {:>10.6} {:>8} {:>12.1} {:>9.1} {:>12.1} {:>9.1} {:>13.1} {:>12.1} {:>11.1} {:>9.1} {:>12.1} {:>7} {:>12} {:>8} {:>9}",
             ratio,
             z,
             target.observables().impacts.len(),
@@ -160,6 +181,8 @@ fn main() {
             fresh_us,
             transient_us,
             approach_us,
+            cold_us,
+            full_check_us,
             format!("{}/{}", warm.iterations, predicted.iterations),
             period.statistics.rhs_evaluations,
             // `steps` counts the exact-flow steps too.

@@ -85,21 +85,16 @@ impl Start {
     }
 }
 
-/// Two converged orbits at one `Z` are different orbits when their states at `t = 0` differ by
-/// more than this (nm and nm/us): far above the 1e-10 residual of either, far below the
-/// distance between coexisting orbits.
-const COEXISTING_DISTANCE: f64 = 1e-6;
-
-/// The orbit the other start reaches at the same `Z`, if it is a different converged orbit.
+/// The orbit the other start reaches at the same `Z`, if it is a different converged orbit
+/// (`afm`'s coexistence check: from a stable approach orbit, the transient start stops as soon
+/// as its transient enters the orbit's basin).
 pub fn coexisting_orbit(
     model: &TappingModel,
     orbit: &SteadyOrbit,
     start: Start,
     settings: &SteadyOrbitSettings,
 ) -> Option<SteadyOrbit> {
-    let other = steady_orbit(model, orbit.z_nm, start.other().orbit_start(), settings).ok()?;
-    (other.converged && orbit.converged && !orbit.is_same_orbit(&other, COEXISTING_DISTANCE))
-        .then_some(other)
+    afm::orbit::steady_orbit::coexisting_orbit(model, orbit, start.other().orbit_start(), settings)
 }
 
 /// Run `drumroll simulate`.

@@ -185,7 +185,10 @@ fn every_shell_example_in_the_readme_and_the_guide_runs() {
             }
         }
     }
-    assert!(count >= 10, "only {count} examples found: are the fences marked sh/console?");
+    assert!(
+        count >= 10,
+        "only {count} examples found: are the fences marked sh/console?"
+    );
     assert!(
         failures.is_empty(),
         "{} of {count} examples failed:\n{}",

@@ -8,6 +8,7 @@
 //! settles on none within the budget is reported as not converged, never dressed up as one.
 
 mod approach_walk;
+mod coexistence;
 mod newton;
 mod orbit;
 mod period_maps;
@@ -16,6 +17,7 @@ mod recurrence;
 use continuation::{floquet_multipliers, is_stable, NewtonSettings, Parametrised};
 use hybrid::{HybridSystem, Settings};
 
+pub use coexistence::{coexisting_orbit, COEXISTING_DISTANCE};
 pub use orbit::{PeriodBreakdown, SteadyOrbit};
 pub use period_maps::SteadyOrbitWorkspace;
 
