@@ -37,7 +37,8 @@ pub enum DriveKind {
 }
 
 impl DriveKind {
-    fn name(self) -> &'static str {
+    /// The option's value, as written in the outputs.
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Self::Distributed => "distributed",
             Self::Tip => "tip",
@@ -116,6 +117,33 @@ pub struct CantileverArgs {
     /// the table.
     #[arg(long)]
     pub json: bool,
+    /// Build the modes in a fluid from the cantilever's geometry and material (Sader's
+    /// hydrodynamic function) instead of measured values; needs --length-um, --width-um,
+    /// --thickness-um, --youngs-modulus-gpa, --density-kg-m3 and --fluid (a cantilever file
+    /// is built with --radius).
+    #[arg(long, value_enum, conflicts_with_all = ["k1", "f1", "f2", "f3", "f4", "frequencies", "q1", "q2", "q3", "q4", "quality_factors"])]
+    pub geometry: Option<crate::cantilever_geometry::Geometry>,
+    /// Length L of the beam, um, in [1, 10000].
+    #[arg(long, allow_negative_numbers = true)]
+    pub length_um: Option<f64>,
+    /// Width b of the beam, um, in [0.1, 1000] (and at most L/2).
+    #[arg(long, allow_negative_numbers = true)]
+    pub width_um: Option<f64>,
+    /// Thickness h of the beam, um, in [0.01, 100] (and at most b).
+    #[arg(long, allow_negative_numbers = true)]
+    pub thickness_um: Option<f64>,
+    /// Young's modulus E of the beam's material, GPa, in [0.1, 1500] (silicon 169, silicon
+    /// nitride about 250).
+    #[arg(long, allow_negative_numbers = true)]
+    pub youngs_modulus_gpa: Option<f64>,
+    /// Density of the beam's material, kg/m^3, in [500, 25000] (silicon 2330, silicon
+    /// nitride about 3100).
+    #[arg(long, allow_negative_numbers = true)]
+    pub density_kg_m3: Option<f64>,
+    /// The fluid: `water` (20 C: 998.2 kg/m^3, 1.002e-3 Pa s), `air` (1.18 kg/m^3,
+    /// 1.86e-5 Pa s) or a JSON file {"name", "density_kg_m3", "viscosity_pa_s"}.
+    #[arg(long, value_name = "water|air|FILE")]
+    pub fluid: Option<String>,
 }
 
 /// Where a mode's natural frequency comes from.
@@ -211,6 +239,15 @@ fn per_mode(
 
 /// Run `drumroll cantilever`.
 pub fn run(args: &CantileverArgs) -> Result<()> {
+    if args.geometry.is_some() {
+        return crate::cantilever_geometry::run(args);
+    }
+    if crate::cantilever_geometry::any_geometry_option(args) {
+        bail!(
+            "--length-um, --width-um, --thickness-um, --youngs-modulus-gpa, --density-kg-m3 and \
+             --fluid describe a cantilever by its geometry: add --geometry rectangular"
+        );
+    }
     option_ranges::TIP_MASS_RATIO.check(args.tip_mass_ratio)?;
     let modes = option_ranges::MODES.count(args.modes)?;
     let table = beam::modal_table(args.tip_mass_ratio, modes)
