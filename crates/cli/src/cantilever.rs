@@ -38,7 +38,7 @@ pub enum DriveKind {
 
 impl DriveKind {
     /// The option's value, as written in the outputs.
-    pub(crate) fn name(self) -> &'static str {
+    fn name(self) -> &'static str {
         match self {
             Self::Distributed => "distributed",
             Self::Tip => "tip",
@@ -117,33 +117,9 @@ pub struct CantileverArgs {
     /// the table.
     #[arg(long)]
     pub json: bool,
-    /// Build the modes in a fluid from the cantilever's geometry and material (Sader's
-    /// hydrodynamic function) instead of measured values; needs --length-um, --width-um,
-    /// --thickness-um, --youngs-modulus-gpa, --density-kg-m3 and --fluid (a cantilever file
-    /// is built with --radius).
-    #[arg(long, value_enum, conflicts_with_all = ["k1", "f1", "f2", "f3", "f4", "frequencies", "q1", "q2", "q3", "q4", "quality_factors"])]
-    pub geometry: Option<crate::cantilever_geometry::Geometry>,
-    /// Length L of the beam, um, in [1, 10000].
-    #[arg(long, allow_negative_numbers = true)]
-    pub length_um: Option<f64>,
-    /// Width b of the beam, um, in [0.1, 1000] (and at most L/2).
-    #[arg(long, allow_negative_numbers = true)]
-    pub width_um: Option<f64>,
-    /// Thickness h of the beam, um, in [0.01, 100] (and at most b).
-    #[arg(long, allow_negative_numbers = true)]
-    pub thickness_um: Option<f64>,
-    /// Young's modulus E of the beam's material, GPa, in [0.1, 1500] (silicon 169, silicon
-    /// nitride about 250).
-    #[arg(long, allow_negative_numbers = true)]
-    pub youngs_modulus_gpa: Option<f64>,
-    /// Density of the beam's material, kg/m^3, in [500, 25000] (silicon 2330, silicon
-    /// nitride about 3100).
-    #[arg(long, allow_negative_numbers = true)]
-    pub density_kg_m3: Option<f64>,
-    /// The fluid: `water` (20 C: 998.2 kg/m^3, 1.002e-3 Pa s), `air` (1.18 kg/m^3,
-    /// 1.86e-5 Pa s) or a JSON file {"name", "density_kg_m3", "viscosity_pa_s"}.
-    #[arg(long, value_name = "water|air|FILE")]
-    pub fluid: Option<String>,
+    /// The geometry, material and fluid (`--geometry rectangular ...`).
+    #[command(flatten)]
+    pub geometry: crate::cantilever_geometry::GeometryArgs,
 }
 
 /// Where a mode's natural frequency comes from.
@@ -239,10 +215,20 @@ fn per_mode(
 
 /// Run `drumroll cantilever`.
 pub fn run(args: &CantileverArgs) -> Result<()> {
-    if args.geometry.is_some() {
-        return crate::cantilever_geometry::run(args);
+    if args.geometry.geometry.is_some() {
+        let common = crate::cantilever_geometry::CommonOptions {
+            tip_mass_ratio: args.tip_mass_ratio,
+            modes: args.modes,
+            tip_drive: args.drive == DriveKind::Tip,
+            drive_name: args.drive.name(),
+            radius: args.radius,
+            name: args.name.as_deref(),
+            out: args.out.as_deref(),
+            json: args.json,
+        };
+        return crate::cantilever_geometry::run(&args.geometry, &common);
     }
-    if crate::cantilever_geometry::any_geometry_option(args) {
+    if args.geometry.any_option() {
         bail!(
             "--length-um, --width-um, --thickness-um, --youngs-modulus-gpa, --density-kg-m3 and \
              --fluid describe a cantilever by its geometry: add --geometry rectangular"

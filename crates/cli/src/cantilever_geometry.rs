@@ -7,11 +7,10 @@ use std::path::Path;
 use afm::{Cantilever, Eigenmode};
 use anyhow::{bail, Context, Result};
 use beam::{BeamError, Fluid, FluidMode, RectangularCantilever};
-use clap::ValueEnum;
+use clap::{Args, ValueEnum};
 use serde_json::json;
 use std::fmt::Write as _;
 
-use crate::cantilever::{CantileverArgs, DriveKind};
 use crate::model_args::output_path;
 use crate::option_ranges;
 use crate::output::{print_stdout, write_atomically};
@@ -23,6 +22,60 @@ pub enum Geometry {
     Rectangular,
 }
 
+/// The options of `drumroll cantilever` that describe the cantilever by its geometry
+/// (flattened into `CantileverArgs`).
+#[derive(Debug, Clone, Args)]
+pub struct GeometryArgs {
+    /// Build the modes in a fluid from the cantilever's geometry and material (Sader's
+    /// hydrodynamic function) instead of measured values; needs --length-um, --width-um,
+    /// --thickness-um, --youngs-modulus-gpa, --density-kg-m3 and --fluid (a cantilever file
+    /// is built with --radius).
+    #[arg(long, value_enum, conflicts_with_all = ["k1", "f1", "f2", "f3", "f4", "frequencies", "q1", "q2", "q3", "q4", "quality_factors"])]
+    pub geometry: Option<Geometry>,
+    /// Length L of the beam, um, in [1, 10000].
+    #[arg(long, allow_negative_numbers = true)]
+    pub length_um: Option<f64>,
+    /// Width b of the beam, um, in [0.1, 1000] (and at most L/2).
+    #[arg(long, allow_negative_numbers = true)]
+    pub width_um: Option<f64>,
+    /// Thickness h of the beam, um, in [0.01, 100] (and at most b).
+    #[arg(long, allow_negative_numbers = true)]
+    pub thickness_um: Option<f64>,
+    /// Young's modulus E of the beam's material, GPa, in [0.1, 1500] (silicon 169, silicon
+    /// nitride about 250).
+    #[arg(long, allow_negative_numbers = true)]
+    pub youngs_modulus_gpa: Option<f64>,
+    /// Density of the beam's material, kg/m^3, in [500, 25000] (silicon 2330, silicon
+    /// nitride about 3100).
+    #[arg(long, allow_negative_numbers = true)]
+    pub density_kg_m3: Option<f64>,
+    /// The fluid: `water` (20 C: 998.2 kg/m^3, 1.002e-3 Pa s), `air` (1.18 kg/m^3,
+    /// 1.86e-5 Pa s) or a JSON file {"name", "density_kg_m3", "viscosity_pa_s"}.
+    #[arg(long, value_name = "water|air|FILE")]
+    pub fluid: Option<String>,
+}
+
+/// The options `drumroll cantilever` shares between its two ways of building a cantilever.
+#[derive(Debug, Clone, Copy)]
+pub struct CommonOptions<'a> {
+    /// `--tip-mass-ratio`, `m_tip / m_c`.
+    pub tip_mass_ratio: f64,
+    /// `--modes` as typed (checked here).
+    pub modes: i64,
+    /// `--drive tip`: every `F_n / F_1 = 1`; otherwise a distributed load.
+    pub tip_drive: bool,
+    /// `--drive`'s value as written in the outputs.
+    pub drive_name: &'static str,
+    /// `--radius`, nm.
+    pub radius: Option<f64>,
+    /// `--name`.
+    pub name: Option<&'a str>,
+    /// `--out`.
+    pub out: Option<&'a Path>,
+    /// `--json`.
+    pub json: bool,
+}
+
 /// The geometry and material options, once all are given.
 struct GeometryInputs {
     cantilever: RectangularCantilever,
@@ -32,7 +85,7 @@ struct GeometryInputs {
 }
 
 /// The options `--geometry` needs, with their values or `None`.
-fn geometry_options(args: &CantileverArgs) -> [(&'static str, Option<f64>); 5] {
+fn geometry_options(args: &GeometryArgs) -> [(&'static str, Option<f64>); 5] {
     [
         ("--length-um", args.length_um),
         ("--width-um", args.width_um),
@@ -42,15 +95,18 @@ fn geometry_options(args: &CantileverArgs) -> [(&'static str, Option<f64>); 5] {
     ]
 }
 
-/// Whether any geometry option (or `--fluid`) is given, so that a forgotten `--geometry` is
-/// named rather than the options silently ignored.
-pub fn any_geometry_option(args: &CantileverArgs) -> bool {
-    geometry_options(args).iter().any(|(_, v)| v.is_some()) || args.fluid.is_some()
+impl GeometryArgs {
+    /// Whether any geometry option (or `--fluid`) is given, so that a forgotten `--geometry`
+    /// is named rather than the options silently ignored.
+    #[must_use]
+    pub fn any_option(&self) -> bool {
+        geometry_options(self).iter().any(|(_, v)| v.is_some()) || self.fluid.is_some()
+    }
 }
 
 /// Read the options into a validated geometry and fluid; errors name the option or the fluid
 /// file and field.
-fn inputs(args: &CantileverArgs) -> Result<GeometryInputs> {
+fn inputs(args: &GeometryArgs, tip_mass_ratio: f64) -> Result<GeometryInputs> {
     let options = geometry_options(args);
     let mut missing: Vec<&str> = options
         .iter()
@@ -70,7 +126,7 @@ fn inputs(args: &CantileverArgs) -> Result<GeometryInputs> {
         thickness_um: value(2),
         youngs_modulus_gpa: value(3),
         density_kg_m3: value(4),
-        tip_mass_ratio: args.tip_mass_ratio,
+        tip_mass_ratio,
     };
     cantilever.validate().map_err(|error| match error {
         BeamError::FieldOutOfRange {
@@ -114,16 +170,15 @@ fn read_fluid(path: &Path) -> Result<Fluid> {
 }
 
 /// Run `drumroll cantilever --geometry rectangular`.
-pub fn run(args: &CantileverArgs) -> Result<()> {
+pub fn run(geometry: &GeometryArgs, args: &CommonOptions) -> Result<()> {
     option_ranges::TIP_MASS_RATIO.check(args.tip_mass_ratio)?;
     let count = option_ranges::MODES.count(args.modes)?;
-    let inputs = inputs(args)?;
+    let inputs = inputs(geometry, args.tip_mass_ratio)?;
     if let Some(radius) = args.radius {
         option_ranges::RADIUS.check(radius)?;
     }
     let out = args
         .out
-        .as_ref()
         .map(|p| output_path(p, "json", "--out"))
         .transpose()?;
     if out.is_some() && args.radius.is_none() {
@@ -165,15 +220,15 @@ pub fn run(args: &CantileverArgs) -> Result<()> {
 /// The cantilever file: every mode's `k_n`, `f_n`, `Q_n`, `chi_n` in the fluid and the drive's
 /// forcing ratios.
 fn build(
-    args: &CantileverArgs,
+    args: &CommonOptions,
     inputs: &GeometryInputs,
     modes: &[FluidMode],
     radius: f64,
     out: Option<&Path>,
 ) -> Result<Cantilever> {
     let geometry = &inputs.cantilever;
-    let name = match (&args.name, out) {
-        (Some(name), _) => name.clone(),
+    let name = match (args.name, out) {
+        (Some(name), _) => name.to_string(),
         (None, Some(path)) => path
             .file_stem()
             .and_then(|stem| stem.to_str())
@@ -197,7 +252,7 @@ fn build(
             inputs.fluid.name,
             inputs.fluid.density_kg_m3,
             inputs.fluid.viscosity_pa_s,
-            args.drive.name()
+            args.drive_name
         ),
         tip_radius_nm: radius,
         tip_mass_ratio: geometry.tip_mass_ratio,
@@ -214,9 +269,10 @@ fn build(
                 } else {
                     mode.optical_sensitivity
                 },
-                force_ratio: match (mode.index, args.drive) {
-                    (1, _) | (_, DriveKind::Tip) => 1.0,
-                    (_, DriveKind::Distributed) => mode.force_ratio_distributed,
+                force_ratio: if mode.index == 1 || args.tip_drive {
+                    1.0
+                } else {
+                    mode.force_ratio_distributed
                 },
             })
             .collect(),
@@ -229,7 +285,7 @@ fn build(
 
 /// The JSON of `drumroll cantilever --geometry rectangular --json` (docs/output-schema.md).
 fn report_json(
-    args: &CantileverArgs,
+    args: &CommonOptions,
     inputs: &GeometryInputs,
     modes: &[FluidMode],
     built: Option<&Cantilever>,
@@ -262,7 +318,7 @@ fn report_json(
             "options": {
                 "tip_mass_ratio": args.tip_mass_ratio,
                 "modes": args.modes,
-                "drive": args.drive.name(),
+                "drive": args.drive_name,
                 "geometry": "rectangular",
                 "length_um": geometry.length_um,
                 "width_um": geometry.width_um,
@@ -276,7 +332,7 @@ fn report_json(
             },
         },
         "tip_mass_ratio": args.tip_mass_ratio,
-        "drive": args.drive.name(),
+        "drive": args.drive_name,
         "fluid": {
             "name": inputs.fluid.name,
             "density_kg_m3": inputs.fluid.density_kg_m3,
@@ -296,7 +352,7 @@ fn report_json(
 
 /// The readable output: the modes in the fluid, then the written file.
 fn summary(
-    args: &CantileverArgs,
+    args: &CommonOptions,
     inputs: &GeometryInputs,
     modes: &[FluidMode],
     built: Option<&Cantilever>,
@@ -363,9 +419,7 @@ fn summary(
         let _ = writeln!(
             s,
             "cantilever `{}`: R = {} nm, {} drive",
-            cantilever.name,
-            cantilever.tip_radius_nm,
-            args.drive.name()
+            cantilever.name, cantilever.tip_radius_nm, args.drive_name
         );
     }
     if let Some(path) = out {
