@@ -3,7 +3,7 @@
 //! 10 modes, without and with a tip mass (the fixed point then re-solves the eigenvalue at each
 //! iterate). Target: under a millisecond per mode, so that `drumroll cantilever --geometry`
 //! answers at once. Measured 2026-11-26 on the shared 2-core machine: 0.17 to 0.26 ms per mode
-//! (about 30 fixed-point iterations, each one Bessel quadrature of a few hundred nodes).
+//! (each fixed-point iteration evaluates one Bessel quadrature and one eigenvalue).
 //!
 //! Run with `cargo bench -p beam --bench fluid_modes`; prints the median wall time of 200 runs.
 
