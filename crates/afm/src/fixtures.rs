@@ -34,6 +34,7 @@ macro_rules! embedded {
 const CANTILEVERS: &[Embedded] = &[
     embedded!("cantilevers", "biolever"),
     embedded!("cantilevers", "maclever"),
+    embedded!("cantilevers", "rectangular-silicon-water"),
 ];
 
 const SAMPLES: &[Embedded] = &[
@@ -57,7 +58,7 @@ fn names(table: &[Embedded]) -> Vec<&'static str> {
     table.iter().map(|entry| entry.name).collect()
 }
 
-/// The names of the built-in cantilevers (`biolever`, `maclever`).
+/// The names of the built-in cantilevers (`biolever`, `maclever`, `rectangular-silicon-water`).
 pub fn cantilever_names() -> Vec<&'static str> {
     names(CANTILEVERS)
 }

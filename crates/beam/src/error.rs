@@ -57,4 +57,47 @@ pub enum BeamError {
         /// The largest accepted value.
         max: usize,
     },
+    /// A number of a geometry or fluid lies outside its accepted range (or is not finite).
+    #[error("invalid `{field}` = {value}: must be finite and in [{min}, {max}]")]
+    FieldOutOfRange {
+        /// The field's name, with its unit (e.g. `length_um`).
+        field: &'static str,
+        /// The value given.
+        value: f64,
+        /// The smallest accepted value.
+        min: f64,
+        /// The largest accepted value.
+        max: f64,
+    },
+    /// Two numbers of a geometry contradict the slender-beam theory's assumptions.
+    #[error("invalid geometry: {reason}")]
+    Geometry {
+        /// What is wrong, with the numbers.
+        reason: String,
+    },
+    /// A mode's Reynolds number lies outside the range of Sader's fit of the rectangular beam's
+    /// hydrodynamic function.
+    #[error(
+        "mode {mode}: Reynolds number Re = rho w b^2 / (4 eta) = {value:.3e} is outside \
+         [{min:e}, {max:e}], the range of Sader's (1998) fit of the rectangular beam's \
+         hydrodynamic function: change the width, the mode count or the fluid"
+    )]
+    ReynoldsOutOfRange {
+        /// The 1-based mode number.
+        mode: usize,
+        /// The Reynolds number.
+        value: f64,
+        /// The smallest value of the fit.
+        min: f64,
+        /// The largest value of the fit.
+        max: f64,
+    },
+    /// The fixed point `w_n = b_n(mu_eff(w_n))^2 sqrt(EI / (m_eff(w_n) L^4))` was not reached.
+    #[error("mode {mode}: the frequency in the fluid did not converge: {reason}")]
+    FluidFrequencyNotConverged {
+        /// The 1-based mode number.
+        mode: usize,
+        /// The last iterates.
+        reason: String,
+    },
 }

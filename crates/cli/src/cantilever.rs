@@ -37,6 +37,7 @@ pub enum DriveKind {
 }
 
 impl DriveKind {
+    /// The option's value, as written in the outputs.
     fn name(self) -> &'static str {
         match self {
             Self::Distributed => "distributed",
@@ -116,6 +117,9 @@ pub struct CantileverArgs {
     /// the table.
     #[arg(long)]
     pub json: bool,
+    /// The geometry, material and fluid (`--geometry rectangular ...`).
+    #[command(flatten)]
+    pub geometry: crate::cantilever_geometry::GeometryArgs,
 }
 
 /// Where a mode's natural frequency comes from.
@@ -211,6 +215,25 @@ fn per_mode(
 
 /// Run `drumroll cantilever`.
 pub fn run(args: &CantileverArgs) -> Result<()> {
+    if args.geometry.geometry.is_some() {
+        let common = crate::cantilever_geometry::CommonOptions {
+            tip_mass_ratio: args.tip_mass_ratio,
+            modes: args.modes,
+            tip_drive: args.drive == DriveKind::Tip,
+            drive_name: args.drive.name(),
+            radius: args.radius,
+            name: args.name.as_deref(),
+            out: args.out.as_deref(),
+            json: args.json,
+        };
+        return crate::cantilever_geometry::run(&args.geometry, &common);
+    }
+    if args.geometry.any_option() {
+        bail!(
+            "--length-um, --width-um, --thickness-um, --youngs-modulus-gpa, --density-kg-m3 and \
+             --fluid describe a cantilever by its geometry: add --geometry rectangular"
+        );
+    }
     option_ranges::TIP_MASS_RATIO.check(args.tip_mass_ratio)?;
     let modes = option_ranges::MODES.count(args.modes)?;
     let table = beam::modal_table(args.tip_mass_ratio, modes)

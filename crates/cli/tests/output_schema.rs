@@ -333,6 +333,28 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
             out.to_str().expect("utf-8 path"),
             "--json",
         ]),
+        one(&[
+            "cantilever",
+            "--geometry",
+            "rectangular",
+            "--length-um",
+            "200",
+            "--width-um",
+            "20",
+            "--thickness-um",
+            "1",
+            "--youngs-modulus-gpa",
+            "169",
+            "--density-kg-m3",
+            "2330",
+            "--fluid",
+            "water",
+            "--tip-mass-ratio",
+            "0",
+            "--radius",
+            "10",
+            "--json",
+        ]),
     ];
     printed.extend(check(&schema, "`drumroll cantilever --json`", &cantilever));
 
