@@ -436,3 +436,28 @@ fn indentation_virial_and_dissipation_match_sampled_sums() {
         );
     }
 }
+
+/// Every point of a diagram reports a closed energy balance (below 1e-9) and harmonics
+/// `1..=4`; the dissipation of the paper's Hertz case vanishes all along the branch.
+#[test]
+fn every_diagram_point_closes_its_energy_balance() {
+    let model =
+        TappingModel::from_case(&builtin_case("biolever-mica").expect("case")).expect("model");
+    let settings = afm::DiagramSettings::approach(&model);
+    let diagram = afm::approach_diagram(&model, &settings).expect("diagram");
+    assert!(diagram.points.len() > 100);
+    for point in &diagram.points {
+        assert!(
+            point.energy_balance_residual < 1e-9,
+            "Z = {}: {:e}",
+            point.z_nm,
+            point.energy_balance_residual
+        );
+        assert_eq!(point.harmonics.len(), 4);
+        let scale = point.peak_force_nn * point.max_indentation_nm * afm::NN_NM_IN_EV;
+        assert!(point.dissipated_ev.abs() <= 1e-11 * scale.max(1e-3));
+    }
+    for special in &diagram.special_points {
+        assert_eq!(special.harmonics.len(), 4);
+    }
+}

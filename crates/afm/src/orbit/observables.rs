@@ -726,12 +726,14 @@ fn observe_in(
     Ok((flow, observables))
 }
 
-/// The observables of one period of `model` from state `x0` at `t = 0` (MODEL.md section 4).
+/// The observables of one period of `model` from state `x0` at `t = 0` (MODEL.md sections 4
+/// and 10), with harmonics `1..=harmonic_count` of `u`.
 pub fn orbit_observables(
     model: &TappingModel,
     x0: &[f64],
     settings: &Settings,
+    harmonic_count: usize,
 ) -> Result<OrbitObservables, AfmError> {
-    observe_period(model, 0.0, x0, Sensitivity::None, settings, 1)
+    observe_period(model, 0.0, x0, Sensitivity::None, settings, harmonic_count)
         .map(|(_, observables)| observables)
 }
