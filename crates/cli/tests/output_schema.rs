@@ -359,7 +359,24 @@ fn csv_columns_are_the_documented_json_keys_in_order() {
         csv.to_str().expect("utf-8 path"),
     ]);
     let written = std::fs::read_to_string(&csv).expect("CSV");
-    let header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    let full_header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    // The harmonic columns `harmonic_<n>_amplitude_nm`, `harmonic_<n>_phase_deg`, n = 1..N,
+    // come last, from the point's `harmonics[n - 1]`.
+    let (header, harmonic_columns): (Vec<&str>, Vec<&str>) = full_header
+        .iter()
+        .partition(|column| !column.starts_with("harmonic_"));
+    assert!(!harmonic_columns.is_empty());
+    for (index, pair) in harmonic_columns.chunks(2).enumerate() {
+        let n = index + 1;
+        assert_eq!(
+            pair,
+            [
+                format!("harmonic_{n}_amplitude_nm"),
+                format!("harmonic_{n}_phase_deg")
+            ]
+        );
+    }
+    assert_eq!(&full_header[..header.len()], &header[..]);
     assert_eq!(header[0], "direction");
     let points = &schema["`drumroll continue --json`"];
     for column in &header[1..] {
