@@ -71,8 +71,13 @@ fn work(model: &TappingModel, settings: &DiagramSettings, diagram: &BifurcationD
             });
         observables_us += 1e6
             * median_seconds(5, || {
-                let o = orbit_observables(&at, &point.state, &settings.orbit.integration)
-                    .expect("observables");
+                let o = orbit_observables(
+                    &at,
+                    &point.state,
+                    &settings.orbit.integration,
+                    settings.orbit.harmonics,
+                )
+                .expect("observables");
                 std::hint::black_box(o);
             });
         samples += 1;

@@ -56,7 +56,8 @@ pub use model::separation::Separation;
 pub use model::TappingModel;
 pub use orbit::observables::{
     observe_orbit_in, observe_period, observe_period_in, orbit_observables, GapMinimum,
-    GapMinimumKind, Harmonic, Impact, OrbitObservables, PeriodObserver, NEAR_IMPACT_FRACTION,
+    GapMinimumKind, Harmonic, Impact, ModeEnergy, OrbitObservables, PeriodObserver,
+    NEAR_IMPACT_FRACTION, NN_NM_IN_EV,
 };
 pub use orbit::prediction::{hermite_state, tangent_state};
 pub use orbit::steady_orbit::{

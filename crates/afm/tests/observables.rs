@@ -72,7 +72,8 @@ fn free_orbit_observables_equal_the_closed_form() {
             .set_separation(Separation::Constant(z))
             .expect("finite");
         let x0 = model.free_state();
-        let observed = orbit_observables(&model, &x0, &Settings::default()).expect("observables");
+        let observed =
+            orbit_observables(&model, &x0, &Settings::default(), 1).expect("observables");
         // Exact flow + 8-point Gauss-Legendre on steps of <= a quarter of the shortest period:
         // quadrature error < 1e-15 relative; allow rounding of a few hundred nodes.
         assert!(

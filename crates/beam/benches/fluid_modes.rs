@@ -1,4 +1,4 @@
-//! Benchmark of `RectangularCantilever::modes_in_fluid` (MODEL.md section 10): the modes of the
+//! Benchmark of `RectangularCantilever::modes_in_fluid` (MODEL.md section 11): the modes of the
 //! built-in `rectangular-silicon-water` geometry (200 x 20 x 1 um silicon) in water, for 2 and
 //! 10 modes, without and with a tip mass (the fixed point then re-solves the eigenvalue at each
 //! iterate). Target: under a millisecond per mode, so that `drumroll cantilever --geometry`

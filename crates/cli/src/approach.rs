@@ -20,9 +20,21 @@ use crate::output::check_writable;
 use crate::plot::{render_svg, FigureFile, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 use crate::progress::{note, Progress};
 
-/// The CSV header: the JSON Lines records' keys, in their order (docs/output-schema.md).
+/// The CSV header: the JSON Lines records' scalar keys, in their order (docs/output-schema.md);
+/// the harmonic columns ([`harmonic_columns`]) follow.
 pub const CSV_HEADER: &str =
-    "cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,direction";
+    "cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,dissipated_ev,direction";
+
+/// The harmonics each reading gives by default (`--harmonics`).
+pub const DEFAULT_HARMONICS: i64 = 4;
+
+/// The CSV columns of harmonics `1..=count` after [`CSV_HEADER`]:
+/// `,harmonic_<n>_amplitude_nm,harmonic_<n>_phase_deg` for each `n`.
+pub fn harmonic_columns(count: usize) -> String {
+    (1..=count)
+        .map(|n| format!(",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"))
+        .collect()
+}
 
 /// Progress bar updates: at most one per this many cycles (indicatif also limits redraws).
 const PROGRESS_STRIDE: u64 = 256;
@@ -98,6 +110,10 @@ pub struct ApproachArgs {
         allow_negative_numbers = true
     )]
     pub tolerance: f64,
+    /// The harmonics n = 1..N of u each reading gives (amplitude and phase of the block's
+    /// lock-in at n times the drive frequency), N in [1, 20].
+    #[arg(long, default_value_t = DEFAULT_HARMONICS, allow_negative_numbers = true)]
+    pub harmonics: i64,
     /// Write JSON Lines (one object per reading) instead of CSV.
     #[arg(long)]
     pub jsonl: bool,
@@ -127,6 +143,11 @@ impl ApproachArgs {
         )
         .check(from)?;
         let lockin_cycles = option_ranges::LOCKIN_CYCLES.count(self.lockin_cycles)?;
+        let harmonics = OptionRange::new(
+            "--harmonics",
+            Interval::closed(1.0, afm::orbit::lockin::MAX_LOCKIN_HARMONICS as f64, ""),
+        )
+        .count(self.harmonics)?;
         let every = option_ranges::EVERY.count(self.every)?;
         let settle_cycles = option_ranges::SETTLE_CYCLES.count(self.settle_cycles)?;
         option_ranges::TOLERANCE.check(self.tolerance)?;
@@ -156,6 +177,7 @@ impl ApproachArgs {
         settings.settle_cycles = settle_cycles;
         settings.lockin_cycles = lockin_cycles;
         settings.every = every;
+        settings.harmonics = harmonics;
         settings.integration.relative_tolerance = self.tolerance;
         settings.integration.absolute_tolerance = self.tolerance;
         settings.validate().context("invalid sweep settings")?;
@@ -198,17 +220,22 @@ pub fn format_record(record: &SweepRecord, jsonl: bool, line: &mut String) -> Re
         line.push_str(&serde_json::to_string(record)?);
         line.push('\n');
     } else {
-        writeln!(
+        write!(
             line,
-            "{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{}",
             record.cycle,
             record.z_nm,
             record.amplitude_ratio,
             record.phase_deg,
             record.impacts_per_period,
             record.peak_force_nn,
+            record.dissipated_ev,
             record.direction.name()
         )?;
+        for harmonic in &record.harmonics {
+            write!(line, ",{},{}", harmonic.amplitude_nm, harmonic.phase_deg)?;
+        }
+        line.push('\n');
     }
     Ok(())
 }
@@ -228,6 +255,7 @@ pub fn approach_inputs_json(
         "settle_cycles": settings.settle_cycles,
         "lockin_cycles": settings.lockin_cycles,
         "every": settings.every,
+        "harmonics": settings.harmonics,
     });
     inputs_json("approach", options, case, model, &settings.integration)
 }
@@ -248,7 +276,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         let inputs = approach_inputs_json(&case, &model, &settings);
         format!("{}\n", json!({ "inputs": inputs }))
     } else {
-        format!("{CSV_HEADER}\n")
+        format!("{CSV_HEADER}{}\n", harmonic_columns(settings.harmonics))
     };
     let mut sweep = Sweep::new(&model, settings).context("cannot set up the sweep")?;
     let mut sink = match &args.out {

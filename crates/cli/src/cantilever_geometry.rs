@@ -1,6 +1,6 @@
 //! `drumroll cantilever --geometry rectangular ...`: the modes of a rectangular cantilever in a
 //! fluid from its geometry and material (`beam::RectangularCantilever::modes_in_fluid`, Sader's
-//! hydrodynamic function; MODEL.md section 10), and a cantilever file built from them.
+//! hydrodynamic function; MODEL.md section 11), and a cantilever file built from them.
 
 use std::path::Path;
 

@@ -12,7 +12,7 @@ use serde_json::json;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use crate::continue_figure::{figure, CaseDiagrams};
+use crate::continue_figure::{contrast_figure, figure, CaseDiagrams, PanelQuantity};
 use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{model_of, output_path, ModelArgs};
@@ -64,6 +64,16 @@ pub struct ContinueArgs {
     /// a legend naming the cases) instead of one panel per case.
     #[arg(long, requires = "plot")]
     pub overlay: bool,
+    /// With --plot: draw these quantities against A/A0 instead, one panel each in a column
+    /// sharing the A/A0 axis and the special points' marks, comma-separated: phase,
+    /// dissipated, virial, max-indentation, mean-indentation, harmonic-N (MODEL.md section
+    /// 10), e.g. `phase,dissipated,harmonic-2`.
+    #[arg(long, requires = "plot", value_name = "LIST")]
+    pub panels: Option<String>,
+    /// The harmonics n = 1..N of u reported at every point, N in [1, 1000] (raised to the
+    /// highest harmonic --panels draws).
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
+    pub harmonics: i64,
 }
 
 /// One case's approach, its optional retract and their bistable ranges.
@@ -89,6 +99,12 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     // The options that need no model, checked before the output paths and the models.
     option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
     option_ranges::MAX_POINTS.count(args.max_points)?;
+    option_ranges::HARMONICS.count(args.harmonics)?;
+    let panels = args
+        .panels
+        .as_deref()
+        .map(PanelQuantity::parse_list)
+        .transpose()?;
     let csv_path = args
         .csv
         .as_ref()
@@ -145,7 +161,11 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     }
     progress.finish();
     if let Some(plot) = plot {
-        plot.write(&figure(&drawn, args.overlay)?)?;
+        let svg = match &panels {
+            Some(quantities) => contrast_figure(&drawn, quantities)?,
+            None => figure(&drawn, args.overlay)?,
+        };
+        plot.write(&svg)?;
     }
     if unfinished.is_empty() {
         return Ok(());
@@ -190,6 +210,13 @@ pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<Dia
     let mut settings =
         approach_settings(model, args.floor, args.min_amplitude_ratio, args.max_step)?;
     settings.max_points = option_ranges::MAX_POINTS.count(args.max_points)?;
+    let drawn = args
+        .panels
+        .as_deref()
+        .map(PanelQuantity::parse_list)
+        .transpose()?
+        .map_or(0, |quantities| PanelQuantity::highest_harmonic(&quantities));
+    settings.orbit.harmonics = option_ranges::HARMONICS.count(args.harmonics)?.max(drawn);
     Ok(settings)
 }
 
@@ -309,6 +336,7 @@ pub fn continue_json(
         "max_step_nm": settings.max_step,
         "max_points": settings.max_points,
         "retract": args.retract,
+        "harmonics": settings.orbit.harmonics,
     });
     let mut object = json!({
         "inputs": orbit_inputs_json("continue", options, case, model, &settings.orbit),
@@ -433,7 +461,7 @@ fn merge_ranges(mut ranges: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
 
 /// The CSV columns after `direction`: the scalar keys of a JSON branch point, in this order
 /// (docs/output-schema.md).
-pub const CSV_COLUMNS: [&str; 15] = [
+pub const CSV_COLUMNS: [&str; 20] = [
     "z_nm",
     "amplitude_ratio",
     "phase_deg",
@@ -445,6 +473,11 @@ pub const CSV_COLUMNS: [&str; 15] = [
     "mean_force_nn",
     "impulse_nn_us",
     "contact_time_periods",
+    "dissipated_ev",
+    "virial_ev",
+    "max_indentation_nm",
+    "mean_indentation_nm",
+    "energy_balance_residual",
     "spectral_radius",
     "stable",
     "iterations",
@@ -453,9 +486,17 @@ pub const CSV_COLUMNS: [&str; 15] = [
 
 /// The CSV of a diagram's points (header line first): `direction` (`approach` or `retract`),
 /// then [`CSV_COLUMNS`], each the value of the JSON point's key of that name (empty for
-/// `null`).
+/// `null`), then `harmonic_<n>_amplitude_nm` and `harmonic_<n>_phase_deg` for `n = 1..N`
+/// (the JSON point's `harmonics[n - 1]`).
 fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
-    let mut text = format!("direction,{}\n", CSV_COLUMNS.join(","));
+    let count = diagram.points.first().map_or(0, |p| p.harmonics.len());
+    let mut text = format!("direction,{}", CSV_COLUMNS.join(","));
+    for n in 1..=count {
+        text.push_str(&format!(
+            ",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"
+        ));
+    }
+    text.push('\n');
     for point in &diagram.points {
         push_csv_row(
             &mut text,
@@ -463,6 +504,17 @@ fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
             &serde_json::to_value(point)?,
             &CSV_COLUMNS,
         );
+        // The row's newline moves after the harmonics.
+        text.pop();
+        for n in 0..count {
+            let harmonic = point.harmonics.get(n);
+            text.push_str(&format!(
+                ",{},{}",
+                harmonic.map_or(f64::NAN, |h| h.amplitude_nm),
+                harmonic.map_or(f64::NAN, |h| h.phase_deg)
+            ));
+        }
+        text.push('\n');
     }
     Ok(text)
 }

@@ -5,8 +5,8 @@
 //! dashed; a retract branch is drawn over the approach dash-dotted (dotted where unstable).
 //! Quantities and labels: MODEL.md (amplitude ratio, phase lag, impacts, special points).
 
-use afm::{BifurcationDiagram, Case, DiagramPoint, TappingModel};
-use anyhow::Result;
+use afm::{BifurcationDiagram, Case, DiagramPoint, DiagramSpecialPoint, Harmonic, TappingModel};
+use anyhow::{bail, Result};
 
 use crate::plot::{render_svg, Marker, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 
@@ -296,5 +296,178 @@ fn case_panel(index: usize, c: &CaseDiagrams) -> Panel {
         y_period: Some(PHASE_PERIOD_DEG),
         y_integer_ticks: false,
         ..Panel::default()
+    }
+}
+
+/// A quantity `continue --plot --panels` draws against `A/A0` (MODEL.md sections 4 and 10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PanelQuantity {
+    /// The phase lag `Phi`, degrees.
+    Phase,
+    /// The energy dissipated in the sample per drive period, eV.
+    Dissipated,
+    /// The virial, eV.
+    Virial,
+    /// The largest indentation, nm.
+    MaxIndentation,
+    /// The mean indentation over the time in contact, nm.
+    MeanIndentation,
+    /// The amplitude of harmonic `n` of `u`, nm.
+    Harmonic(usize),
+}
+
+/// The names `--panels` takes, for its help and errors.
+pub const PANEL_NAMES: &str =
+    "phase, dissipated, virial, max-indentation, mean-indentation, harmonic-N (N >= 1)";
+
+impl PanelQuantity {
+    /// Parse the comma-separated `--panels` list (`phase,dissipated,harmonic-2`); an error names
+    /// the unknown entry and the allowed ones.
+    pub fn parse_list(list: &str) -> Result<Vec<Self>> {
+        let mut quantities = Vec::new();
+        for word in list.split(',').map(str::trim) {
+            let quantity = match word {
+                "phase" => Self::Phase,
+                "dissipated" => Self::Dissipated,
+                "virial" => Self::Virial,
+                "max-indentation" => Self::MaxIndentation,
+                "mean-indentation" => Self::MeanIndentation,
+                _ => match word
+                    .strip_prefix("harmonic-")
+                    .and_then(|n| n.parse::<usize>().ok())
+                {
+                    Some(n) if (1..=1000).contains(&n) => Self::Harmonic(n),
+                    _ => bail!(
+                        "--panels: `{word}` is not a panel; the panels are {PANEL_NAMES} (N in [1, 1000]), comma-separated"
+                    ),
+                },
+            };
+            quantities.push(quantity);
+        }
+        Ok(quantities)
+    }
+
+    /// The highest harmonic the panels need (0 for none).
+    pub fn highest_harmonic(quantities: &[Self]) -> usize {
+        quantities
+            .iter()
+            .map(|q| match q {
+                Self::Harmonic(n) => *n,
+                _ => 0,
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// The axis label, with units.
+    fn label(self) -> String {
+        match self {
+            Self::Phase => String::from("phase (deg)"),
+            Self::Dissipated => String::from("dissipated energy E_ts (eV per period)"),
+            Self::Virial => String::from("virial V_ts (eV)"),
+            Self::MaxIndentation => String::from("max indentation (nm)"),
+            Self::MeanIndentation => String::from("mean indentation (nm)"),
+            Self::Harmonic(n) => format!("harmonic {n} amplitude |U_{n}| (nm)"),
+        }
+    }
+
+    /// Its value at a branch point.
+    fn of_point(self, p: &DiagramPoint) -> f64 {
+        self.value(
+            p.phase_deg,
+            [
+                p.dissipated_ev,
+                p.virial_ev,
+                p.max_indentation_nm,
+                p.mean_indentation_nm,
+            ],
+            &p.harmonics,
+        )
+    }
+
+    /// Its value at a special point.
+    fn of_special(self, p: &DiagramSpecialPoint) -> f64 {
+        self.value(
+            p.phase_deg,
+            [
+                p.dissipated_ev,
+                p.virial_ev,
+                p.max_indentation_nm,
+                p.mean_indentation_nm,
+            ],
+            &p.harmonics,
+        )
+    }
+
+    fn value(
+        self,
+        phase: f64,
+        [dissipated, virial, max, mean]: [f64; 4],
+        harmonics: &[Harmonic],
+    ) -> f64 {
+        match self {
+            Self::Phase => phase,
+            Self::Dissipated => dissipated,
+            Self::Virial => virial,
+            Self::MaxIndentation => max,
+            Self::MeanIndentation => mean,
+            Self::Harmonic(n) => harmonics.get(n - 1).map_or(f64::NAN, |h| h.amplitude_nm),
+        }
+    }
+}
+
+/// Size of one panel of the `--panels` column, pixels.
+const CONTRAST_PANEL_SIZE: (u32, u32) = (700, 300);
+
+/// The figure of `continue --plot --panels`: the chosen quantities against `A/A0`, one panel
+/// each, stacked in one column on the same `A/A0` axis, every case's special points (`G_n`,
+/// folds, ...) marked on each.
+pub fn contrast_figure(cases: &[CaseDiagrams], quantities: &[PanelQuantity]) -> Result<String> {
+    let title = match cases {
+        [one] => case_title(None, one),
+        _ => String::new(),
+    };
+    let panels: Vec<Panel> = quantities
+        .iter()
+        .enumerate()
+        .map(|(i, &quantity)| Panel {
+            title: if i == 0 { title.clone() } else { String::new() },
+            x_label: String::from("amplitude ratio A/A0"),
+            y_label: quantity.label(),
+            series: all_series(cases, move |p| (p.amplitude_ratio, quantity.of_point(p))),
+            markers: markers(cases, move |p| (p.amplitude_ratio, quantity.of_special(p))),
+            y_period: (quantity == PanelQuantity::Phase).then_some(PHASE_PERIOD_DEG),
+            y_integer_ticks: false,
+            ..Panel::default()
+        })
+        .collect();
+    render_svg(&panels, panels.len(), 1, CONTRAST_PANEL_SIZE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn panel_lists_parse_and_bad_entries_name_the_allowed_ones() {
+        assert_eq!(
+            PanelQuantity::parse_list("phase,dissipated,harmonic-2").expect("valid"),
+            vec![
+                PanelQuantity::Phase,
+                PanelQuantity::Dissipated,
+                PanelQuantity::Harmonic(2)
+            ]
+        );
+        assert_eq!(
+            PanelQuantity::highest_harmonic(&[PanelQuantity::Harmonic(7), PanelQuantity::Phase]),
+            7
+        );
+        for bad in ["phase,amplitude", "harmonic-0", "harmonic-x", ""] {
+            let error = PanelQuantity::parse_list(bad).expect_err(bad).to_string();
+            assert!(
+                error.contains("--panels") && error.contains("dissipated"),
+                "{error}"
+            );
+        }
     }
 }

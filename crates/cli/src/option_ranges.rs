@@ -48,6 +48,9 @@ pub const AMPLITUDE_RATIO: OptionRange = OptionRange::new(
 /// `--min-amplitude-ratio` of `continue` (0 disables the stop).
 pub const MIN_AMPLITUDE_RATIO: OptionRange =
     OptionRange::new("--min-amplitude-ratio", Interval::right_open(0.0, 1.0, ""));
+/// `--harmonics` of `simulate` and `continue`: the harmonics `1..=N` of `u` reported.
+pub const HARMONICS: OptionRange =
+    OptionRange::new("--harmonics", Interval::closed(1.0, 1000.0, ""));
 /// `--max-points` of `continue`.
 pub const MAX_POINTS: OptionRange =
     OptionRange::new("--max-points", Interval::closed(2.0, 1e7, ""));
@@ -94,6 +97,7 @@ pub const TABLE: &[OptionRange] = &[
     AMPLITUDE_RATIO,
     MIN_AMPLITUDE_RATIO,
     MAX_POINTS,
+    HARMONICS,
     RATE,
     TO,
     TOLERANCE,

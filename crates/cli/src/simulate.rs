@@ -16,7 +16,7 @@ use crate::model_args::ModelArgs;
 use crate::option_ranges;
 use crate::output::print_stdout;
 use crate::plot::{render_svg, FigureFile};
-use crate::trajectory_plot::trajectory_panels;
+use crate::trajectory_plot::{harmonic_spectrum_panel, trajectory_panels};
 
 /// Options of `drumroll simulate`.
 #[derive(Debug, Clone, Args)]
@@ -44,11 +44,15 @@ pub struct SimulateArgs {
     /// when it differs.
     #[arg(long, value_enum, default_value_t = Start::Approach)]
     pub start: Start,
+    /// The harmonics n = 1..N of u reported (amplitude and phase of each, MODEL.md section 10),
+    /// N in [1, 1000].
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
+    pub harmonics: i64,
     /// Print one JSON object instead of the readable summary.
     #[arg(long)]
     pub json: bool,
-    /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) into this file
-    /// (.svg, .png or .pdf by the extension).
+    /// Draw two periods of u(t) and F_ts(t) (the layout of the paper's Fig. 1) and the
+    /// harmonic spectrum of u into this file (.svg, .png or .pdf by the extension).
     #[arg(long, value_name = "FILE.svg|png|pdf")]
     pub plot: Option<PathBuf>,
 }
@@ -100,13 +104,17 @@ pub fn coexisting_orbit(
 /// Run `drumroll simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
     check_orbit_options(args.z, args.amplitude_ratio)?;
+    let harmonics = option_ranges::HARMONICS.count(args.harmonics)?;
     let plot_path = args
         .plot
         .as_ref()
         .map(|p| FigureFile::new(p, "--plot"))
         .transpose()?;
     let (case, model) = args.model.model()?;
-    let settings = SteadyOrbitSettings::default();
+    let settings = SteadyOrbitSettings {
+        harmonics,
+        ..SteadyOrbitSettings::default()
+    };
     let (orbit, start) = orbit_at(&model, args.z, args.amplitude_ratio, args.start, &settings)?;
     let coexisting = match args.z {
         Some(_) => coexisting_orbit(&model, &orbit, start, &settings),
@@ -125,6 +133,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             "z_nm": args.z,
             "amplitude_ratio": args.amplitude_ratio,
             "start": start.name(),
+            "harmonics": harmonics,
         });
         let object = simulate_json(
             &case,
@@ -147,7 +156,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         if let Some(first) = panels.first_mut() {
             first.title = format!("{}: {}", case.name, first.title);
         }
-        path.write(&render_svg(&panels, 2, 1, (800, 320))?)?;
+        panels.push(harmonic_spectrum_panel(&orbit));
+        path.write(&render_svg(&panels, 3, 1, (800, 320))?)?;
         if !args.json {
             print_stdout(&format!("figure: {}\n", path.path.display()))?;
         }
@@ -254,6 +264,12 @@ pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serd
         "mean_force_nn": observables.mean_force_nn,
         "contact_time_periods": observables.contact_time_periods,
         "impulse_nn_us": observables.impulse_nn_us,
+        "dissipated_ev": observables.dissipated_ev,
+        "virial_ev": observables.virial_ev,
+        "max_indentation_nm": observables.max_indentation_nm,
+        "mean_indentation_nm": observables.mean_indentation_nm,
+        "energy_balance_residual": observables.energy_balance_residual,
+        "harmonics": observables.harmonics,
         "state": orbit.state,
         "periods": orbit.period_breakdown(model.free_amplitude_nm()),
     })
@@ -372,6 +388,23 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
     // (+ 0.0 prints a negative zero as 0.)
     let _ = writeln!(s, "peak force {:.6} nN, mean force {:.6e} nN, contact time {:.6} periods per period, impulse {:.6} nN us per period",
         observables.peak_force_nn, observables.mean_force_nn + 0.0, observables.contact_time_periods + 0.0, observables.impulse_nn_us + 0.0);
+    let _ = writeln!(
+        s,
+        "dissipated {:.6e} eV per period, virial {:.6e} eV, indentation max {:.6} nm, mean {:.6} nm (in contact); energy balance residual {:.1e}",
+        observables.dissipated_ev + 0.0,
+        observables.virial_ev + 0.0,
+        observables.max_indentation_nm,
+        observables.mean_indentation_nm,
+        observables.energy_balance_residual
+    );
+    let _ = writeln!(s, "harmonics of u:  n  amplitude (nm)  phase (deg)");
+    for harmonic in &observables.harmonics {
+        let _ = writeln!(
+            s,
+            "  {:>16} {:>14.6e} {:>12.4}",
+            harmonic.n, harmonic.amplitude_nm, harmonic.phase_deg
+        );
+    }
     if k > 1 {
         let _ = writeln!(
             s,

@@ -1,5 +1,5 @@
 //! The paper's Fig. 1 layout: the photodiode signal `u(t)` above the tip-sample force
-//! `F_ts(t)` over a few periods of a steady orbit.
+//! `F_ts(t)` over a few periods of a steady orbit; and the orbit's harmonic spectrum.
 
 use afm::{sample_trajectory, SteadyOrbit, TappingModel};
 use anyhow::Result;
@@ -67,4 +67,30 @@ pub fn trajectory_panels(
             cells: Vec::new(),
         },
     ])
+}
+
+/// The harmonic spectrum of `orbit`'s `u`: `log10 |U_n|` (amplitude in nm, MODEL.md section
+/// 10) against the order `n = 1..N`, one dot per harmonic (harmonics that vanish to rounding,
+/// below 1e-15 nm, are left out).
+pub fn harmonic_spectrum_panel(orbit: &SteadyOrbit) -> Panel {
+    let points = orbit
+        .observables()
+        .harmonics
+        .iter()
+        .filter(|h| h.amplitude_nm > 1e-15)
+        .map(|h| (h.n as f64, h.amplitude_nm.log10()))
+        .collect();
+    Panel {
+        title: String::from("harmonic spectrum of u"),
+        x_label: String::from("harmonic n (multiple of the drive frequency)"),
+        y_label: String::from("log10 |U_n| (amplitude in nm)"),
+        series: vec![Series {
+            label: String::new(),
+            points,
+            stroke: Stroke::Dots,
+            colour: 0,
+        }],
+        y_integer_ticks: false,
+        ..Panel::default()
+    }
 }

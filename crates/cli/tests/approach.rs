@@ -20,10 +20,14 @@ fn stdout_of(args: &[&str]) -> String {
     String::from_utf8(output.stdout).expect("UTF-8")
 }
 
-/// One CSV row: (cycle, z, A/A0, phase, impacts, peak force, direction).
+/// One CSV row: (cycle, z, A/A0, phase, impacts, peak force, direction); the dissipated
+/// energy and the four harmonics' eight columns are checked to be numbers.
 fn parse_row(line: &str) -> (u64, f64, f64, f64, f64, f64, String) {
     let fields: Vec<&str> = line.split(',').collect();
-    assert_eq!(fields.len(), 7, "{line}");
+    assert_eq!(fields.len(), 16, "{line}");
+    for i in [6].into_iter().chain(8..16) {
+        fields[i].parse::<f64>().expect("a number");
+    }
     let number = |i: usize| fields[i].parse::<f64>().expect("a number");
     (
         fields[0].parse().expect("cycle"),
@@ -32,7 +36,7 @@ fn parse_row(line: &str) -> (u64, f64, f64, f64, f64, f64, String) {
         number(3),
         number(4),
         number(5),
-        fields[6].to_string(),
+        fields[7].to_string(),
     )
 }
 
@@ -68,7 +72,12 @@ fn csv_rows_follow_the_steady_orbit() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
-        Some("cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,direction")
+        Some(concat!(
+            "cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,dissipated_ev,",
+            "direction,harmonic_1_amplitude_nm,harmonic_1_phase_deg,harmonic_2_amplitude_nm,",
+            "harmonic_2_phase_deg,harmonic_3_amplitude_nm,harmonic_3_phase_deg,",
+            "harmonic_4_amplitude_nm,harmonic_4_phase_deg"
+        ))
     );
     let rows: Vec<_> = lines.map(parse_row).collect();
     let free = simulate(12.0);
@@ -243,7 +252,8 @@ fn a_killed_run_leaves_only_complete_records() {
         .expect("starts");
     // Wait until some records are there, then kill the process (SIGKILL: no clean-up).
     let start = std::time::Instant::now();
-    while std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0) < 20_000 {
+    // (Rows of about 250 bytes with the four harmonics.)
+    while std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0) < 60_000 {
         assert!(start.elapsed().as_secs() < 60, "no records within a minute");
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
@@ -254,7 +264,12 @@ fn a_killed_run_leaves_only_complete_records() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
-        Some("cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,direction")
+        Some(concat!(
+            "cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,dissipated_ev,",
+            "direction,harmonic_1_amplitude_nm,harmonic_1_phase_deg,harmonic_2_amplitude_nm,",
+            "harmonic_2_phase_deg,harmonic_3_amplitude_nm,harmonic_3_phase_deg,",
+            "harmonic_4_amplitude_nm,harmonic_4_phase_deg"
+        ))
     );
     let rows: Vec<_> = lines.map(parse_row).collect();
     assert!(rows.len() > 100);

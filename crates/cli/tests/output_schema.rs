@@ -381,7 +381,24 @@ fn csv_columns_are_the_documented_json_keys_in_order() {
         csv.to_str().expect("utf-8 path"),
     ]);
     let written = std::fs::read_to_string(&csv).expect("CSV");
-    let header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    let full_header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    // The harmonic columns `harmonic_<n>_amplitude_nm`, `harmonic_<n>_phase_deg`, n = 1..N,
+    // come last, from the point's `harmonics[n - 1]`.
+    let (header, harmonic_columns): (Vec<&str>, Vec<&str>) = full_header
+        .iter()
+        .partition(|column| !column.starts_with("harmonic_"));
+    assert!(!harmonic_columns.is_empty());
+    for (index, pair) in harmonic_columns.chunks(2).enumerate() {
+        let n = index + 1;
+        assert_eq!(
+            pair,
+            [
+                format!("harmonic_{n}_amplitude_nm"),
+                format!("harmonic_{n}_phase_deg")
+            ]
+        );
+    }
+    assert_eq!(&full_header[..header.len()], &header[..]);
     assert_eq!(header[0], "direction");
     let points = &schema["`drumroll continue --json`"];
     for column in &header[1..] {
@@ -447,7 +464,15 @@ fn csv_columns_are_the_documented_json_keys_in_order() {
 
     // approach's CSV header is the documented line, each column a record key.
     let sweep = stdout_of(&["approach", "--from", "8.8", "--to", "8.79", "--rate", "10"]);
-    let header = sweep.lines().next().expect("header");
+    let full_header = sweep.lines().next().expect("header");
+    // The harmonic columns (4 by default) follow the documented scalar columns.
+    let header = full_header
+        .split_once(",harmonic_")
+        .map_or(full_header, |(scalars, _)| scalars);
+    let harmonics: String = (1..=4)
+        .map(|n| format!(",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"))
+        .collect();
+    assert_eq!(full_header, format!("{header}{harmonics}"));
     assert!(
         text.contains(&format!("`{header}`")),
         "header {header} not documented"

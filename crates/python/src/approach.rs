@@ -49,6 +49,7 @@ pub fn compute_approach<'py>(
         every: options.every,
         settle_cycles: options.settle_cycles,
         tolerance: options.tolerance,
+        harmonics: drumroll::approach::DEFAULT_HARMONICS,
         jsonl: true,
         out: None,
         plot: None,

@@ -14,7 +14,7 @@ use serde::Serialize;
 use crate::error::AfmError;
 use crate::model::separation::Separation;
 use crate::model::TappingModel;
-use crate::orbit::observables::{orbit_observables, GapMinimum, OrbitObservables};
+use crate::orbit::observables::{orbit_observables, GapMinimum, Harmonic, OrbitObservables};
 use crate::orbit::steady_orbit::SteadyOrbitSettings;
 
 /// How a diagram is computed. [`DiagramSettings::approach`] and [`DiagramSettings::retract`]
@@ -129,6 +129,18 @@ pub struct DiagramPoint {
     pub impulse_nn_us: f64,
     /// Time in contact per drive period, in periods.
     pub contact_time_periods: f64,
+    /// Harmonics `1..=N` of `u` (N = `SteadyOrbitSettings::harmonics`; MODEL.md section 10).
+    pub harmonics: Vec<Harmonic>,
+    /// Energy dissipated in the sample per drive period, eV (MODEL.md section 10).
+    pub dissipated_ev: f64,
+    /// The virial, eV.
+    pub virial_ev: f64,
+    /// The largest indentation, nm.
+    pub max_indentation_nm: f64,
+    /// The mean indentation over the time in contact, nm.
+    pub mean_indentation_nm: f64,
+    /// The energy balance's relative residual.
+    pub energy_balance_residual: f64,
     /// Floquet multipliers `[re, im]`, by decreasing modulus.
     pub floquet_multipliers: Vec<[f64; 2]>,
     /// The largest modulus of the Floquet multipliers.
@@ -170,6 +182,16 @@ pub struct DiagramSpecialPoint {
     pub converged: bool,
     /// The orbit's state at the point.
     pub state: Vec<f64>,
+    /// Harmonics `1..=N` of `u` there (MODEL.md section 10).
+    pub harmonics: Vec<Harmonic>,
+    /// Energy dissipated in the sample per drive period there, eV.
+    pub dissipated_ev: f64,
+    /// The virial there, eV.
+    pub virial_ev: f64,
+    /// The largest indentation there, nm.
+    pub max_indentation_nm: f64,
+    /// The mean indentation over the time in contact there, nm.
+    pub mean_indentation_nm: f64,
 }
 
 /// A computed diagram.
@@ -286,6 +308,7 @@ pub fn diagram_until(
     let a0 = model.free_amplitude_nm();
     let min_ratio = settings.min_amplitude_ratio;
     let integration = settings.orbit.integration.clone();
+    let harmonics = settings.orbit.harmonics;
     // Observables are computed once per point, inside the stop predicate, and kept.
     let mut observed: Vec<Result<OrbitObservables, AfmError>> = Vec::new();
     let mut was_interrupted = false;
@@ -301,7 +324,7 @@ pub fn diagram_until(
                 }
                 at_point.set_parameter(point.parameter);
                 let observables =
-                    orbit_observables(&at_point, point.state.as_slice(), &integration);
+                    orbit_observables(&at_point, point.state.as_slice(), &integration, harmonics);
                 let stop = match &observables {
                     Ok(o) => o.amplitude_nm / a0 < min_ratio,
                     Err(_) => true,
@@ -324,6 +347,7 @@ pub fn diagram_until(
             &system,
             special,
             &settings.orbit.integration,
+            settings.orbit.harmonics,
         )?);
     }
     Ok(BifurcationDiagram {
@@ -368,6 +392,12 @@ fn diagram_point(point: &BranchPoint, observables: &OrbitObservables) -> Diagram
         mean_force_nn: observables.mean_force_nn,
         impulse_nn_us: observables.impulse_nn_us,
         contact_time_periods: observables.contact_time_periods,
+        harmonics: observables.harmonics.clone(),
+        dissipated_ev: observables.dissipated_ev,
+        virial_ev: observables.virial_ev,
+        max_indentation_nm: observables.max_indentation_nm,
+        mean_indentation_nm: observables.mean_indentation_nm,
+        energy_balance_residual: observables.energy_balance_residual,
         floquet_multipliers: multipliers_of(&point.multipliers),
         spectral_radius: continuation::spectral_radius(&point.multipliers),
         stable: point.stable,
@@ -381,10 +411,12 @@ fn diagram_special_point(
     system: &TappingModel,
     special: &SpecialPoint,
     integration: &hybrid::Settings,
+    harmonics: usize,
 ) -> Result<DiagramSpecialPoint, AfmError> {
     let mut at_point = system.clone();
     at_point.set_parameter(special.parameter);
-    let observables = orbit_observables(&at_point, special.state.as_slice(), integration)?;
+    let observables =
+        orbit_observables(&at_point, special.state.as_slice(), integration, harmonics)?;
     // A grazing is named after the impact count on its impacting side, whichever way the
     // branch runs: G_n is the onset of n impacts per period on approach (MODEL.md section 5),
     // and the same point met on a retract (n -> n - 1) keeps its name.
@@ -419,5 +451,10 @@ fn diagram_special_point(
         precision_nm: special.precision,
         converged: special.converged,
         state: special.state.as_slice().to_vec(),
+        harmonics: observables.harmonics,
+        dissipated_ev: observables.dissipated_ev,
+        virial_ev: observables.virial_ev,
+        max_indentation_nm: observables.max_indentation_nm,
+        mean_indentation_nm: observables.mean_indentation_nm,
     })
 }

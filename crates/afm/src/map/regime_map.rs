@@ -373,7 +373,7 @@ fn observe(
         )?
         .state
     };
-    let observables = orbit_observables(&model, &at_zero, integration)?;
+    let observables = orbit_observables(&model, &at_zero, integration, 1)?;
     Ok((at_zero, observables.amplitude_ratio, observables.phase_deg))
 }
 

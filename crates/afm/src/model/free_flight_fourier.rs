@@ -22,22 +22,74 @@
 
 use nalgebra::Complex;
 
+use crate::model::drive::Drive;
+use crate::model::eigenmode::Eigenmode;
 use crate::model::free_flight::DrivenOscillator;
 use crate::model::TappingModel;
 
 /// Modes closer to critical damping than this (`|1 - 4 Q^2| <` it) have nearly equal roots, for
 /// which the two-exponential form loses accuracy: [`FreeFlightFourier::new`] declines them.
-const CRITICAL_DAMPING_MARGIN: f64 = 1e-3;
+pub(crate) const CRITICAL_DAMPING_MARGIN: f64 = 1e-3;
 
-/// One mode's constants for the closed form.
+/// One mode's free flight split for the closed forms: the steady part
+/// `p(t) = alpha cos(w t) + beta sin(w t)` and the characteristic roots of the homogeneous
+/// part (shared with [`crate::model::free_flight_energy`]).
 #[derive(Debug, Clone)]
-struct ModeFourier {
+pub(crate) struct FreeFlightMode {
     /// `chi_i`.
-    optical_sensitivity: f64,
+    pub(crate) optical_sensitivity: f64,
     /// `[alpha_i, beta_i]`, nm: the steady free response `alpha cos(w t) + beta sin(w t)`.
-    steady: [f64; 2],
+    pub(crate) steady: [f64; 2],
     /// The characteristic roots `lambda_1`, `lambda_2`, 1/us.
-    roots: [Complex<f64>; 2],
+    pub(crate) roots: [Complex<f64>; 2],
+}
+
+impl FreeFlightMode {
+    /// The split of `mode` under `drive`; `None` within [`CRITICAL_DAMPING_MARGIN`] of
+    /// critical damping (`|1 - 4 Q^2|` below it), where the two exponentials lose accuracy.
+    pub(crate) fn new(mode: &Eigenmode, drive: &Drive) -> Option<Self> {
+        let w = drive.angular_frequency;
+        let q = mode.quality_factor;
+        if (1.0 - 4.0 * q * q).abs() < CRITICAL_DAMPING_MARGIN {
+            return None;
+        }
+        let natural = mode.angular_frequency();
+        let static_deflection = mode.force_ratio * drive.force_nn / mode.stiffness_n_per_m;
+        let steady = DrivenOscillator::new(natural, q, static_deflection, w).steady_coefficients();
+        let mu = -natural / (2.0 * q);
+        let roots = if q > 0.5 {
+            let delta = natural * (1.0 - 1.0 / (4.0 * q * q)).sqrt();
+            [Complex::new(mu, delta), Complex::new(mu, -delta)]
+        } else {
+            // Over-damped: the fast root directly, the slow one from lambda_1 lambda_2 =
+            // w_i^2 (no cancellation).
+            let fast = mu - (mu * mu - natural * natural).sqrt();
+            [
+                Complex::new(fast, 0.0),
+                Complex::new(natural * natural / fast, 0.0),
+            ]
+        };
+        Some(Self {
+            optical_sensitivity: mode.optical_sensitivity,
+            steady,
+            roots,
+        })
+    }
+
+    /// The homogeneous part's coefficients `[c_1, c_2]` (nm) of the flight from `q`, `q'`
+    /// (nm, nm/us) at time `a` under the drive `w` (rad/us): `y(s) = c_1 e^{lambda_1 s} +
+    /// c_2 e^{lambda_2 s}`, `s = t - a`, with `y = q - p`.
+    pub(crate) fn homogeneous(&self, w: f64, a: f64, q: f64, velocity: f64) -> [Complex<f64>; 2] {
+        let [alpha, beta] = self.steady;
+        let (sin_a, cos_a) = (w * a).sin_cos();
+        let p = alpha * cos_a + beta * sin_a;
+        let dp = w * (beta * cos_a - alpha * sin_a);
+        let y = q - p;
+        let dy = velocity - dp;
+        let [l1, l2] = self.roots;
+        let c1 = (dy - l2 * y) / (l1 - l2);
+        [c1, Complex::new(y, 0.0) - c1]
+    }
 }
 
 /// The closed-form Fourier integrals of `u` over free flight of a [`TappingModel`].
@@ -45,7 +97,7 @@ struct ModeFourier {
 pub struct FreeFlightFourier {
     /// Drive angular frequency `w`, rad/us.
     angular_frequency: f64,
-    modes: Vec<ModeFourier>,
+    modes: Vec<FreeFlightMode>,
 }
 
 impl FreeFlightFourier {
@@ -53,38 +105,14 @@ impl FreeFlightFourier {
     /// damping (`Q_i` near 1/2), where the caller should integrate numerically instead.
     pub fn new(model: &TappingModel) -> Option<Self> {
         let drive = model.drive();
-        let w = drive.angular_frequency;
-        let mut modes = Vec::with_capacity(model.mode_count());
-        for mode in &model.cantilever().modes {
-            let q = mode.quality_factor;
-            if (1.0 - 4.0 * q * q).abs() < CRITICAL_DAMPING_MARGIN {
-                return None;
-            }
-            let natural = mode.angular_frequency();
-            let static_deflection = mode.force_ratio * drive.force_nn / mode.stiffness_n_per_m;
-            let steady =
-                DrivenOscillator::new(natural, q, static_deflection, w).steady_coefficients();
-            let mu = -natural / (2.0 * q);
-            let roots = if q > 0.5 {
-                let delta = natural * (1.0 - 1.0 / (4.0 * q * q)).sqrt();
-                [Complex::new(mu, delta), Complex::new(mu, -delta)]
-            } else {
-                // Over-damped: the fast root directly, the slow one from lambda_1 lambda_2 =
-                // w_i^2 (no cancellation).
-                let fast = mu - (mu * mu - natural * natural).sqrt();
-                [
-                    Complex::new(fast, 0.0),
-                    Complex::new(natural * natural / fast, 0.0),
-                ]
-            };
-            modes.push(ModeFourier {
-                optical_sensitivity: mode.optical_sensitivity,
-                steady,
-                roots,
-            });
-        }
+        let modes = model
+            .cantilever()
+            .modes
+            .iter()
+            .map(|mode| FreeFlightMode::new(mode, drive))
+            .collect::<Option<Vec<_>>>()?;
         Some(Self {
-            angular_frequency: w,
+            angular_frequency: drive.angular_frequency,
             modes,
         })
     }
@@ -105,7 +133,6 @@ impl FreeFlightFourier {
         let w = self.angular_frequency;
         let kw = k as f64 * w;
         let length = b - a;
-        let (sin_a, cos_a) = (w * a).sin_cos();
         let (sin_ka, cos_ka) = (kw * a).sin_cos();
         // e^{-ikwa}, by which the homogeneous part is rotated.
         let rotation_a = Complex::new(cos_ka, -sin_ka);
@@ -120,16 +147,9 @@ impl FreeFlightFourier {
             // The steady part.
             let steady = Complex::new(alpha, -beta) * 0.5 * co_rotating
                 + Complex::new(alpha, beta) * 0.5 * counter_rotating;
-            // The homogeneous part's initial conditions.
-            let p = alpha * cos_a + beta * sin_a;
-            let dp = w * (beta * cos_a - alpha * sin_a);
-            let y = x_a[2 * i] - p;
-            let dy = x_a[2 * i + 1] - dp;
-            let [l1, l2] = mode.roots;
-            let c1 = (dy - l2 * y) / (l1 - l2);
-            let c2 = Complex::new(y, 0.0) - c1;
+            let coefficients = mode.homogeneous(w, a, x_a[2 * i], x_a[2 * i + 1]);
             let mut homogeneous = Complex::new(0.0, 0.0);
-            for (c, l) in [(c1, l1), (c2, l2)] {
+            for (c, l) in coefficients.into_iter().zip(mode.roots) {
                 let z = l + minus_ikw;
                 homogeneous += c * ((z * length).exp() - 1.0) / z;
             }

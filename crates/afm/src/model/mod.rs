@@ -16,6 +16,7 @@ pub mod drive;
 pub mod eigenmode;
 pub mod film_validity;
 pub mod free_flight;
+pub mod free_flight_energy;
 pub mod free_flight_fourier;
 pub mod free_response;
 pub mod hertz_contact;

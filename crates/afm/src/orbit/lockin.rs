@@ -7,7 +7,8 @@
 //! ```
 //!
 //! with `t` measured from the cycle's start (drive phase zero), together with the impacts
-//! (contact onsets, MODEL.md section 5) and the peak Hertz force in the cycle; and the average
+//! (contact onsets, MODEL.md section 5), the peak Hertz force, the higher harmonics `n = 2..N`
+//! likewise and the energy dissipated in the sample (MODEL.md section 10) in the cycle; and the average
 //! of those readings over consecutive blocks of `N` cycles, as a lock-in amplifier with an
 //! integration time of `N T` reports them.
 //!
@@ -22,9 +23,14 @@ use crate::model::free_flight_fourier::FreeFlightFourier;
 use crate::model::TappingModel;
 use crate::model::GAP_SURFACE;
 use crate::orbit::gauss_legendre::GAUSS_LEGENDRE_4;
+use crate::orbit::observables::NN_NM_IN_EV;
+
+/// The most harmonics of `u` a lock-in reads per cycle (its readings are fixed-size, so a
+/// sweep allocates nothing per cycle).
+pub const MAX_LOCKIN_HARMONICS: usize = 20;
 
 /// What the lock-in reads over one drive cycle `[0, T]` (time from the cycle's start).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleReading {
     /// `a = (2/T) int u cos(w t) dt`, nm.
     pub cosine_nm: f64,
@@ -37,6 +43,14 @@ pub struct CycleReading {
     /// minimum of every contact, and the force at the cycle's ends for a contact that spans a
     /// cycle boundary.
     pub peak_force_nn: f64,
+    /// `[a_n, b_n] = (2/T) int u [cos(n w t), sin(n w t)] dt`, nm, for `n = 1..=harmonic_count`
+    /// (`harmonics[0]` is `[cosine_nm, sine_nm]`; the rest are zero).
+    pub harmonics: [[f64; 2]; MAX_LOCKIN_HARMONICS],
+    /// The harmonics read (at least 1).
+    pub harmonic_count: usize,
+    /// The energy dissipated in the sample over the cycle, `-int F_ts w' dt` (`w = sum_i q_i`),
+    /// eV (MODEL.md section 10).
+    pub dissipated_ev: f64,
 }
 
 /// Accumulates a [`CycleReading`] from the steps of a solver that integrates one drive cycle
@@ -46,8 +60,11 @@ pub struct CycleReading {
 pub struct CycleLockIn {
     period: f64,
     angular_frequency: f64,
-    cosine: f64,
-    sine: f64,
+    /// `[int u cos(n w t) dt, int u sin(n w t) dt]`, `n = 1..=harmonic_count`.
+    fourier: [[f64; 2]; MAX_LOCKIN_HARMONICS],
+    harmonic_count: usize,
+    /// `int F_ts w' dt` over the cycle, nN nm.
+    contact_work: f64,
     impacts: usize,
     peak_force: f64,
     /// The states at a contact step's quadrature nodes (`n` per node).
@@ -66,13 +83,21 @@ pub struct CycleLockIn {
 }
 
 impl CycleLockIn {
-    /// A lock-in for cycles of `model`'s drive period `T = 2 pi / w` (us).
+    /// A lock-in for cycles of `model`'s drive period `T = 2 pi / w` (us), reading the first
+    /// harmonic.
     pub fn new(model: &TappingModel) -> Self {
+        Self::with_harmonics(model, 1)
+    }
+
+    /// A lock-in reading harmonics `1..=harmonic_count` of `u` (clamped to
+    /// `1..=`[`MAX_LOCKIN_HARMONICS`]).
+    pub fn with_harmonics(model: &TappingModel, harmonic_count: usize) -> Self {
         Self {
             period: model.period_us(),
             angular_frequency: model.drive_angular_frequency(),
-            cosine: 0.0,
-            sine: 0.0,
+            fourier: [[0.0; 2]; MAX_LOCKIN_HARMONICS],
+            harmonic_count: harmonic_count.clamp(1, MAX_LOCKIN_HARMONICS),
+            contact_work: 0.0,
             impacts: 0,
             peak_force: 0.0,
             node_states: vec![0.0; GAUSS_LEGENDRE_4.len() * model.dim()],
@@ -88,8 +113,8 @@ impl CycleLockIn {
     /// Start a cycle at local time 0 from state `x0` (the model's separation law must be the
     /// one of this cycle): clears the sums and records the contact force at the start.
     pub fn begin(&mut self, model: &TappingModel, x0: &[f64]) {
-        self.cosine = 0.0;
-        self.sine = 0.0;
+        self.fourier = [[0.0; 2]; MAX_LOCKIN_HARMONICS];
+        self.contact_work = 0.0;
         self.impacts = 0;
         self.peak_force = model.tip_sample_force(0.0, x0);
         self.mode = model.mode_of(0.0, x0);
@@ -145,9 +170,12 @@ impl CycleLockIn {
     /// Add the closed-form integrals over the free-flight interval in progress, up to `end`.
     fn close_free_flight(&mut self, end: f64) {
         if let (Some(start), Some(free_flight)) = (self.free_start.take(), &self.free_flight) {
-            let [cosine, sine] = free_flight.integrate(start, &self.free_state, end);
-            self.cosine += cosine;
-            self.sine += sine;
+            for (k, coefficient) in self.fourier[..self.harmonic_count].iter_mut().enumerate() {
+                let [cosine, sine] =
+                    free_flight.integrate_harmonic(k + 1, start, &self.free_state, end);
+                coefficient[0] += cosine;
+                coefficient[1] += sine;
+            }
         }
     }
 
@@ -165,8 +193,15 @@ impl CycleLockIn {
         {
             let u = model.photodiode(state);
             let (sin, cos) = node.drive;
-            self.cosine += node.weight * u * cos;
-            self.sine += node.weight * u * sin;
+            let (mut sin_k, mut cos_k) = (sin, cos);
+            for coefficient in self.fourier[..self.harmonic_count].iter_mut() {
+                coefficient[0] += node.weight * u * cos_k;
+                coefficient[1] += node.weight * u * sin_k;
+                (sin_k, cos_k) = (sin_k * cos + cos_k * sin, cos_k * cos - sin_k * sin);
+            }
+            let deflection_rate: f64 = state.chunks_exact(2).map(|mode| mode[1]).sum();
+            self.contact_work +=
+                node.weight * model.tip_sample_force(node.t, state) * deflection_rate;
         }
     }
 
@@ -174,9 +209,16 @@ impl CycleLockIn {
     pub fn finish(&mut self, model: &TappingModel, x_end: &[f64]) -> CycleReading {
         self.close_free_flight(self.previous_end);
         let scale = 2.0 / self.period;
+        let mut harmonics = [[0.0; 2]; MAX_LOCKIN_HARMONICS];
+        for (reading, [a, b]) in harmonics.iter_mut().zip(self.fourier) {
+            *reading = [scale * a, scale * b];
+        }
         CycleReading {
-            cosine_nm: scale * self.cosine,
-            sine_nm: scale * self.sine,
+            cosine_nm: harmonics[0][0],
+            sine_nm: harmonics[0][1],
+            harmonics,
+            harmonic_count: self.harmonic_count,
+            dissipated_ev: -NN_NM_IN_EV * self.contact_work,
             impacts: self.impacts,
             peak_force_nn: self
                 .peak_force
@@ -202,6 +244,12 @@ pub struct BlockReading {
     pub impacts_per_cycle: f64,
     /// The largest Hertz force over the block, nN.
     pub peak_force_nn: f64,
+    /// The block means of `[a_n, b_n]`, nm, `n = 1..=harmonic_count` (the rest zero).
+    pub harmonics: [[f64; 2]; MAX_LOCKIN_HARMONICS],
+    /// The harmonics read.
+    pub harmonic_count: usize,
+    /// The energy dissipated in the sample per cycle, averaged over the block, eV.
+    pub dissipated_ev: f64,
 }
 
 /// Averages consecutive, non-overlapping blocks of `N` cycle readings (a lock-in with an
@@ -218,6 +266,9 @@ pub struct BlockAverage {
     z: f64,
     impacts: usize,
     peak_force: f64,
+    harmonics: [[f64; 2]; MAX_LOCKIN_HARMONICS],
+    harmonic_count: usize,
+    dissipated: f64,
 }
 
 impl BlockAverage {
@@ -234,6 +285,9 @@ impl BlockAverage {
             z: 0.0,
             impacts: 0,
             peak_force: 0.0,
+            harmonics: [[0.0; 2]; MAX_LOCKIN_HARMONICS],
+            harmonic_count: 1,
+            dissipated: 0.0,
         }
     }
 
@@ -249,6 +303,12 @@ impl BlockAverage {
         self.z += z_nm;
         self.impacts += reading.impacts;
         self.peak_force = self.peak_force.max(reading.peak_force_nn);
+        for (sum, [a, b]) in self.harmonics.iter_mut().zip(reading.harmonics) {
+            sum[0] += a;
+            sum[1] += b;
+        }
+        self.harmonic_count = reading.harmonic_count;
+        self.dissipated += reading.dissipated_ev;
         (self.count == self.cycles_per_block).then(|| self.flush())
     }
 
@@ -260,6 +320,8 @@ impl BlockAverage {
         self.z = 0.0;
         self.impacts = 0;
         self.peak_force = 0.0;
+        self.harmonics = [[0.0; 2]; MAX_LOCKIN_HARMONICS];
+        self.dissipated = 0.0;
     }
 
     fn flush(&mut self) -> BlockReading {
@@ -273,6 +335,9 @@ impl BlockAverage {
             phase_deg: b.atan2(a).to_degrees(),
             impacts_per_cycle: self.impacts as f64 / n,
             peak_force_nn: self.peak_force,
+            harmonics: self.harmonics.map(|[a, b]| [a / n, b / n]),
+            harmonic_count: self.harmonic_count,
+            dissipated_ev: self.dissipated / n,
         };
         self.clear();
         reading

@@ -17,6 +17,7 @@ use hybrid::{
 use serde::Serialize;
 
 use crate::error::AfmError;
+use crate::model::free_flight_energy::{FreeFlightEnergy, ModeIntegrals};
 use crate::model::free_flight_fourier::FreeFlightFourier;
 use crate::model::TappingModel;
 use crate::model::{CONTACT, GAP_SURFACE};
@@ -100,11 +101,43 @@ pub struct GapMinimum {
 /// One harmonic `k` of the photodiode signal: `u ~ sum_k A_k cos(k w t - Phi_k)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Harmonic {
+    /// The order `k` (1 for the drive frequency).
+    pub n: usize,
     /// `A_k = hypot(a_k, b_k)`, nm, with `a_k = (2/W) int u cos(k w t) dt` and `b_k` with sin,
     /// over the window `W` of whole drive periods (the lock-in reading of the whole window).
     pub amplitude_nm: f64,
     /// `Phi_k = atan2(b_k, a_k)`, degrees (a lag).
     pub phase_deg: f64,
+}
+
+/// One nN nm in eV (1 nN nm = 1e-18 J; 1 eV = 1.602176634e-19 J, exact in the SI).
+pub const NN_NM_IN_EV: f64 = 1e-18 / 1.602_176_634e-19;
+
+/// The energy balance of one mode over the window, per drive period (MODEL.md section 10):
+/// Eq. 1 times `m_i q_i'` (`m_i = k_i / w_i^2`) integrated over the window gives
+/// `drive_work_ev = damping_loss_ev + dissipated_share_ev + stored_energy_change_ev`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct ModeEnergy {
+    /// The drive's work on the mode `W_i = int F_i cos(w t) q_i' dt`, eV.
+    pub drive_work_ev: f64,
+    /// The loss in the mode's damping `D_i = (k_i / (w_i Q_i)) int q_i'^2 dt`, eV.
+    pub damping_loss_ev: f64,
+    /// The mode's share of the tip-sample dissipation `-int F_ts q_i' dt`, eV (the shares sum
+    /// to `dissipated_ev`).
+    pub dissipated_share_ev: f64,
+    /// The change of the mode's energy `m_i q_i'^2 / 2 + k_i q_i^2 / 2` from the window's
+    /// start to its end, eV (zero on a periodic orbit to Newton's tolerance).
+    pub stored_energy_change_ev: f64,
+}
+
+impl ModeEnergy {
+    /// The balance's residual `W_i - D_i - E_i - dE_i`, eV.
+    pub fn residual_ev(&self) -> f64 {
+        self.drive_work_ev
+            - self.damping_loss_ev
+            - self.dissipated_share_ev
+            - self.stored_energy_change_ev
+    }
 }
 
 /// The observables of a trajectory over a window of `k` whole drive periods
@@ -139,6 +172,23 @@ pub struct OrbitObservables {
     pub contact_time_periods: f64,
     /// The impulse per drive period `(1/k) int F_ts dt` over the window, nN us.
     pub impulse_nn_us: f64,
+    /// The energy dissipated in the sample per drive period,
+    /// `E_ts = -(1/k) int F_ts w' dt` over the window (`w = sum_i q_i` the tip deflection),
+    /// eV (MODEL.md section 10): zero for a conservative law, positive for a dissipative one.
+    pub dissipated_ev: f64,
+    /// The virial `V_ts = (1/(k T)) int F_ts w dt` over the window, eV.
+    pub virial_ev: f64,
+    /// The largest indentation `s = d_c - d` of the law's contact geometry in the window, nm
+    /// (0 without contact).
+    pub max_indentation_nm: f64,
+    /// The mean indentation over the time in contact, `int s dt / t_contact`, nm (0 without
+    /// contact).
+    pub mean_indentation_nm: f64,
+    /// The energy balance's relative residual: the largest `|W_i - D_i - E_i - dE_i|` of the
+    /// modes over the total damping loss `sum_i D_i` (MODEL.md section 10); 0 at rest.
+    pub energy_balance_residual: f64,
+    /// Each mode's energy balance per drive period.
+    pub mode_energy: Vec<ModeEnergy>,
 }
 
 impl OrbitObservables {
@@ -183,17 +233,51 @@ pub struct PeriodObserver {
     /// `(t, direction, rate)` of every contact event in the window.
     events: Vec<(f64, Direction, f64)>,
     minima: Vec<(f64, f64)>,
-    state: Vec<f64>,
     /// The states at a contact step's quadrature nodes (`n` per node).
     node_states: Vec<f64>,
     /// The closed-form Fourier integrals over free flight (`None` near critical damping, where
     /// free flight is integrated by quadrature like contact).
     free_flight: Option<FreeFlightFourier>,
+    /// The closed-form energy integrals over free flight (`None` where `free_flight` is).
+    free_flight_energy: Option<FreeFlightEnergy>,
     /// The mode of the next step (the solver's mode after the last one observed).
     mode: Mode,
     /// Start time and state of the free-flight interval in progress, if any.
     free_start: Option<f64>,
     free_state: Vec<f64>,
+    /// Each mode's constants for the energy balance.
+    modes: Vec<ModeConstants>,
+    /// Each mode's drive work and `int q_i'^2 dt` over the window.
+    mode_integrals: Vec<ModeIntegrals>,
+    /// Each mode's `int F_ts q_i' dt` over the window, nN nm.
+    contact_work: Vec<f64>,
+    /// `int F_ts w dt` over the window, nN nm us.
+    virial: f64,
+    /// `int s dt` over the window (`s = max(d_c - d, 0)`), nm us.
+    indentation: f64,
+    /// The states at the window's start and end.
+    start_state: Vec<f64>,
+    end_state: Vec<f64>,
+}
+
+/// One mode's constants in the energy balance (MODEL.md section 10).
+#[derive(Debug, Clone, Copy)]
+struct ModeConstants {
+    /// `k_i`, nN/nm.
+    stiffness: f64,
+    /// The modal mass `m_i = k_i / w_i^2`, nN us^2/nm.
+    mass: f64,
+    /// The damping coefficient `k_i / (w_i Q_i)`, nN us/nm.
+    damping: f64,
+    /// The drive amplitude `F_i`, nN.
+    drive_force: f64,
+}
+
+impl ModeConstants {
+    /// The mode's energy `m q'^2 / 2 + k q^2 / 2` at `(q, q')`, nN nm.
+    fn energy(&self, q: f64, velocity: f64) -> f64 {
+        0.5 * (self.mass * velocity * velocity + self.stiffness * q * q)
+    }
 }
 
 impl PeriodObserver {
@@ -231,12 +315,32 @@ impl PeriodObserver {
             impulse: 0.0,
             events: Vec::new(),
             minima: Vec::new(),
-            state: vec![0.0; model.dim()],
             node_states: vec![0.0; GAUSS_LEGENDRE_8.len() * model.dim()],
             free_flight: FreeFlightFourier::new(model),
+            free_flight_energy: FreeFlightEnergy::new(model),
             mode: model.mode_of(t0, x0),
             free_start: None,
             free_state: vec![0.0; model.dim()],
+            modes: model
+                .cantilever()
+                .modes
+                .iter()
+                .map(|mode| {
+                    let omega = mode.angular_frequency();
+                    ModeConstants {
+                        stiffness: mode.stiffness_n_per_m,
+                        mass: mode.stiffness_n_per_m / (omega * omega),
+                        damping: mode.stiffness_n_per_m / (omega * mode.quality_factor),
+                        drive_force: mode.force_ratio * model.drive_force_nn(),
+                    }
+                })
+                .collect(),
+            mode_integrals: vec![ModeIntegrals::default(); model.mode_count()],
+            contact_work: vec![0.0; model.mode_count()],
+            virial: 0.0,
+            indentation: 0.0,
+            start_state: x0.to_vec(),
+            end_state: vec![f64::NAN; model.dim()],
         }
     }
 
@@ -287,16 +391,16 @@ impl PeriodObserver {
         }
         if step_end >= self.end && step_start < self.end {
             if step_end == self.end {
-                self.gap_at_end = model.gap(step_end, solver.state());
+                self.end_state.copy_from_slice(solver.state());
             } else {
-                solver.interpolate(self.end, &mut self.state);
-                self.gap_at_end = model.gap(self.end, &self.state);
+                solver.interpolate(self.end, &mut self.end_state);
             }
+            self.gap_at_end = model.gap(self.end, &self.end_state);
         }
     }
 
-    /// Add the closed-form Fourier integrals of the free-flight interval in progress, up to
-    /// `end`, and close it.
+    /// Add the closed-form Fourier and energy integrals of the free-flight interval in
+    /// progress, up to `end`, and close it (`F_ts = 0` there: no force integral).
     fn close_free_flight(&mut self, end: f64) {
         if let (Some(start), Some(free_flight)) = (self.free_start.take(), &self.free_flight) {
             for (k, coefficient) in self.fourier.iter_mut().enumerate() {
@@ -304,6 +408,9 @@ impl PeriodObserver {
                     free_flight.integrate_harmonic(k + 1, start, &self.free_state, end);
                 coefficient[0] += cosine;
                 coefficient[1] += sine;
+            }
+            if let Some(energy) = &self.free_flight_energy {
+                energy.accumulate(start, &self.free_state, end, &mut self.mode_integrals);
             }
         }
     }
@@ -317,7 +424,24 @@ impl PeriodObserver {
             ..
         } = *node;
         let u = model.photodiode(state);
-        self.impulse += weight * model.tip_sample_force(t, state);
+        let force = model.tip_sample_force(t, state);
+        self.impulse += weight * force;
+        let mut deflection = 0.0;
+        for (((constants, integrals), work), mode_state) in self
+            .modes
+            .iter()
+            .zip(self.mode_integrals.iter_mut())
+            .zip(self.contact_work.iter_mut())
+            .zip(state.chunks_exact(2))
+        {
+            let (q, velocity) = (mode_state[0], mode_state[1]);
+            deflection += q;
+            integrals.drive_work += weight * constants.drive_force * cos * velocity;
+            integrals.velocity_square += weight * velocity * velocity;
+            *work += weight * force * velocity;
+        }
+        self.virial += weight * force * deflection;
+        self.indentation += weight * (self.contact_gap - model.gap(t, state)).max(0.0);
         let (mut sin_k, mut cos_k) = (sin, cos);
         for coefficient in self.fourier.iter_mut() {
             coefficient[0] += weight * u * cos_k;
@@ -333,7 +457,9 @@ impl PeriodObserver {
         let harmonics: Vec<Harmonic> = self
             .fourier
             .iter()
-            .map(|&[a, b]| Harmonic {
+            .enumerate()
+            .map(|(index, &[a, b])| Harmonic {
+                n: index + 1,
                 amplitude_nm: scale * a.hypot(b),
                 phase_deg: b.atan2(a).to_degrees(),
             })
@@ -347,6 +473,52 @@ impl PeriodObserver {
         let contact_time_periods = impacts.iter().fold(0.0, |sum, impact| {
             sum + (impact.end_periods - impact.start_periods)
         }) / k;
+        let per_period = NN_NM_IN_EV / k;
+        let mode_energy: Vec<ModeEnergy> = self
+            .modes
+            .iter()
+            .zip(&self.mode_integrals)
+            .zip(&self.contact_work)
+            .enumerate()
+            .map(|(i, ((constants, integrals), work))| {
+                let energy = |x: &[f64]| constants.energy(x[2 * i], x[2 * i + 1]);
+                ModeEnergy {
+                    drive_work_ev: per_period * integrals.drive_work,
+                    damping_loss_ev: per_period * constants.damping * integrals.velocity_square,
+                    dissipated_share_ev: -per_period * work,
+                    stored_energy_change_ev: per_period
+                        * (energy(&self.end_state) - energy(&self.start_state)),
+                }
+            })
+            .collect();
+        let total_damping: f64 = mode_energy.iter().map(|mode| mode.damping_loss_ev).sum();
+        let largest_residual = mode_energy
+            .iter()
+            .map(|mode| mode.residual_ev().abs())
+            .fold(0.0, f64::max);
+        let energy_balance_residual = if total_damping > 0.0 {
+            largest_residual / total_damping
+        } else {
+            0.0
+        };
+        // The deepest point: a gap minimum below the contact surface, or a window end in
+        // contact (the minima are recorded as `d`; the ends as `d`).
+        let max_indentation_nm = gap_minima
+            .iter()
+            .map(|minimum| self.contact_gap - minimum.gap_nm)
+            .chain(
+                [self.gap_at_start, self.gap_at_end]
+                    .into_iter()
+                    .filter(|gap| gap.is_finite())
+                    .map(|gap| self.contact_gap - gap),
+            )
+            .fold(0.0, f64::max);
+        let contact_time_us = contact_time_periods * k * self.period;
+        let mean_indentation_nm = if contact_time_us > 0.0 {
+            self.indentation / contact_time_us
+        } else {
+            0.0
+        };
         OrbitObservables {
             window_periods: self.window_periods,
             amplitude_nm: harmonics[0].amplitude_nm,
@@ -360,6 +532,15 @@ impl PeriodObserver {
             mean_force_nn: self.impulse / (k * self.period),
             contact_time_periods,
             impulse_nn_us: self.impulse / k,
+            dissipated_ev: mode_energy
+                .iter()
+                .map(|mode| mode.dissipated_share_ev)
+                .sum(),
+            virial_ev: NN_NM_IN_EV * self.virial / (k * self.period),
+            max_indentation_nm,
+            mean_indentation_nm,
+            energy_balance_residual,
+            mode_energy,
         }
     }
 
@@ -490,16 +671,18 @@ pub fn observe_period_in(
 /// (`k = multiplicity`, at least 1): one window of `k` drive periods, so that an impact in
 /// progress across a period boundary is one impact and every list and integral covers the
 /// orbit. Also returns the state after the `k` periods (`x0` again, to the integration's
-/// accuracy, on a converged orbit). The solver's buffers come from `workspace`.
+/// accuracy, on a converged orbit), with harmonics `1..=harmonic_count` of `u`. The solver's
+/// buffers come from `workspace`.
 pub fn observe_orbit_in(
     model: &TappingModel,
     x0: &[f64],
     multiplicity: usize,
     settings: &Settings,
+    harmonic_count: usize,
     workspace: &mut SolverWorkspace,
 ) -> Result<(Vec<f64>, OrbitObservables), AfmError> {
     check_state(model, x0)?;
-    let observer = PeriodObserver::over_periods(model, 0.0, x0, multiplicity, 1);
+    let observer = PeriodObserver::over_periods(model, 0.0, x0, multiplicity, harmonic_count);
     observe_in(model, observer, x0, Sensitivity::None, settings, workspace)
         .map(|(flow, observables)| (flow.state, observables))
 }
@@ -543,12 +726,14 @@ fn observe_in(
     Ok((flow, observables))
 }
 
-/// The observables of one period of `model` from state `x0` at `t = 0` (MODEL.md section 4).
+/// The observables of one period of `model` from state `x0` at `t = 0` (MODEL.md sections 4
+/// and 10), with harmonics `1..=harmonic_count` of `u`.
 pub fn orbit_observables(
     model: &TappingModel,
     x0: &[f64],
     settings: &Settings,
+    harmonic_count: usize,
 ) -> Result<OrbitObservables, AfmError> {
-    observe_period(model, 0.0, x0, Sensitivity::None, settings, 1)
+    observe_period(model, 0.0, x0, Sensitivity::None, settings, harmonic_count)
         .map(|(_, observables)| observables)
 }

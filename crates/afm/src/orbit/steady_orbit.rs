@@ -74,6 +74,9 @@ pub struct SteadyOrbitSettings {
     pub recurrence_periods: usize,
     /// The largest multiplicity `k` (orbit period `k T`) searched for (default 8). Range 1..=64.
     pub max_multiplicity: usize,
+    /// The harmonics `1..=harmonics` of `u` in the orbit's observables (default 4, as
+    /// `drumroll simulate --harmonics`). Range 1..=1000.
+    pub harmonics: usize,
 }
 
 impl Default for SteadyOrbitSettings {
@@ -84,6 +87,7 @@ impl Default for SteadyOrbitSettings {
             transient_periods: 20,
             recurrence_periods: 4000,
             max_multiplicity: 8,
+            harmonics: 4,
         }
     }
 }
@@ -97,6 +101,7 @@ impl SteadyOrbitSettings {
             ("transient_periods", self.transient_periods, 0, 100_000),
             ("recurrence_periods", self.recurrence_periods, 1, 1_000_000),
             ("max_multiplicity", self.max_multiplicity, 1, 64),
+            ("harmonics", self.harmonics, 1, 1000),
         ];
         for (field, value, low, high) in checks {
             if !(low..=high).contains(&value) {
@@ -250,6 +255,7 @@ pub fn steady_orbit_in(
         predicted,
         &settings.newton,
         &settings.integration,
+        settings.harmonics,
         workspace,
     )?;
     let first_multipliers = floquet_multipliers(&first.sensitivities.monodromy);

@@ -30,7 +30,10 @@ use serde::Serialize;
 use crate::error::AfmError;
 use crate::model::separation::Separation;
 use crate::model::TappingModel;
-use crate::orbit::lockin::{BlockAverage, BlockReading, CycleLockIn, CycleReading};
+use crate::orbit::lockin::{
+    BlockAverage, BlockReading, CycleLockIn, CycleReading, MAX_LOCKIN_HARMONICS,
+};
+use crate::orbit::observables::Harmonic;
 use crate::validation::{check, invalid, Interval};
 
 /// Microseconds per second: rates are given in nm/s, the model's time is in us.
@@ -81,7 +84,7 @@ impl SweepDirection {
 }
 
 /// One lock-in reading of a sweep: a block of `lockin_cycles` drive cycles.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SweepRecord {
     /// Index of the block's first drive cycle, counted from the start of the approach (the
     /// retract continues the count); settling cycles are not counted.
@@ -98,6 +101,11 @@ pub struct SweepRecord {
     pub impacts_per_period: f64,
     /// The largest tip-sample force in the block, nN.
     pub peak_force_nn: f64,
+    /// Harmonics `1..=N` of `u` from the block means of `a_n` and `b_n` (N =
+    /// [`SweepSettings::harmonics`]; MODEL.md section 10).
+    pub harmonics: Vec<Harmonic>,
+    /// The energy dissipated in the sample per cycle, averaged over the block, eV.
+    pub dissipated_ev: f64,
     /// Approach or retract.
     pub direction: SweepDirection,
 }
@@ -111,6 +119,16 @@ impl SweepRecord {
             phase_deg: block.phase_deg,
             impacts_per_period: block.impacts_per_cycle,
             peak_force_nn: block.peak_force_nn,
+            harmonics: block.harmonics[..block.harmonic_count]
+                .iter()
+                .enumerate()
+                .map(|(index, &[a, b])| Harmonic {
+                    n: index + 1,
+                    amplitude_nm: a.hypot(b),
+                    phase_deg: b.atan2(a).to_degrees(),
+                })
+                .collect(),
+            dissipated_ev: block.dissipated_ev,
             direction,
         }
     }
@@ -139,6 +157,9 @@ pub struct SweepSettings {
     /// Return every `every`-th block's record (the first of each direction included),
     /// `1..=1e8`; default 1.
     pub every: usize,
+    /// The harmonics `1..=harmonics` of `u` each reading gives, `1..=`
+    /// [`crate::orbit::lockin::MAX_LOCKIN_HARMONICS`]; default 4.
+    pub harmonics: usize,
     /// Settings of the hybrid solver. Default: `hybrid::Settings::default()` with relative and
     /// absolute tolerances [`DEFAULT_TOLERANCE`] (the lock-in's targets, 1e-3 in `A/A0` and 0.1
     /// deg, are six orders above the error this leaves; the free flight is exact regardless),
@@ -160,6 +181,7 @@ impl SweepSettings {
             settle_cycles: 20,
             lockin_cycles: 1,
             every: 1,
+            harmonics: 4,
             integration: Settings {
                 relative_tolerance: DEFAULT_TOLERANCE,
                 absolute_tolerance: DEFAULT_TOLERANCE,
@@ -207,6 +229,14 @@ impl SweepSettings {
                     format!("an integer in [{min}, {MAX_CYCLE_COUNT}]"),
                 ));
             }
+        }
+        if !(1..=MAX_LOCKIN_HARMONICS).contains(&self.harmonics) {
+            return Err(invalid(
+                FILE,
+                "harmonics",
+                self.harmonics as f64,
+                format!("an integer in [1, {MAX_LOCKIN_HARMONICS}]"),
+            ));
         }
         self.integration.validate()?;
         Ok(())
@@ -288,7 +318,7 @@ impl Sweep {
         Ok(Self {
             state: model.free_state(),
             workspace: SolverWorkspace::default(),
-            lockin: CycleLockIn::new(&model),
+            lockin: CycleLockIn::with_harmonics(&model, settings.harmonics),
             average: BlockAverage::new(settings.lockin_cycles, model.free_amplitude_nm()),
             floor_nm: settings.from_nm - cycles_per_leg as f64 * z_step_nm,
             model,

@@ -67,12 +67,13 @@ fn observed_map(
     sensitivity: Sensitivity,
     observe: bool,
     integration: &Settings,
+    harmonics: usize,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<ObservedMap, AfmError> {
     let (flow, observables) = if observe {
         let buffers = workspace.for_maps(sensitivity);
         let (flow, observables) =
-            observe_period_in(model, 0.0, x, sensitivity, integration, 1, buffers)?;
+            observe_period_in(model, 0.0, x, sensitivity, integration, harmonics, buffers)?;
         (flow, Some(observables))
     } else {
         (
@@ -140,6 +141,7 @@ pub(crate) fn shoot_observed(
     predicted: bool,
     newton: &NewtonSettings,
     integration: &Settings,
+    harmonics: usize,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<ObservedShot, AfmError> {
     let n = x0.len();
@@ -148,7 +150,7 @@ pub(crate) fn shoot_observed(
     let full = Sensitivity::TransitionAndParameter;
     let mut x = x0.to_vec();
     let (mut image, mut first_sensitivities, mut observables) = if predicted {
-        observed_map(model, &x, full, false, integration, workspace)?
+        observed_map(model, &x, full, false, integration, harmonics, workspace)?
     } else {
         observed_map(
             model,
@@ -156,13 +158,14 @@ pub(crate) fn shoot_observed(
             Sensitivity::Transition,
             false,
             &first_iterate(integration),
+            harmonics,
             workspace,
         )?
     };
     let mut full_tolerance = predicted;
     if !predicted && state_distance(&image, &x) <= LOOSE_RESIDUAL_FLOOR {
         (image, first_sensitivities, observables) =
-            observed_map(model, &x, full, false, integration, workspace)?;
+            observed_map(model, &x, full, false, integration, harmonics, workspace)?;
         full_tolerance = true;
     }
     let mut sensitivities = first_sensitivities.unwrap_or_else(|| MapSensitivities {
@@ -177,7 +180,8 @@ pub(crate) fn shoot_observed(
         let residual_vector = DVector::from_iterator(n, image.iter().zip(&x).map(|(p, x)| p - x));
         let residual = residual_vector.norm();
         if residual <= newton.tolerance || iterations >= newton.max_iterations {
-            let observables = observables_at(model, &x, observables, integration, workspace)?;
+            let observables =
+                observables_at(model, &x, observables, integration, harmonics, workspace)?;
             return Ok(ObservedShot {
                 state: x,
                 iterations,
@@ -219,11 +223,13 @@ pub(crate) fn shoot_observed(
             next_sensitivity,
             predicted_final,
             integration,
+            harmonics,
             workspace,
         )?;
         let next_residual = state_distance(&next_image, &candidate);
         if next_residual > newton.divergence_factor * residual {
-            let observables = observables_at(model, &x, observables, integration, workspace)?;
+            let observables =
+                observables_at(model, &x, observables, integration, harmonics, workspace)?;
             return Ok(ObservedShot {
                 state: x,
                 iterations,
@@ -235,8 +241,15 @@ pub(crate) fn shoot_observed(
         }
         if next_sensitivities.is_none() && next_residual > newton.tolerance {
             // The prediction failed: Newton goes on and needs the monodromy there.
-            (next_image, next_sensitivities, next_observables) =
-                observed_map(model, &candidate, full, false, integration, workspace)?;
+            (next_image, next_sensitivities, next_observables) = observed_map(
+                model,
+                &candidate,
+                full,
+                false,
+                integration,
+                harmonics,
+                workspace,
+            )?;
         }
         previous_residual = Some(residual);
         x = candidate;
@@ -255,13 +268,23 @@ fn observables_at(
     x: &[f64],
     known: Option<OrbitObservables>,
     integration: &Settings,
+    harmonics: usize,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<OrbitObservables, AfmError> {
     match known {
         Some(observables) => Ok(observables),
         None => {
             let buffers = workspace.for_maps(Sensitivity::None);
-            Ok(observe_period_in(model, 0.0, x, Sensitivity::None, integration, 1, buffers)?.1)
+            Ok(observe_period_in(
+                model,
+                0.0,
+                x,
+                Sensitivity::None,
+                integration,
+                harmonics,
+                buffers,
+            )?
+            .1)
         }
     }
 }

@@ -81,6 +81,16 @@ pub struct PeriodBreakdown {
     pub contact_time_periods: f64,
     /// The lowest local minimum of the gap in this period, nm (`null` in JSON if none).
     pub min_gap_nm: Option<f64>,
+    /// The energy dissipated in the sample in this period, eV (MODEL.md section 10).
+    pub dissipated_ev: f64,
+    /// The virial over this period, eV.
+    pub virial_ev: f64,
+    /// The largest indentation in this period, nm.
+    pub max_indentation_nm: f64,
+    /// The mean indentation over this period's time in contact, nm.
+    pub mean_indentation_nm: f64,
+    /// The relative residual of this period's energy balance.
+    pub energy_balance_residual: f64,
 }
 
 impl SteadyOrbit {
@@ -144,6 +154,11 @@ impl SteadyOrbit {
                     impulse_nn_us: period.impulse_nn_us,
                     contact_time_periods: period.contact_time_periods,
                     min_gap_nm: min_gap.is_finite().then_some(min_gap),
+                    dissipated_ev: period.dissipated_ev,
+                    virial_ev: period.virial_ev,
+                    max_indentation_nm: period.max_indentation_nm,
+                    mean_indentation_nm: period.mean_indentation_nm,
+                    energy_balance_residual: period.energy_balance_residual,
                 }
             })
             .collect()

@@ -170,7 +170,7 @@ fn finish(
             &x,
             Sensitivity::None,
             &settings.integration,
-            1,
+            settings.harmonics,
             workspace.for_maps(Sensitivity::None),
         )?;
         periods.push(observables);
@@ -184,6 +184,7 @@ fn finish(
             &attempt.state,
             attempt.multiplicity,
             &settings.integration,
+            settings.harmonics,
             workspace.for_maps(Sensitivity::None),
         )?
         .1
