@@ -6,9 +6,10 @@
 #
 # Installs what it needs, once: the Rust target wasm32-unknown-unknown (rustup), and
 # wasm-bindgen-cli at exactly the version of the wasm-bindgen crate in Cargo.lock (cargo install
-# --locked; the two must match). When Debian's binaryen can be installed (as root, with
-# apt-get) its wasm-opt shrinks the module (-O3); without it the module is used as built.
-# Prints the .wasm's size. Uses CARGO_TARGET_DIR when set.
+# --locked; the two must match). A wasm-opt of binaryen 116 or newer found on PATH shrinks the
+# module further (-O3); none is installed: the module is under 3 MB without it, and Debian 12's
+# binaryen (108) breaks the module's reference-typed table (the page fails to load). Prints the
+# .wasm's size. Uses CARGO_TARGET_DIR when set.
 set -euo pipefail
 
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -33,13 +34,6 @@ if [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$bindgen_ver
         || cargo install wasm-bindgen-cli --version "$bindgen_version"
 fi
 
-# wasm-opt from Debian's binaryen, when it can be had cheaply (root and apt-get).
-if ! command -v wasm-opt >/dev/null && [ "$(id -u)" -eq 0 ] && command -v apt-get >/dev/null; then
-    DEBIAN_FRONTEND=noninteractive apt-get install -y binaryen >/dev/null 2>&1 \
-        || { apt-get update >/dev/null && DEBIAN_FRONTEND=noninteractive apt-get install -y binaryen >/dev/null; } \
-        || echo "build-web.sh: binaryen not installed; the module stays unoptimised by wasm-opt" >&2
-fi
-
 # The module: the workspace's `web` profile (release without debug information, fat LTO).
 cargo build --profile web --target wasm32-unknown-unknown -p drumroll-web
 built="$target_dir/wasm32-unknown-unknown/web/drumroll_web.wasm"
@@ -48,8 +42,9 @@ rm -rf "$dist"
 mkdir -p "$dist/pkg"
 wasm-bindgen --target web --no-typescript --out-dir "$dist/pkg" "$built"
 wasm="$dist/pkg/drumroll_web_bg.wasm"
-if command -v wasm-opt >/dev/null; then
-    # Rust's wasm32 target emits these post-MVP features by default.
+binaryen_version=$(wasm-opt --version 2>/dev/null | awk '{print $3}' || true)
+if [ -n "$binaryen_version" ] && [ "$binaryen_version" -ge 116 ] 2>/dev/null; then
+    # Rust's wasm32 target and wasm-bindgen emit these post-MVP features.
     if wasm-opt -O3 --enable-bulk-memory --enable-nontrapping-float-to-int --enable-sign-ext \
         --enable-mutable-globals --enable-reference-types --enable-multivalue \
         "$wasm" -o "$wasm.opt"; then

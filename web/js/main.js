@@ -21,7 +21,11 @@ const state = {
   requestedAt: 0,
 };
 // Timings and counters for the browser tests (web/tests) and the curious.
-window.drumroll = { diagramsDrawn: 0, firstDiagramMs: null, lastDiagramMs: null, lastComputeMs: null, orbitsDrawn: 0, mapsDrawn: 0 };
+window.drumroll = {
+  diagramsDrawn: 0, firstDiagramMs: null, lastDiagramMs: null, lastComputeMs: null, orbitsDrawn: 0, mapsDrawn: 0,
+  /** The text an export button downloads (`diagram_csv`, `map_svg`, ...). */
+  exportText: async (method) => (await compute.call(method)).value,
+};
 
 function showError(message) {
   const box = $("error");
@@ -70,11 +74,21 @@ function diagramOptions() {
   return options;
 }
 
+/** JSON text of `value` with every object's keys sorted (`null` and absent keys alike). */
+function canonical(value) {
+  if (Array.isArray(value)) return `[${value.map(canonical).join(",")}]`;
+  if (value && typeof value === "object") {
+    const keys = Object.keys(value).filter((k) => value[k] !== null && value[k] !== undefined).sort();
+    return `{${keys.map((k) => `${JSON.stringify(k)}:${canonical(value[k])}`).join(",")}}`;
+  }
+  return JSON.stringify(value);
+}
+
 /** The edited case; renamed `NAME-edited` once it differs from the built-in case. */
 function editedCase() {
   const edited = form.read();
   const base = state.catalogueCase;
-  const same = JSON.stringify({ ...edited, name: base.name, description: base.description }) === JSON.stringify({ ...base });
+  const same = canonical({ ...edited, name: base.name, description: base.description }) === canonical(base);
   if (!same) edited.name = `${base.name}-edited`;
   return edited;
 }
@@ -363,6 +377,10 @@ async function main() {
   } catch (error) {
     showError(`The computing module did not load: ${error.message}`);
     status("");
+    if (params.get("report") === "1") {
+      $("report").hidden = false;
+      $("report").textContent = JSON.stringify({ error: $("error").textContent });
+    }
     return;
   }
   const select = $("case-select");

@@ -118,8 +118,16 @@ export function drawPlot(svg, spec) {
   for (const m of markers) {
     if (!Number.isFinite(m.x) || !Number.isFinite(m.y)) continue;
     element("circle", { cx: px(m.x), cy: py(m.y), r: 4, class: "marker", fill: m.colour ?? "#222" }, plotArea);
-    if (m.label) {
-      element("text", { x: px(m.x) + 6, y: py(m.y) - 6 }, plotArea).textContent = m.label;
+    const inside = px(m.x) >= left && px(m.x) <= right && py(m.y) >= top && py(m.y) <= bottom;
+    if (m.label && inside) {
+      // Labels are not clipped: near the right or top edge they go to the left or below.
+      const nearRight = px(m.x) > right - 40;
+      const nearTop = py(m.y) < top + 14;
+      element("text", {
+        x: px(m.x) + (nearRight ? -7 : 7),
+        y: py(m.y) + (nearTop ? 15 : -7),
+        "text-anchor": nearRight ? "end" : "start",
+      }, svg).textContent = m.label;
     }
   }
   if (spec.picked && Number.isFinite(spec.picked.x) && Number.isFinite(spec.picked.y)) {

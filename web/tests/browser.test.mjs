@@ -250,3 +250,103 @@ test("errors in the inputs show a message on the page, not a stack trace", async
   await other.page.close();
   await page.close();
 });
+
+test("the exports are the CLI's: CSV to 1e-9, the SVG figure", async () => {
+  const { page, errors } = await open("?case=biolever-mica");
+  await diagramsDrawn(page, 0);
+  const csv = await page.evaluate(() => window.drumroll.exportText("diagram_csv"));
+  const svg = await page.evaluate(() => window.drumroll.exportText("diagram_svg"));
+  const json = JSON.parse(await page.evaluate(() => window.drumroll.exportText("diagram_json")));
+  const scratch = await mkdtemp(path.join(tmpdir(), "drumroll-web-export-"));
+  try {
+    const files = { csv: path.join(scratch, "d.csv"), svg: path.join(scratch, "d.svg") };
+    execFileSync(drumroll, ["continue", "--case", "biolever-mica", "--quiet", "--csv", files.csv, "--plot", files.svg]);
+    const cliCsv = (await readFile(files.csv, "utf8")).trim().split("\n");
+    const pageCsv = csv.trim().split("\n");
+    assert.equal(pageCsv[0], cliCsv[0], "the CSV header");
+    assert.equal(pageCsv.length, cliCsv.length, "the CSV rows");
+    // The module and the CLI run the same code, but wasm32's sin, cos, exp (Rust's libm port)
+    // and the native glibc's differ in the last bit: every converged number agrees to 1e-9,
+    // while Newton's statistics (iterations, residual, both at roundoff) may differ.
+    const header = cliCsv[0].split(",");
+    const statistics = new Set(["iterations", "residual"].map((name) => header.indexOf(name)));
+    pageCsv.forEach((line, i) => {
+      const ours = line.split(",");
+      const theirs = cliCsv[i].split(",");
+      ours.forEach((cell, j) => {
+        if (statistics.has(j)) return;
+        const a = Number(cell);
+        const b = Number(theirs[j]);
+        if (Number.isFinite(a) && Number.isFinite(b) && cell !== "" && theirs[j] !== "") {
+          assert.ok(Math.abs(a - b) <= 1e-9 * Math.max(1, Math.abs(b)), `row ${i} column ${j}: ${cell} vs ${theirs[j]}`);
+        } else {
+          assert.equal(cell, theirs[j], `row ${i} column ${j}`);
+        }
+      });
+    });
+    const cliSvg = await readFile(files.svg, "utf8");
+    await writeFile(path.join(artifacts, "diagram-page.svg"), svg);
+    await writeFile(path.join(artifacts, "diagram-cli.svg"), cliSvg);
+    // The figure: identical but for the curves' polylines, which the decimation to pixel
+    // columns may thin by a point where a last-bit difference moves a point across a pixel's
+    // rounding (as measured: one point of 260 on one curve); axes, ticks, labels, markers agree.
+    const polylines = /points="([^"]*)"/g;
+    assert.equal(svg.replace(polylines, 'points=""'), cliSvg.replace(polylines, 'points=""'), "the SVG figure without its polylines");
+    const counts = (text) => [...text.matchAll(polylines)].map((m) => m[1].split(" ").length);
+    const ours = counts(svg);
+    const theirs = counts(cliSvg);
+    assert.equal(ours.length, theirs.length, "the number of polylines");
+    ours.forEach((n, i) => assert.ok(Math.abs(n - theirs[i]) <= Math.max(1, 0.01 * theirs[i]), `polyline ${i}: ${n} vs ${theirs[i]} points`));
+    assert.equal(json.case, "biolever-mica");
+    assert.equal(json.points.length, pageCsv.length - 1);
+  } finally {
+    await rm(scratch, { recursive: true, force: true });
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test("the regime-map tab draws the curves of drumroll map", async () => {
+  const { page, errors } = await open("?case=biolever-mica");
+  await diagramsDrawn(page, 0);
+  await page.click("#tab-map");
+  assert.equal(await page.$eval("#panel-map", (e) => e.hidden), false);
+  await page.$eval("#map-from", (e) => { e.value = "5"; });
+  await page.$eval("#map-to", (e) => { e.value = "20"; });
+  await page.$eval("#map-points", (e) => { e.value = "40"; });
+  const start = Date.now();
+  await page.click("#map-form button[type=submit]");
+  await page.waitForFunction(() => window.drumroll.mapsDrawn > 0 || !document.getElementById("error").hidden, { timeout: WAIT_MS });
+  assert.equal(await page.$eval("#error", (e) => e.hidden), true, await page.$eval("#error", (e) => e.textContent));
+  timings["regime map over a0 in [5, 20] nm, 40 points, browser wall time"] = Date.now() - start;
+  const map = JSON.parse(await page.evaluate(() => window.drumroll.exportText("map_json")));
+  const startNative = process.hrtime.bigint();
+  const native = JSON.parse(execFileSync(drumroll, ["map", "--case", "biolever-mica", "--vary", "a0", "--from", "5", "--to", "20", "--points", "40", "--json"], { encoding: "utf8" }));
+  timings["same map, native CLI process wall time"] = Number(process.hrtime.bigint() - startNative) / 1e6;
+  assert.deepEqual(map.curves.map((c) => c.label), native.curves.map((c) => c.label));
+  // Curve points are Newton solutions to a residual of 1e-10 nm, whose Z the last-bit
+  // differences of wasm32's and glibc's sin, cos and exp move by up to the residual over the
+  // gap's sensitivity: 1e-8 nm bounds it; the curves' shapes and counts agree exactly.
+  let largest = 0;
+  map.curves.forEach((curve, i) => {
+    const cli = native.curves[i];
+    // Points between are wherever the arclength steps fall (on the same curve); the points at
+    // fixed values of the parameter (the range's ends, the case's own) are compared.
+    const fixed = (points) => points.filter((p) => p.at_fixed_parameter);
+    const ours = fixed(curve.points);
+    const theirs = fixed(cli.points);
+    assert.deepEqual(ours.map((p) => p.parameter), theirs.map((p) => p.parameter), `${curve.label}: the fixed values`);
+    assert.ok(ours.length >= 2, `${curve.label}: at least the range's ends`);
+    ours.forEach((p, j) => {
+      const difference = Math.abs(p.z_nm - theirs[j].z_nm);
+      largest = Math.max(largest, difference);
+      assert.ok(difference <= 1e-8, `${curve.label} at ${p.parameter}: Z ${p.z_nm} vs ${theirs[j].z_nm}`);
+    });
+  });
+  timings["map curve points, largest |difference| from the CLI's (nm)"] = largest.toExponential(2);
+  const curves = await page.$$eval("#plot-map-z path.curve", (paths) => paths.length);
+  assert.ok(curves >= map.curves.length, `curves drawn: ${curves}`);
+  await page.screenshot({ path: path.join(artifacts, "map.png") });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
