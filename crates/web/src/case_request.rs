@@ -134,7 +134,9 @@ mod tests {
 
     #[test]
     fn a_builtin_name_gives_the_command_lines_case() {
-        let (case, model) = CaseRequest::builtin("biolever-mica").resolve().expect("case");
+        let (case, model) = CaseRequest::builtin("biolever-mica")
+            .resolve()
+            .expect("case");
         let expected = afm::builtin_case("biolever-mica").expect("fixture");
         assert_eq!(case, expected);
         assert_eq!(model.free_amplitude_nm(), 10.0);
@@ -158,9 +160,10 @@ mod tests {
 
     #[test]
     fn bad_fields_are_named_with_their_range() {
-        let mut sample = serde_json::to_value(afm::builtin_sample("mica").expect("mica"))
-            .expect("sample json");
-        sample["contact"] = json!({"law": "dmt", "hamaker_constant_j": 1.0, "intermolecular_distance_nm": 0.2});
+        let mut sample =
+            serde_json::to_value(afm::builtin_sample("mica").expect("mica")).expect("sample json");
+        sample["contact"] =
+            json!({"law": "dmt", "hamaker_constant_j": 1.0, "intermolecular_distance_nm": 0.2});
         let request = CaseRequest {
             cantilever: Some(json!("biolever")),
             sample: Some(sample),

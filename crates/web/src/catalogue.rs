@@ -64,7 +64,11 @@ mod tests {
                 serde_json::from_value(entry["case"].clone()).expect("request");
             let (case, _) = request.resolve().expect("inline case");
             let name = entry["name"].as_str().expect("name");
-            assert_eq!(case, fixtures::builtin_case(name).expect("builtin"), "{name}");
+            assert_eq!(
+                case,
+                fixtures::builtin_case(name).expect("builtin"),
+                "{name}"
+            );
         }
     }
 }

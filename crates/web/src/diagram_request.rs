@@ -170,9 +170,16 @@ mod tests {
             lines.next(),
             Some(format!("direction,{}", CSV_COLUMNS.join(",")).as_str())
         );
-        assert_eq!(lines.count(), json["points"].as_array().expect("points").len());
+        assert_eq!(
+            lines.count(),
+            json["points"].as_array().expect("points").len()
+        );
         let svg = run.svg().expect("svg");
-        assert!(svg.starts_with("<svg") && svg.contains("G1"), "{}", &svg[..80]);
+        assert!(
+            svg.starts_with("<svg") && svg.contains("G1"),
+            "{}",
+            &svg[..80]
+        );
     }
 
     #[test]

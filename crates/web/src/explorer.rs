@@ -215,7 +215,10 @@ mod tests {
     fn malformed_requests_give_messages() {
         let mut explorer = Explorer::new();
         let message = explorer.diagram("{").unwrap_err();
-        assert!(message.starts_with("the page's diagram request"), "{message}");
+        assert!(
+            message.starts_with("the page's diagram request"),
+            "{message}"
+        );
         let message = explorer
             .diagram(r#"{"case": {"name": "biolever-mica"}, "colour": 1}"#)
             .unwrap_err();

@@ -180,7 +180,11 @@ mod tests {
             .resolve()
             .expect("case at a0");
             let exact = model.grazing_separation_nm();
-            assert!((point.z_nm - exact).abs() < 1e-7, "{} vs {exact}", point.z_nm);
+            assert!(
+                (point.z_nm - exact).abs() < 1e-7,
+                "{} vs {exact}",
+                point.z_nm
+            );
         }
         let csv = run.csv().expect("csv");
         assert!(csv.starts_with("label,parameter,"));
@@ -203,6 +207,9 @@ mod tests {
             max_step_nm: None,
         };
         let message = format!("{:#}", request.compute().unwrap_err());
-        assert!(message.contains("--vary") && message.contains("a0"), "{message}");
+        assert!(
+            message.contains("--vary") && message.contains("a0"),
+            "{message}"
+        );
     }
 }

@@ -136,11 +136,17 @@ mod tests {
         );
         let gaps = object["trajectory"]["gap_nm"].as_array().expect("gaps");
         assert_eq!(gaps.len(), 2 * 2000 + 1);
-        let lowest = gaps.iter().filter_map(Value::as_f64).fold(f64::INFINITY, f64::min);
+        let lowest = gaps
+            .iter()
+            .filter_map(Value::as_f64)
+            .fold(f64::INFINITY, f64::min);
         let min_gap = object["orbit"]["min_gap_nm"].as_f64().expect("min gap");
         // One sample step is 1/2000 of a period; the gap's speed is at most w A ~ 0.6 nm/us
         // times T/2000 ~ 0.05 us: 0.03 nm.
-        assert!(lowest >= min_gap - 1e-9 && lowest - min_gap < 0.03, "{lowest} vs {min_gap}");
+        assert!(
+            lowest >= min_gap - 1e-9 && lowest - min_gap < 0.03,
+            "{lowest} vs {min_gap}"
+        );
         assert!(orbit_svg(&run, &orbit).expect("svg").contains("<svg"));
     }
 
