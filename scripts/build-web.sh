@@ -9,12 +9,11 @@
 # --locked; the two must match). A wasm-opt of binaryen 116 or newer found on PATH shrinks the
 # module further (-O3); none is installed: the module is under 3 MB without it, and Debian 12's
 # binaryen (108) breaks the module's reference-typed table (the page fails to load). Prints the
-# .wasm's size. Uses CARGO_TARGET_DIR when set.
+# .wasm's size.
 set -euo pipefail
 
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cd "$repo"
-target_dir=${CARGO_TARGET_DIR:-$repo/target}
 dist=web/dist
 
 if ! rustup target list --installed | grep -qx wasm32-unknown-unknown; then
@@ -35,8 +34,14 @@ if [ "$(wasm-bindgen --version 2>/dev/null | awk '{print $2}')" != "$bindgen_ver
 fi
 
 # The module: the workspace's `web` profile (release without debug information, fat LTO).
-cargo build --profile web --target wasm32-unknown-unknown -p drumroll-web
-built="$target_dir/wasm32-unknown-unknown/web/drumroll_web.wasm"
+# Where cargo wrote it, as cargo reports it (whatever the target directory).
+built=$(cargo build --profile web --target wasm32-unknown-unknown -p drumroll-web \
+    --message-format=json-render-diagnostics \
+    | grep -o '"[^"]*/drumroll_web\.wasm"' | tail -n 1 | tr -d '"')
+if [ ! -f "$built" ]; then
+    echo "build-web.sh: cargo reported no drumroll_web.wasm" >&2
+    exit 1
+fi
 
 rm -rf "$dist"
 mkdir -p "$dist/pkg"

@@ -1,6 +1,10 @@
 // The page's side of the worker (worker.js): calls as promises, a new worker after a trap, and
 // "latest wins" for requests that a newer one makes obsolete (a slider dragged: only the last
-// position's diagram is computed once the running one ends).
+// position's diagram is computed once the running one ends, or at once when the running one
+// has taken over a second: its worker is then replaced).
+
+/** A running call made obsolete is abandoned (the worker restarted) after this long, ms. */
+const RESTART_AFTER_MS = 1000;
 
 export class Compute {
   constructor() {
@@ -34,13 +38,28 @@ export class Compute {
     };
   }
 
-  /** Call `method` of the module's Explorer with the text `request`. */
-  call(method, request) {
+  /** Call `method` of the module's Explorer with the text `request` (`kind` tags the call). */
+  call(method, request, kind = "other") {
     const id = this.nextId++;
     return new Promise((resolve, reject) => {
-      this.waiting.set(id, { resolve, reject });
+      this.waiting.set(id, { resolve, reject, kind, since: performance.now() });
       this.worker.postMessage({ id, method, request });
     });
+  }
+
+  /**
+   * Stop the worker when it only runs an obsolete call of `kind` that has run for over
+   * `RESTART_AFTER_MS` (a long diagram while the slider moves on): that call resolves to null
+   * (superseded) and a new worker starts, so the newest request need not wait for it.
+   */
+  abandon(kind) {
+    const calls = [...this.waiting.values()];
+    const now = performance.now();
+    if (calls.length === 0 || calls.some((c) => c.kind !== kind || now - c.since < RESTART_AFTER_MS)) return;
+    this.worker.terminate();
+    for (const call of calls) call.resolve(null);
+    this.waiting.clear();
+    this.start();
   }
 
   /**
@@ -52,6 +71,7 @@ export class Compute {
       const previous = this.pending.get(kind);
       if (previous) previous.resolve(null);
       this.pending.set(kind, { method, request, resolve, reject });
+      if (this.busy.get(kind)) this.abandon(kind);
       this.drain(kind);
     });
   }
@@ -62,7 +82,7 @@ export class Compute {
     if (!next) return;
     this.pending.delete(kind);
     this.busy.set(kind, true);
-    this.call(next.method, next.request)
+    this.call(next.method, next.request, kind)
       .then(next.resolve, next.reject)
       .finally(() => {
         this.busy.set(kind, false);

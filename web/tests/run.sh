@@ -28,8 +28,13 @@ if [ ! -f "$repo/web/dist/index.html" ]; then
 fi
 
 # The reference: the native command line.
-(cd "$repo" && cargo build --release -p drumroll)
-export DRUMROLL="${CARGO_TARGET_DIR:-$repo/target}/release/drumroll"
+DRUMROLL=$(cd "$repo" && cargo build --release -p drumroll --message-format=json-render-diagnostics \
+    | grep -o '"executable":"[^"]*/drumroll"' | tail -n 1 | sed 's/^"executable":"//; s/"$//')
+if [ ! -x "$DRUMROLL" ]; then
+    echo "web/tests/run.sh: cargo reported no drumroll binary" >&2
+    exit 1
+fi
+export DRUMROLL
 export CHROMIUM
 CHROMIUM=$(command -v chromium)
 
