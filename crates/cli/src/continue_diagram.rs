@@ -135,15 +135,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         let continued = continue_case(args, &case, &model)?;
         print_report(args, &case, &model, &continued)?;
         if let Some(path) = &csv_path {
-            let mut text = csv_text(&continued.approach, "approach")?;
-            if let Some(retract) = &continued.retract {
-                text.push_str(
-                    csv_text(retract, "retract")?
-                        .split_once('\n')
-                        .map_or("", |(_, rows)| rows),
-                );
-            }
-            write_atomically(path, text.as_bytes())?;
+            write_atomically(path, continued_csv(&continued)?.as_bytes())?;
         }
         if let Some(why) = unfinished_branches(&continued.approach, continued.retract.as_ref()) {
             unfinished.push(if several {
@@ -457,6 +449,19 @@ fn merge_ranges(mut ranges: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
         }
     }
     merged
+}
+
+/// What `continue --csv` writes: the approach's rows, then the retract's (one header line).
+pub fn continued_csv(continued: &Continued) -> Result<String> {
+    let mut text = csv_text(&continued.approach, "approach")?;
+    if let Some(retract) = &continued.retract {
+        text.push_str(
+            csv_text(retract, "retract")?
+                .split_once('\n')
+                .map_or("", |(_, rows)| rows),
+        );
+    }
+    Ok(text)
 }
 
 /// The CSV columns after `direction`: the scalar keys of a JSON branch point, in this order

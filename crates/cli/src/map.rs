@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::continue_diagram::approach_settings;
-use crate::grid_overlay::read_grid;
+use crate::grid_overlay::{read_grid, Grid};
 use crate::inputs::orbit_inputs_json;
 use crate::map_plot::map_panels;
 use crate::model_args::{output_path, ModelArgs};
@@ -111,12 +111,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         write_atomically(&path, csv_text(&map.curves)?.as_bytes())?;
     }
     if let Some(path) = plot_path {
-        path.write(&render_svg(
-            &map_panels(axis, &map, grid.as_ref()),
-            1,
-            2,
-            (620, 480),
-        )?)?;
+        path.write(&map_figure(axis, &map, grid.as_ref())?)?;
     }
     Ok(())
 }
@@ -314,8 +309,14 @@ pub const CSV_COLUMNS: [&str; 10] = [
     "at_fixed_parameter",
 ];
 
-/// The CSV of every curve's points: `label`, then [`CSV_COLUMNS`].
-fn csv_text(curves: &[MapCurve]) -> Result<String> {
+/// The figure `map --plot` draws (SVG): the map in the `(PARAM, Z)` and `(PARAM, A/A0)`
+/// planes, with the cells of a `drumroll grid` result under the curves when `grid` is given.
+pub fn map_figure(axis: ParameterAxis, map: &RegimeMap, grid: Option<&Grid>) -> Result<String> {
+    render_svg(&map_panels(axis, map, grid), 1, 2, (620, 480))
+}
+
+/// The CSV of every curve's points: `label`, then [`CSV_COLUMNS`] (what `map --csv` writes).
+pub fn csv_text(curves: &[MapCurve]) -> Result<String> {
     let mut text = format!("label,{}\n", CSV_COLUMNS.join(","));
     for curve in curves {
         for point in &curve.points {

@@ -152,12 +152,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     if let Some(path) = plot_path {
-        let mut panels = trajectory_panels(&model, &orbit, 2)?;
-        if let Some(first) = panels.first_mut() {
-            first.title = format!("{}: {}", case.name, first.title);
-        }
-        panels.push(harmonic_spectrum_panel(&orbit));
-        path.write(&render_svg(&panels, 3, 1, (800, 320))?)?;
+        path.write(&orbit_figure(&case.name, &model, &orbit)?)?;
         if !args.json {
             print_stdout(&format!("figure: {}\n", path.path.display()))?;
         }
@@ -217,6 +212,17 @@ pub fn simulate_json(
         });
     object["inputs"] = orbit_inputs_json("simulate", options, case, model, settings);
     object
+}
+
+/// The figure `simulate --plot` draws (SVG): two periods of `u(t)` above `F_ts(t)` of `orbit`
+/// (the layout of the paper's Fig. 1), titled with the case's name `case`.
+pub fn orbit_figure(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> Result<String> {
+    let mut panels = trajectory_panels(model, orbit, 2)?;
+    if let Some(first) = panels.first_mut() {
+        first.title = format!("{case}: {}", first.title);
+    }
+    panels.push(harmonic_spectrum_panel(orbit));
+    render_svg(&panels, 3, 1, (800, 320))
 }
 
 /// Check `--z` and `--amplitude-ratio` of `simulate` and `theory` against the table of
