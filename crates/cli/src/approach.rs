@@ -26,7 +26,7 @@ pub const CSV_HEADER: &str =
     "cycle,z_nm,amplitude_ratio,phase_deg,impacts_per_period,peak_force_nn,dissipated_ev,direction";
 
 /// The harmonics each reading gives by default (`--harmonics`).
-pub const DEFAULT_HARMONICS: i64 = 4;
+pub const DEFAULT_HARMONICS: i64 = afm::orbit::lockin::DEFAULT_HARMONICS as i64;
 
 /// The CSV columns of harmonics `1..=count` after [`CSV_HEADER`]:
 /// `,harmonic_<n>_amplitude_nm,harmonic_<n>_phase_deg` for each `n`.

@@ -72,7 +72,7 @@ pub struct ContinueArgs {
     pub panels: Option<String>,
     /// The harmonics n = 1..N of u reported at every point, N in [1, 1000] (raised to the
     /// highest harmonic --panels draws).
-    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = crate::approach::DEFAULT_HARMONICS, allow_negative_numbers = true)]
     pub harmonics: i64,
 }
 

@@ -46,7 +46,7 @@ pub struct SimulateArgs {
     pub start: Start,
     /// The harmonics n = 1..N of u reported (amplitude and phase of each, MODEL.md section 10),
     /// N in [1, 1000].
-    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = crate::approach::DEFAULT_HARMONICS, allow_negative_numbers = true)]
     pub harmonics: i64,
     /// Print one JSON object instead of the readable summary.
     #[arg(long)]

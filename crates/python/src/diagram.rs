@@ -168,6 +168,8 @@ pub fn compute_diagram(
         csv: None,
         plot: None,
         overlay: false,
+        panels: None,
+        harmonics: drumroll::approach::DEFAULT_HARMONICS,
     };
     let (json, warning) = without_gil(
         py,

@@ -82,6 +82,8 @@ impl DiagramRequest {
             csv: None,
             plot: None,
             overlay: false,
+            panels: None,
+            harmonics: drumroll::approach::DEFAULT_HARMONICS,
         }
     }
 

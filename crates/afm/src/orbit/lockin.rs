@@ -29,6 +29,10 @@ use crate::orbit::observables::NN_NM_IN_EV;
 /// sweep allocates nothing per cycle).
 pub const MAX_LOCKIN_HARMONICS: usize = 20;
 
+/// The number of harmonics n = 1..N of u that orbits, diagram points and lock-in readings
+/// report unless told otherwise (MODEL.md section 10).
+pub const DEFAULT_HARMONICS: usize = 4;
+
 /// What the lock-in reads over one drive cycle `[0, T]` (time from the cycle's start).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleReading {
