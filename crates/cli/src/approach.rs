@@ -143,11 +143,7 @@ impl ApproachArgs {
         )
         .check(from)?;
         let lockin_cycles = option_ranges::LOCKIN_CYCLES.count(self.lockin_cycles)?;
-        let harmonics = OptionRange::new(
-            "--harmonics",
-            Interval::closed(1.0, afm::orbit::lockin::MAX_LOCKIN_HARMONICS as f64, ""),
-        )
-        .count(self.harmonics)?;
+        let harmonics = option_ranges::LOCKIN_HARMONICS.count(self.harmonics)?;
         let every = option_ranges::EVERY.count(self.every)?;
         let settle_cycles = option_ranges::SETTLE_CYCLES.count(self.settle_cycles)?;
         option_ranges::TOLERANCE.check(self.tolerance)?;

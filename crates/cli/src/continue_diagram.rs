@@ -489,18 +489,26 @@ pub const CSV_COLUMNS: [&str; 20] = [
     "residual",
 ];
 
+/// The header line of a diagram's CSV (no newline) with harmonics `1..=harmonics`:
+/// `direction`, then [`CSV_COLUMNS`], then `harmonic_<n>_amplitude_nm,harmonic_<n>_phase_deg`
+/// for each `n`.
+pub fn csv_header(harmonics: usize) -> String {
+    let mut header = format!("direction,{}", CSV_COLUMNS.join(","));
+    for n in 1..=harmonics {
+        header.push_str(&format!(
+            ",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"
+        ));
+    }
+    header
+}
+
 /// The CSV of a diagram's points (header line first): `direction` (`approach` or `retract`),
 /// then [`CSV_COLUMNS`], each the value of the JSON point's key of that name (empty for
 /// `null`), then `harmonic_<n>_amplitude_nm` and `harmonic_<n>_phase_deg` for `n = 1..N`
 /// (the JSON point's `harmonics[n - 1]`).
 fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
     let count = diagram.points.first().map_or(0, |p| p.harmonics.len());
-    let mut text = format!("direction,{}", CSV_COLUMNS.join(","));
-    for n in 1..=count {
-        text.push_str(&format!(
-            ",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"
-        ));
-    }
+    let mut text = csv_header(count);
     text.push('\n');
     for point in &diagram.points {
         push_csv_row(

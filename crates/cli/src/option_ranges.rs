@@ -51,6 +51,12 @@ pub const MIN_AMPLITUDE_RATIO: OptionRange =
 /// `--harmonics` of `simulate` and `continue`: the harmonics `1..=N` of `u` reported.
 pub const HARMONICS: OptionRange =
     OptionRange::new("--harmonics", Interval::closed(1.0, 1000.0, ""));
+/// `--harmonics` of `approach`: the lock-in's harmonics per reading, at most
+/// [`afm::orbit::lockin::MAX_LOCKIN_HARMONICS`].
+pub const LOCKIN_HARMONICS: OptionRange = OptionRange::new(
+    "--harmonics",
+    Interval::closed(1.0, afm::orbit::lockin::MAX_LOCKIN_HARMONICS as f64, ""),
+);
 /// `--max-points` of `continue`.
 pub const MAX_POINTS: OptionRange =
     OptionRange::new("--max-points", Interval::closed(2.0, 1e7, ""));
@@ -98,6 +104,7 @@ pub const TABLE: &[OptionRange] = &[
     MIN_AMPLITUDE_RATIO,
     MAX_POINTS,
     HARMONICS,
+    LOCKIN_HARMONICS,
     RATE,
     TO,
     TOLERANCE,

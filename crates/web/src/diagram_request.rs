@@ -150,7 +150,8 @@ impl DiagramRun {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use drumroll::continue_diagram::CSV_COLUMNS;
+    use drumroll::approach::DEFAULT_HARMONICS;
+    use drumroll::continue_diagram::csv_header;
 
     /// G1 is where the free orbit's lowest gap is zero: `Z_G1` of the closed-form free orbit
     /// (`TappingModel::grazing_separation_nm`), independent of the continuation that locates
@@ -170,7 +171,7 @@ mod tests {
         let mut lines = csv.lines();
         assert_eq!(
             lines.next(),
-            Some(format!("direction,{}", CSV_COLUMNS.join(",")).as_str())
+            Some(csv_header(DEFAULT_HARMONICS as usize).as_str())
         );
         assert_eq!(
             lines.count(),
