@@ -257,6 +257,69 @@ pub(crate) fn warnings_of(file: &str, fields: &[NumericField]) -> Vec<String> {
         .collect()
 }
 
+/// The plausibility warnings of `fields`, those of one kind gathered into one line: fields
+/// whose paths differ only in their list indices (`modes[3].stiffness_n_per_m`,
+/// `modes[4].stiffness_n_per_m`) give one warning with their count, the first and last path
+/// and the range of their values, in the order of their first occurrence.
+pub(crate) fn gathered_warnings(file: &str, fields: &[NumericField]) -> Vec<String> {
+    let mut kinds: Vec<(String, Vec<&NumericField>)> = Vec::new();
+    for field in fields {
+        if !field.2.implausible(field.1) {
+            continue;
+        }
+        let kind = without_indices(&field.0);
+        match kinds.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, members)) => members.push(field),
+            None => kinds.push((kind, vec![field])),
+        }
+    }
+    kinds
+        .into_iter()
+        .filter_map(|(kind, members)| match members.as_slice() {
+            [(field, value, interval)] => {
+                plausibility_warning(file, field, *value, *interval)
+            }
+            [first, .., last] => {
+                let low = members.iter().map(|f| f.1).fold(f64::INFINITY, f64::min);
+                let high = members.iter().map(|f| f.1).fold(f64::NEG_INFINITY, f64::max);
+                Some(format!(
+                    "{file}: field `{kind}` is unusual for AFM in {} entries (`{}` to `{}`, \
+                     values {} to {}; allowed {})",
+                    members.len(),
+                    first.0,
+                    last.0,
+                    format_number(low),
+                    format_number(high),
+                    first.2.describe()
+                ))
+            }
+            [] => None,
+        })
+        .collect()
+}
+
+/// A field path with every list index replaced by `[i]`: `modes[3].stiffness_n_per_m` ->
+/// `modes[i].stiffness_n_per_m`.
+fn without_indices(field: &str) -> String {
+    let mut kind = String::with_capacity(field.len());
+    let mut in_index = false;
+    for c in field.chars() {
+        match c {
+            '[' => {
+                in_index = true;
+                kind.push_str("[i");
+            }
+            ']' => {
+                in_index = false;
+                kind.push(']');
+            }
+            _ if in_index => {}
+            _ => kind.push(c),
+        }
+    }
+    kind
+}
+
 /// Check that a name is a non-empty string without surrounding whitespace.
 pub(crate) fn check_name(file: &str, field: &str, name: &str) -> Result<(), AfmError> {
     if !name.is_empty() && name.trim() == name {
