@@ -23,6 +23,7 @@ pub fn check_writable(path: &Path, option: &str) -> Result<()> {
     probe_name.push(file_name);
     probe_name.push(format!(".{}.probe", std::process::id()));
     let probe = path.with_file_name(probe_name);
+    remove_stale_temporaries(path);
     match std::fs::OpenOptions::new()
         .write(true)
         .create_new(true)
@@ -99,8 +100,9 @@ pub fn write_atomically_with(
     result
 }
 
-/// Remove the temporary files `<path>.<PID>.partial` that killed runs left beside `path`
-/// (Linux: those whose process no longer runs, `/proc/<PID>` absent); elsewhere nothing.
+/// Remove the temporary files `<path>.<PID>.partial` (and the probes `.<name>.<PID>.probe` of
+/// [`check_writable`]) that killed runs left beside `path` (Linux: those whose process no
+/// longer runs, `/proc/<PID>` absent); elsewhere nothing.
 fn remove_stale_temporaries(path: &Path) {
     if !cfg!(target_os = "linux") || !Path::new("/proc/self").exists() {
         return;
@@ -123,12 +125,16 @@ fn remove_stale_temporaries(path: &Path) {
     };
     for entry in entries.flatten() {
         let file_name = entry.file_name();
-        let Some(pid) = file_name
-            .to_str()
-            .and_then(|n| n.strip_prefix(prefix.as_str()))
-            .and_then(|rest| rest.strip_suffix(".partial"))
-            .and_then(|pid| pid.parse::<u32>().ok())
-        else {
+        let Some(pid) = file_name.to_str().and_then(|n| {
+            n.strip_prefix(prefix.as_str())
+                .and_then(|rest| rest.strip_suffix(".partial"))
+                .or_else(|| {
+                    n.strip_prefix('.')
+                        .and_then(|n| n.strip_prefix(prefix.as_str()))
+                        .and_then(|rest| rest.strip_suffix(".probe"))
+                })
+                .and_then(|pid| pid.parse::<u32>().ok())
+        }) else {
             continue;
         };
         if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
