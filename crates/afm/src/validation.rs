@@ -276,12 +276,13 @@ pub(crate) fn gathered_warnings(file: &str, fields: &[NumericField]) -> Vec<Stri
     kinds
         .into_iter()
         .filter_map(|(kind, members)| match members.as_slice() {
-            [(field, value, interval)] => {
-                plausibility_warning(file, field, *value, *interval)
-            }
+            [(field, value, interval)] => plausibility_warning(file, field, *value, *interval),
             [first, .., last] => {
                 let low = members.iter().map(|f| f.1).fold(f64::INFINITY, f64::min);
-                let high = members.iter().map(|f| f.1).fold(f64::NEG_INFINITY, f64::max);
+                let high = members
+                    .iter()
+                    .map(|f| f.1)
+                    .fold(f64::NEG_INFINITY, f64::max);
                 Some(format!(
                     "{file}: field `{kind}` is unusual for AFM in {} entries (`{}` to `{}`, \
                      values {} to {}; allowed {})",

@@ -19,10 +19,10 @@ use std::path::{Path, PathBuf};
 
 use crate::grid_file::{assemble, assemble_locked, PartWriter};
 use crate::grid_row::seal;
-use crate::progress::note;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
 use crate::output::print_stdout;
+use crate::progress::note;
 
 /// The most rows, and the most separations per row, a grid may have.
 pub const MAX_STEPS: usize = 100_000;

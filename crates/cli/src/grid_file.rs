@@ -108,7 +108,10 @@ fn read_part_from(mut file: File, path: &Path) -> Result<PartContent> {
                 );
             }
             shape = Some(GridShape::of_header(text).map_err(|reason| {
-                anyhow::anyhow!("{} line 1: {reason} (not a drumroll grid file?)", path.display())
+                anyhow::anyhow!(
+                    "{} line 1: {reason} (not a drumroll grid file?)",
+                    path.display()
+                )
             })?);
             header = Some(format!("{text}\n"));
             offset += length;

@@ -19,7 +19,9 @@ pub fn seal(json: &str) -> String {
 /// Check a row line's checksum (the line without its newline); the reason it fails in words.
 pub fn check_seal(line: &str) -> Result<(), String> {
     let Some(at) = line.rfind(CHECKSUM_KEY) else {
-        return Err(String::from("no `crc32` checksum (not written by this drumroll?)"));
+        return Err(String::from(
+            "no `crc32` checksum (not written by this drumroll?)",
+        ));
     };
     let stored = &line[at + CHECKSUM_KEY.len()..];
     let Some(stored) = stored.strip_suffix("\"}") else {
@@ -165,7 +167,10 @@ mod tests {
             let mut bytes = text.as_bytes().to_vec();
             bytes[at] = if bytes[at] == b'7' { b'8' } else { b'7' };
             let changed = String::from_utf8(bytes).expect("ASCII");
-            assert!(check_seal(&changed).is_err(), "byte {at} changed: {changed}");
+            assert!(
+                check_seal(&changed).is_err(),
+                "byte {at} changed: {changed}"
+            );
         }
     }
 

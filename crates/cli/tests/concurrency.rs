@@ -93,8 +93,14 @@ fn start(args: &[&str], path: &Path) -> Child {
 fn wait_for_content(path: &Path, child: &mut Child) {
     let started = Instant::now();
     while std::fs::metadata(path).map_or(0, |m| m.len()) == 0 {
-        assert!(started.elapsed() < Duration::from_secs(60), "nothing written");
-        assert!(child.try_wait().expect("status").is_none(), "finished early");
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "nothing written"
+        );
+        assert!(
+            child.try_wait().expect("status").is_none(),
+            "finished early"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
 }
@@ -120,7 +126,10 @@ fn a_second_writer_on_a_grid_part_refuses_at_once_and_the_first_is_untouched() {
             "the first writer's process: {stderr}"
         );
     }
-    assert!(still_running, "the second writer returned only after the first finished");
+    assert!(
+        still_running,
+        "the second writer returned only after the first finished"
+    );
     // The first writer goes on; stopped now, its part holds valid rows only: merging it
     // names the missing rows, not a damaged line.
     first.kill().expect("kill");
@@ -129,7 +138,10 @@ fn a_second_writer_on_a_grid_part_refuses_at_once_and_the_first_is_untouched() {
         &["grid", "merge", "--output"],
         &[&directory.path().join("map.jsonl"), &part],
     );
-    assert!(!ok && stderr.contains("rows missing from the parts"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("rows missing from the parts"),
+        "{stderr}"
+    );
 
     // The same through a single run's work file `FILE.part`.
     let map = directory.path().join("single.jsonl");
@@ -165,8 +177,15 @@ fn a_second_approach_on_the_same_out_refuses_and_the_first_finishes_complete() {
     let records = lines(&out);
     let columns = records[0].split(',').count();
     assert!(records.len() > 100, "{} records", records.len());
-    assert!(records.iter().all(|r| r.ends_with('\n') && r.split(',').count() == columns));
-    let last_z: f64 = records[records.len() - 1].split(',').nth(1).expect("z").parse().expect("z");
+    assert!(records
+        .iter()
+        .all(|r| r.ends_with('\n') && r.split(',').count() == columns));
+    let last_z: f64 = records[records.len() - 1]
+        .split(',')
+        .nth(1)
+        .expect("z")
+        .parse()
+        .expect("z");
     assert!(last_z <= 6.0 + 0.01, "the sweep ended at {last_z} nm");
 }
 
@@ -194,7 +213,10 @@ fn merge_and_resume_check_every_row_against_the_header() {
     let part = small_part(directory.path(), "good.jsonl");
     let good = lines(&part);
     assert_eq!(good.len(), 5);
-    let (ok, stderr) = run(&["grid", "merge", "--output"], &[&at("good-map.jsonl"), &part]);
+    let (ok, stderr) = run(
+        &["grid", "merge", "--output"],
+        &[&at("good-map.jsonl"), &part],
+    );
     assert!(ok, "{stderr}");
     let good_map = std::fs::read(at("good-map.jsonl")).expect("map");
 
@@ -207,13 +229,22 @@ fn merge_and_resume_check_every_row_against_the_header() {
         reseal(&format!("{}{}", &row[..cut], &row[close..]))
     };
     let without_first_contact = reseal(&row.replacen(
-        &format!("\"first_contact_z_nm\":{},", value_text(&row, "first_contact_z_nm")),
+        &format!(
+            "\"first_contact_z_nm\":{},",
+            value_text(&row, "first_contact_z_nm")
+        ),
         "",
         1,
     ));
     let other_parameter = reseal(&row.replacen(
-        &format!("\"parameter_value\":{}", value_text(&row, "parameter_value")),
-        &format!("\"parameter_value\":{}", value_text(&good[3], "parameter_value")),
+        &format!(
+            "\"parameter_value\":{}",
+            value_text(&row, "parameter_value")
+        ),
+        &format!(
+            "\"parameter_value\":{}",
+            value_text(&good[3], "parameter_value")
+        ),
         1,
     ));
     let out_of_range = reseal(&row.replacen("\"row\":1,", "\"row\":4,", 1));
@@ -236,32 +267,69 @@ fn merge_and_resume_check_every_row_against_the_header() {
     let cases: Vec<(&str, Vec<String>, Vec<&str>)> = vec![
         (
             "one cell short",
-            vec![good[0].clone(), good[1].clone(), without_last_cell, good[3].clone(), good[4].clone()],
+            vec![
+                good[0].clone(),
+                good[1].clone(),
+                without_last_cell,
+                good[3].clone(),
+                good[4].clone(),
+            ],
             vec!["line 3", "12 cells", "13 separations"],
         ),
         (
             "no first_contact_z_nm",
-            vec![good[0].clone(), good[1].clone(), without_first_contact, good[3].clone(), good[4].clone()],
+            vec![
+                good[0].clone(),
+                good[1].clone(),
+                without_first_contact,
+                good[3].clone(),
+                good[4].clone(),
+            ],
             vec!["line 3", "first_contact_z_nm"],
         ),
         (
             "another row's parameter value",
-            vec![good[0].clone(), good[1].clone(), other_parameter, good[3].clone(), good[4].clone()],
+            vec![
+                good[0].clone(),
+                good[1].clone(),
+                other_parameter,
+                good[3].clone(),
+                good[4].clone(),
+            ],
             vec!["line 3", "parameter_value", "not the header's value"],
         ),
         (
             "a row index past the grid",
-            vec![good[0].clone(), good[1].clone(), out_of_range, good[3].clone(), good[4].clone()],
+            vec![
+                good[0].clone(),
+                good[1].clone(),
+                out_of_range,
+                good[3].clone(),
+                good[4].clone(),
+            ],
             vec!["line 3", "row 4 is outside the grid's 4 rows"],
         ),
         (
             "row 1 twice with different contents",
-            vec![good[0].clone(), good[1].clone(), row.clone(), good[3].clone(), good[4].clone(), other_phase],
+            vec![
+                good[0].clone(),
+                good[1].clone(),
+                row.clone(),
+                good[3].clone(),
+                good[4].clone(),
+                other_phase,
+            ],
             vec!["lines 3 and 6 both hold row 1"],
         ),
         (
             "an edited number",
-            vec![good[0].clone(), good[1].clone(), edited, good[3].clone(), good[4].clone()],
+            vec![
+                good[0].clone(),
+                good[1].clone(),
+                edited,
+                good[3].clone(),
+                good[4].clone(),
+            ],
             vec!["line 3", "checksum mismatch"],
         ),
     ];
@@ -296,7 +364,10 @@ fn merge_and_resume_check_every_row_against_the_header() {
     // The same row twice, identical (a requeued task that redid it): kept once.
     let twice = at("twice.jsonl");
     std::fs::write(&twice, format!("{}{}", good.concat(), good[2])).expect("write");
-    let (ok, stderr) = run(&["grid", "merge", "--output"], &[&at("twice-map.jsonl"), &twice]);
+    let (ok, stderr) = run(
+        &["grid", "merge", "--output"],
+        &[&at("twice-map.jsonl"), &twice],
+    );
     assert!(ok, "{stderr}");
     assert_eq!(std::fs::read(at("twice-map.jsonl")).expect("map"), good_map);
 
@@ -379,7 +450,17 @@ fn more_modes_than_the_limit_are_refused_naming_the_field_and_the_limit() {
     cantilever_file(&lever, afm::MAX_MODES + 1, 0.036);
     let lever_text = lever.display().to_string();
     let (ok, stderr) = run(
-        &["simulate", "--cantilever", &lever_text, "--sample", "mica", "--a0", "10", "--z", "5"],
+        &[
+            "simulate",
+            "--cantilever",
+            &lever_text,
+            "--sample",
+            "mica",
+            "--a0",
+            "10",
+            "--z",
+            "5",
+        ],
         &[],
     );
     assert!(!ok, "{} modes accepted", afm::MAX_MODES + 1);
@@ -390,12 +471,31 @@ fn more_modes_than_the_limit_are_refused_naming_the_field_and_the_limit() {
     // The grid's cells are limited too (10^7: 4000 rows of 2501 separations are one past it).
     let (ok, stderr) = run(
         &[
-            "grid", "--case", "biolever-mica", "--vary", "a0", "--from", "9", "--to", "11",
-            "--steps", "4000", "--z-from", "11", "--z-to", "8", "--z-steps", "2501", "--output",
+            "grid",
+            "--case",
+            "biolever-mica",
+            "--vary",
+            "a0",
+            "--from",
+            "9",
+            "--to",
+            "11",
+            "--steps",
+            "4000",
+            "--z-from",
+            "11",
+            "--z-to",
+            "8",
+            "--z-steps",
+            "2501",
+            "--output",
         ],
         &[&directory.path().join("big.jsonl")],
     );
-    assert!(!ok && stderr.contains("--steps 4000 x --z-steps 2501") && stderr.contains("10000000"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("--steps 4000 x --z-steps 2501") && stderr.contains("10000000"),
+        "{stderr}"
+    );
 }
 
 #[test]
@@ -406,10 +506,23 @@ fn warnings_of_one_kind_are_one_line_with_count_and_range() {
     cantilever_file(&lever, 8, 2.0);
     let lever_text = lever.display().to_string();
     let (_, stderr) = run(
-        &["simulate", "--cantilever", &lever_text, "--sample", "mica", "--a0", "10", "--z", "-100"],
+        &[
+            "simulate",
+            "--cantilever",
+            &lever_text,
+            "--sample",
+            "mica",
+            "--a0",
+            "10",
+            "--z",
+            "-100",
+        ],
         &[],
     );
-    let warnings: Vec<&str> = stderr.lines().filter(|l| l.contains("unusual for AFM")).collect();
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("unusual for AFM"))
+        .collect();
     assert_eq!(warnings.len(), 1, "{stderr}");
     assert!(
         warnings[0].contains("modes[i].stiffness_n_per_m")
@@ -441,7 +554,11 @@ fn a_byte_order_mark_is_accepted_and_a_bad_cantilever_reference_is_named() {
             .expect("runs")
     };
     let (marked, unmarked) = (simulate(&with_mark), simulate(&plain));
-    assert!(marked.status.success(), "{}", String::from_utf8_lossy(&marked.stderr));
+    assert!(
+        marked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&marked.stderr)
+    );
     assert_eq!(marked.stdout, unmarked.stdout, "the mark changes nothing");
 
     let dot = case("dot.json", &body.replace("\"biolever\"", "\".\""));

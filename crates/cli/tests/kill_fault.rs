@@ -26,24 +26,56 @@ const SCENARIOS: [Scenario; 4] = [
     Scenario {
         name: "grid",
         args: &[
-            "grid", "--case", "biolever-mica", "--vary", "a0", "--from", "9", "--to", "11",
-            "--steps", "6", "--z-from", "11", "--z-to", "7", "--z-steps", "30", "--retract",
-            "--threads", "2", "--output", "map.jsonl",
+            "grid",
+            "--case",
+            "biolever-mica",
+            "--vary",
+            "a0",
+            "--from",
+            "9",
+            "--to",
+            "11",
+            "--steps",
+            "6",
+            "--z-from",
+            "11",
+            "--z-to",
+            "7",
+            "--z-steps",
+            "30",
+            "--retract",
+            "--threads",
+            "2",
+            "--output",
+            "map.jsonl",
         ],
         outputs: &["map.jsonl"],
     },
     Scenario {
         name: "approach",
         args: &[
-            "approach", "--case", "biolever-mica", "--to", "8.5", "--retract", "--out",
-            "sweep.csv", "--plot", "sweep.svg",
+            "approach",
+            "--case",
+            "biolever-mica",
+            "--to",
+            "8.5",
+            "--retract",
+            "--out",
+            "sweep.csv",
+            "--plot",
+            "sweep.svg",
         ],
         outputs: &["sweep.csv", "sweep.svg"],
     },
     Scenario {
         name: "continue",
         args: &[
-            "continue", "--case", "biolever-mica", "--csv", "diagram.csv", "--plot",
+            "continue",
+            "--case",
+            "biolever-mica",
+            "--csv",
+            "diagram.csv",
+            "--plot",
             "diagram.svg",
         ],
         outputs: &["diagram.csv", "diagram.svg"],
@@ -51,8 +83,19 @@ const SCENARIOS: [Scenario; 4] = [
     Scenario {
         name: "map",
         args: &[
-            "map", "--case", "biolever-mica", "--vary", "a0", "--from", "8", "--to", "12",
-            "--csv", "regimes.csv", "--plot", "regimes.svg",
+            "map",
+            "--case",
+            "biolever-mica",
+            "--vary",
+            "a0",
+            "--from",
+            "8",
+            "--to",
+            "12",
+            "--csv",
+            "regimes.csv",
+            "--plot",
+            "regimes.svg",
         ],
         outputs: &["regimes.csv", "regimes.svg"],
     },
@@ -128,7 +171,12 @@ fn killed_commands_leave_complete_outputs_or_none_and_rerun_identically() {
         let reference = files(reference_directory.path());
         assert_eq!(
             reference.keys().map(String::as_str).collect::<Vec<_>>(),
-            scenario.outputs.iter().copied().collect::<Vec<_>>().tap_sort(),
+            scenario
+                .outputs
+                .iter()
+                .copied()
+                .collect::<Vec<_>>()
+                .tap_sort(),
             "{}: the uninterrupted run's files",
             scenario.name
         );

@@ -4,9 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::AfmError;
 use crate::model::eigenmode::Eigenmode;
-use crate::validation::{
-    check_all, check_name, gathered_warnings, invalid, ranges, NumericField,
-};
+use crate::validation::{check_all, check_name, gathered_warnings, invalid, ranges, NumericField};
 
 /// The tip's Young's modulus the paper uses, GPa (its note 15).
 pub const DEFAULT_TIP_YOUNGS_MODULUS_GPA: f64 = 130.0;

@@ -42,4 +42,3 @@ pub fn reseal(line: &str) -> String {
         crc32fast::hash(body.as_bytes())
     )
 }
-
