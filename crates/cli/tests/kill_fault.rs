@@ -169,14 +169,11 @@ fn killed_commands_leave_complete_outputs_or_none_and_rerun_identically() {
         let reference_directory = tempfile::tempdir().expect("temporary directory");
         let took = complete(scenario, reference_directory.path());
         let reference = files(reference_directory.path());
+        let mut expected = scenario.outputs.to_vec();
+        expected.sort_unstable();
         assert_eq!(
             reference.keys().map(String::as_str).collect::<Vec<_>>(),
-            scenario
-                .outputs
-                .iter()
-                .copied()
-                .collect::<Vec<_>>()
-                .tap_sort(),
+            expected,
             "{}: the uninterrupted run's files",
             scenario.name
         );
@@ -244,17 +241,5 @@ fn killed_commands_leave_complete_outputs_or_none_and_rerun_identically() {
              {identical} times",
             scenario.name
         );
-    }
-}
-
-/// Sorting in an expression.
-trait TapSort {
-    fn tap_sort(self) -> Self;
-}
-
-impl TapSort for Vec<&str> {
-    fn tap_sort(mut self) -> Self {
-        self.sort_unstable();
-        self
     }
 }
