@@ -353,3 +353,46 @@ fn round_to_significant(value: f64) -> f64 {
     }
     format!("{value:.11e}").parse().unwrap_or(value)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warnings_of_one_kind_are_gathered_and_a_single_one_is_kept_as_it_is() {
+        let stiffness = ranges::STIFFNESS_N_PER_M;
+        let field =
+            |i: usize, value: f64| (format!("modes[{i}].stiffness_n_per_m"), value, stiffness);
+        // Typical up to 1e3 N/m: modes 1 and 3 to 5 are above it, mode 2 is not.
+        let mut fields = vec![
+            (String::from("tip_radius_nm"), 2e4, ranges::TIP_RADIUS_NM),
+            field(0, 1.0),
+            field(1, 2e3),
+            field(2, 5.0),
+            field(3, 7e4),
+            field(4, 3e3),
+        ];
+        let warnings = gathered_warnings("lever.json", &fields);
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        assert_eq!(
+            warnings[0],
+            plausibility_warning("lever.json", "tip_radius_nm", 2e4, ranges::TIP_RADIUS_NM)
+                .expect("a warning")
+        );
+        assert!(
+            warnings[1].starts_with(
+                "lever.json: field `modes[i].stiffness_n_per_m` is unusual for AFM in 3 entries \
+                 (`modes[1].stiffness_n_per_m` to `modes[4].stiffness_n_per_m`, values 2000 to \
+                 70000;"
+            ),
+            "{}",
+            warnings[1]
+        );
+        fields.truncate(3);
+        assert_eq!(
+            gathered_warnings("lever.json", &fields)[1],
+            plausibility_warning("lever.json", "modes[1].stiffness_n_per_m", 2e3, stiffness)
+                .expect("a warning")
+        );
+    }
+}
