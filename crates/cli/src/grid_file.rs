@@ -341,10 +341,11 @@ pub fn assemble_locked(parts: &[PathBuf], output: &Path) -> Result<()> {
     let missing: Vec<usize> = (0..rows).filter(|row| !holder.contains_key(row)).collect();
     if !missing.is_empty() {
         bail!(
-            "rows missing from the parts: {} ({} of the grid's {rows} rows; rerun the shards \
-             that hold them, which resume where they stopped)",
+            "rows missing from the parts: {} ({} of the grid's {rows} rows, in none of {}; rerun \
+             the shards that hold them, which resume where they stopped)",
             list_rows(&missing),
-            missing.len()
+            missing.len(),
+            list_parts(parts)
         );
     }
     write_atomically_with(output, |writer| {
@@ -365,6 +366,20 @@ fn read_line(path: &Path, line: RowLine) -> Result<Vec<u8>> {
     file.read_exact(&mut bytes)
         .with_context(|| format!("cannot read {} (changed while merging?)", path.display()))?;
     Ok(bytes)
+}
+
+/// Part file names as a short list: the first 5, then how many more.
+fn list_parts(parts: &[PathBuf]) -> String {
+    let shown: Vec<String> = parts
+        .iter()
+        .take(5)
+        .map(|part| part.display().to_string())
+        .collect();
+    let mut text = shown.join(", ");
+    if parts.len() > 5 {
+        text.push_str(&format!(", ... ({} more)", parts.len() - 5));
+    }
+    text
 }
 
 /// Row indices as a short list: the first 20, then how many more.

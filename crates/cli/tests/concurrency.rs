@@ -569,3 +569,109 @@ fn a_byte_order_mark_is_accepted_and_a_bad_cantilever_reference_is_named() {
         "{stderr}"
     );
 }
+
+/// Damage done to a part file's bytes by [`damaged_parts_are_refused_by_line_or_merge_to_the_same_map`].
+#[derive(Debug, Clone)]
+enum Damage {
+    /// Replace the byte at this position (modulo the row lines' length) by another value.
+    Replace(usize, u8),
+    /// Remove the byte at this position.
+    Remove(usize),
+    /// Cut the file at this position.
+    Cut(usize),
+    /// Append a copy of this row line.
+    Duplicate(usize),
+    /// Swap two row lines.
+    Swap(usize, usize),
+}
+
+#[test]
+fn damaged_parts_are_refused_by_line_or_merge_to_the_same_map() {
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, TestRunner};
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let part = small_part(directory.path(), "good.jsonl");
+    let good = std::fs::read(&part).expect("part");
+    let header_length = good.iter().position(|&b| b == b'\n').expect("header") + 1;
+    let good_map = directory.path().join("good-map.jsonl");
+    drumroll::grid_file::assemble(std::slice::from_ref(&part), &good_map).expect("merges");
+    let good_map = std::fs::read(&good_map).expect("map");
+    let damaged = directory.path().join("damaged.jsonl");
+    let output = directory.path().join("map.jsonl");
+    let damage = prop_oneof![
+        (any::<usize>(), 1u8..=255).prop_map(|(at, by)| Damage::Replace(at, by)),
+        any::<usize>().prop_map(Damage::Remove),
+        any::<usize>().prop_map(Damage::Cut),
+        (0usize..4).prop_map(Damage::Duplicate),
+        (0usize..4, 0usize..4).prop_map(|(a, b)| Damage::Swap(a, b)),
+    ];
+    let cases = std::env::var("DRUMROLL_PART_FUZZ_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(500);
+    let mut runner = TestRunner::new(Config {
+        cases,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    runner
+        .run(&damage, |damage| {
+            let rows = good.len() - header_length;
+            let mut lines: Vec<Vec<u8>> = good
+                .split_inclusive(|&b| b == b'\n')
+                .map(<[u8]>::to_vec)
+                .collect();
+            let mut bytes = good.clone();
+            let must_fail = match &damage {
+                Damage::Replace(at, by) => {
+                    let at = header_length + at % rows;
+                    // A different byte value: `by` added modulo 256, never zero.
+                    bytes[at] = bytes[at].wrapping_add(*by);
+                    true
+                }
+                Damage::Remove(at) => {
+                    bytes.remove(header_length + at % rows);
+                    true
+                }
+                Damage::Cut(at) => {
+                    bytes.truncate(header_length + at % rows);
+                    true
+                }
+                Damage::Duplicate(row) => {
+                    let copy = lines[1 + row].clone();
+                    lines.push(copy);
+                    bytes = lines.concat();
+                    false
+                }
+                Damage::Swap(a, b) => {
+                    lines.swap(1 + a, 1 + b);
+                    bytes = lines.concat();
+                    false
+                }
+            };
+            std::fs::write(&damaged, &bytes).expect("write");
+            let _ = std::fs::remove_file(&output);
+            match drumroll::grid_file::assemble(std::slice::from_ref(&damaged), &output) {
+                Ok(()) => {
+                    prop_assert!(!must_fail, "{damage:?} was merged");
+                    prop_assert!(
+                        std::fs::read(&output).expect("map") == good_map,
+                        "{damage:?}: merged into another map"
+                    );
+                }
+                Err(error) => {
+                    let message = format!("{error:#}");
+                    prop_assert!(!output.exists(), "{damage:?}: a map from a refused merge");
+                    prop_assert!(message.contains("damaged.jsonl"), "{damage:?}: {message}");
+                    prop_assert!(
+                        message.contains(" line ")
+                            || message.contains("lines ")
+                            || message.contains("rows missing"),
+                        "{damage:?}: neither a line nor the missing rows named: {message}"
+                    );
+                }
+            }
+            Ok(())
+        })
+        .unwrap_or_else(|error| panic!("{error}"));
+}
