@@ -11,13 +11,13 @@ use std::path::Path;
 /// Take the exclusive lock of `file` (open at `path`, the value of `option`) without waiting;
 /// if another process holds a lock on it, an error naming `option`, the file and that process.
 pub fn lock_exclusive(file: &File, path: &Path, option: &str) -> Result<()> {
-    let taken = fs4::fs_std::FileExt::try_lock_exclusive(file)
+    let taken = try_lock(file, true)
         .with_context(|| format!("{option} {}: cannot lock it", path.display()))?;
     if !taken {
         bail!(
             "{option} {}: the file is being written by {}; a second writer would overwrite its \
-             rows, so this one stops and leaves the file as it is. Wait for that process to \
-             finish (or stop it) and run again: the rows it wrote are kept",
+             lines, so this one stops and leaves the file as it is. Wait for that process to \
+             finish (or stop it), then run again",
             path.display(),
             holder_words(file)
         );
@@ -28,7 +28,7 @@ pub fn lock_exclusive(file: &File, path: &Path, option: &str) -> Result<()> {
 /// Take a shared lock of `file` (open at `path`) without waiting, for reading a file that a
 /// writer may be appending to; an error naming the file and the writing process otherwise.
 pub fn lock_shared(file: &File, path: &Path, what: &str) -> Result<()> {
-    let taken = fs4::fs_std::FileExt::try_lock_shared(file)
+    let taken = try_lock(file, false)
         .with_context(|| format!("{what} {}: cannot lock it", path.display()))?;
     if !taken {
         bail!(
@@ -38,6 +38,23 @@ pub fn lock_shared(file: &File, path: &Path, what: &str) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Try to take the lock of `file` (`exclusive` or shared) without waiting: whether it was
+/// taken.
+#[cfg(not(target_arch = "wasm32"))]
+fn try_lock(file: &File, exclusive: bool) -> std::io::Result<bool> {
+    if exclusive {
+        fs4::fs_std::FileExt::try_lock_exclusive(file)
+    } else {
+        fs4::fs_std::FileExt::try_lock_shared(file)
+    }
+}
+
+/// WebAssembly (the explorer page): no other process shares the file system; always taken.
+#[cfg(target_arch = "wasm32")]
+fn try_lock(_file: &File, _exclusive: bool) -> std::io::Result<bool> {
+    Ok(true)
 }
 
 /// "process 1234" (or "another process" where the holder cannot be told).
