@@ -91,7 +91,10 @@ fn find<'a>(
         })
 }
 
+/// Parse a JSON file's text; a UTF-8 byte-order mark at its start (written by some Windows
+/// editors) is skipped, so the positions in errors are those of the text after it.
 fn parse<T: DeserializeOwned>(file: &str, text: &str) -> Result<T, AfmError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     serde_json::from_str(text).map_err(|source| AfmError::Json {
         file: file.to_string(),
         field: crate::json_path::path_at(text, source.line(), source.column()),
@@ -234,7 +237,17 @@ fn resolve<T>(
                 other => other,
             })
         }
-        _ => Err(AfmError::UnknownFixture {
+        Some(_) => Err(AfmError::InvalidField {
+            file: case_file.to_string(),
+            field: kind.to_string(),
+            value: format!("{reference:?}"),
+            allowed: format!(
+                "a built-in {kind} ({}) or the path of a {kind} file ending in .json, relative \
+                 to the case file's directory",
+                names(table).join(", ")
+            ),
+        }),
+        None => Err(AfmError::UnknownFixture {
             kind,
             name: reference.to_string(),
             known: names(table).join(", "),

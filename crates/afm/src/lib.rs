@@ -43,7 +43,7 @@ pub use map::parameter_axis::{CaseFamily, ParameterAxis, PARAMETER_NAMES};
 pub use map::regime_map::{
     regime_map, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap, RegimeMapSettings,
 };
-pub use model::cantilever::Cantilever;
+pub use model::cantilever::{Cantilever, MAX_MODES};
 pub use model::case::{Case, CaseFile};
 pub use model::drive::Drive;
 pub use model::eigenmode::Eigenmode;

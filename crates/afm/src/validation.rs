@@ -257,6 +257,70 @@ pub(crate) fn warnings_of(file: &str, fields: &[NumericField]) -> Vec<String> {
         .collect()
 }
 
+/// The plausibility warnings of `fields`, those of one kind gathered into one line: fields
+/// whose paths differ only in their list indices (`modes[3].stiffness_n_per_m`,
+/// `modes[4].stiffness_n_per_m`) give one warning with their count, the first and last path
+/// and the range of their values, in the order of their first occurrence.
+pub(crate) fn gathered_warnings(file: &str, fields: &[NumericField]) -> Vec<String> {
+    let mut kinds: Vec<(String, Vec<&NumericField>)> = Vec::new();
+    for field in fields {
+        if !field.2.implausible(field.1) {
+            continue;
+        }
+        let kind = without_indices(&field.0);
+        match kinds.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, members)) => members.push(field),
+            None => kinds.push((kind, vec![field])),
+        }
+    }
+    kinds
+        .into_iter()
+        .filter_map(|(kind, members)| match members.as_slice() {
+            [(field, value, interval)] => plausibility_warning(file, field, *value, *interval),
+            [first, .., last] => {
+                let low = members.iter().map(|f| f.1).fold(f64::INFINITY, f64::min);
+                let high = members
+                    .iter()
+                    .map(|f| f.1)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                Some(format!(
+                    "{file}: field `{kind}` is unusual for AFM in {} entries (`{}` to `{}`, \
+                     values {} to {}; allowed {})",
+                    members.len(),
+                    first.0,
+                    last.0,
+                    format_number(low),
+                    format_number(high),
+                    first.2.describe()
+                ))
+            }
+            [] => None,
+        })
+        .collect()
+}
+
+/// A field path with every list index replaced by `[i]`: `modes[3].stiffness_n_per_m` ->
+/// `modes[i].stiffness_n_per_m`.
+fn without_indices(field: &str) -> String {
+    let mut kind = String::with_capacity(field.len());
+    let mut in_index = false;
+    for c in field.chars() {
+        match c {
+            '[' => {
+                in_index = true;
+                kind.push_str("[i");
+            }
+            ']' => {
+                in_index = false;
+                kind.push(']');
+            }
+            _ if in_index => {}
+            _ => kind.push(c),
+        }
+    }
+    kind
+}
+
 /// Check that a name is a non-empty string without surrounding whitespace.
 pub(crate) fn check_name(file: &str, field: &str, name: &str) -> Result<(), AfmError> {
     if !name.is_empty() && name.trim() == name {
@@ -288,4 +352,47 @@ fn round_to_significant(value: f64) -> f64 {
         return value;
     }
     format!("{value:.11e}").parse().unwrap_or(value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warnings_of_one_kind_are_gathered_and_a_single_one_is_kept_as_it_is() {
+        let stiffness = ranges::STIFFNESS_N_PER_M;
+        let field =
+            |i: usize, value: f64| (format!("modes[{i}].stiffness_n_per_m"), value, stiffness);
+        // Typical up to 1e3 N/m: modes 1 and 3 to 5 are above it, mode 2 is not.
+        let mut fields = vec![
+            (String::from("tip_radius_nm"), 2e4, ranges::TIP_RADIUS_NM),
+            field(0, 1.0),
+            field(1, 2e3),
+            field(2, 5.0),
+            field(3, 7e4),
+            field(4, 3e3),
+        ];
+        let warnings = gathered_warnings("lever.json", &fields);
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        assert_eq!(
+            warnings[0],
+            plausibility_warning("lever.json", "tip_radius_nm", 2e4, ranges::TIP_RADIUS_NM)
+                .expect("a warning")
+        );
+        assert!(
+            warnings[1].starts_with(
+                "lever.json: field `modes[i].stiffness_n_per_m` is unusual for AFM in 3 entries \
+                 (`modes[1].stiffness_n_per_m` to `modes[4].stiffness_n_per_m`, values 2000 to \
+                 70000;"
+            ),
+            "{}",
+            warnings[1]
+        );
+        fields.truncate(3);
+        assert_eq!(
+            gathered_warnings("lever.json", &fields)[1],
+            plausibility_warning("lever.json", "modes[1].stiffness_n_per_m", 2e3, stiffness)
+                .expect("a warning")
+        );
+    }
 }

@@ -16,7 +16,7 @@ use crate::exit_status::Incomplete;
 use crate::inputs::inputs_json;
 use crate::model_args::ModelArgs;
 use crate::option_ranges::{self, OptionRange};
-use crate::output::check_writable;
+use crate::output::{check_writable, StreamedFile};
 use crate::plot::{render_svg, FigureFile, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 use crate::progress::{note, Progress};
 
@@ -184,7 +184,7 @@ impl ApproachArgs {
 /// Where the records go: standard output or a file, one complete line per write.
 enum RecordSink {
     Stdout(std::io::Stdout),
-    File(std::fs::File, PathBuf),
+    File(StreamedFile),
 }
 
 impl RecordSink {
@@ -200,11 +200,7 @@ impl RecordSink {
                     Err(error) => Err(error).context("cannot write to standard output"),
                 }
             }
-            Self::File(file, path) => file
-                .write_all(line.as_bytes())
-                .and_then(|()| file.flush())
-                .map(|()| true)
-                .with_context(|| format!("cannot write {}", path.display())),
+            Self::File(file) => file.write_line(line).map(|()| true),
         }
     }
 }
@@ -277,11 +273,7 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
     let mut sweep = Sweep::new(&model, settings).context("cannot set up the sweep")?;
     let mut sink = match &args.out {
         None => RecordSink::Stdout(std::io::stdout()),
-        Some(path) => RecordSink::File(
-            std::fs::File::create(path)
-                .with_context(|| format!("--out {}: cannot create it", path.display()))?,
-            path.clone(),
-        ),
+        Some(path) => RecordSink::File(StreamedFile::create(path, "--out")?),
     };
     if !sink.write_line(&first_line)? {
         return Ok(());
@@ -299,9 +291,16 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
             Ok(None) => break,
             Err(error) => {
                 progress.abandon();
+                let kept_in = match &sink {
+                    RecordSink::Stdout(_) => String::from("written"),
+                    RecordSink::File(file) => format!(
+                        "in {} (the --out file is written only by a complete sweep)",
+                        file.part().display()
+                    ),
+                };
                 return Err(Incomplete(format!(
                     "the sweep of case `{}` failed at Z = {} nm after {} cycles ({error}); the \
-                     records before it are written",
+                     records before it are {kept_in}",
                     case.name,
                     sweep.z_nm(),
                     sweep.cycles_done()
@@ -323,6 +322,9 @@ pub fn run(args: &ApproachArgs) -> Result<()> {
         }
     }
     progress.finish();
+    if let RecordSink::File(file) = sink {
+        file.finish()?;
+    }
     if let Some(path) = plot_path {
         let panels = sweep_panels(&case.name, &kept);
         path.write(&render_svg(&panels, 1, 2, (640, 480))?)?;

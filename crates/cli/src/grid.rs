@@ -17,13 +17,18 @@ use serde::Serialize;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
-use crate::grid_file::{assemble, PartWriter};
+use crate::grid_file::{assemble, assemble_locked, PartWriter};
+use crate::grid_row::seal;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{output_path, ModelArgs};
 use crate::output::print_stdout;
+use crate::progress::note;
 
 /// The most rows, and the most separations per row, a grid may have.
 pub const MAX_STEPS: usize = 100_000;
+/// The most cells (rows times separations) a grid may have: at about 200 bytes a cell (300
+/// with `--retract`), a map file of 2 to 3 GB.
+pub const MAX_CELLS: usize = 10_000_000;
 /// The largest separation of a grid, nm (the sweep's bound, `afm::sweep::MAX_SEPARATION_NM`).
 const MAX_SEPARATION_NM: f64 = afm::sweep::MAX_SEPARATION_NM;
 
@@ -219,6 +224,13 @@ fn resolve(args: &GridRunArgs) -> Result<Grid> {
     if !(2..=MAX_STEPS).contains(&z_steps) {
         bail!("--z-steps {z_steps}: allowed 2..={MAX_STEPS}");
     }
+    if steps.saturating_mul(z_steps) > MAX_CELLS {
+        bail!(
+            "--steps {steps} x --z-steps {z_steps} = {} cells: allowed at most {MAX_CELLS} cells \
+             per grid (split it into several grids over parts of the --from/--to range)",
+            steps.saturating_mul(z_steps)
+        );
+    }
     if !(z_from.is_finite() && z_from <= MAX_SEPARATION_NM) {
         bail!("--z-from {z_from}: allowed up to {MAX_SEPARATION_NM} nm");
     }
@@ -311,22 +323,37 @@ fn row_line(grid: &Grid, row: usize) -> Result<String> {
         first_contact_z_nm: model.grazing_separation_nm(),
         cells,
     };
-    Ok(serde_json::to_string(&record)? + "\n")
+    Ok(seal(&serde_json::to_string(&record)?))
 }
 
-/// Compute the rows of `shard` that `part` does not hold yet into it, on `threads` threads.
+/// Compute the rows of `shard` that `part` does not hold yet into it, on `threads` threads;
+/// a resumed part says how many rows it already held. Returns the part's writer, still
+/// holding the part's lock.
 fn fill_part(
     grid: &Grid,
     header: &str,
     part: &Path,
     shard: Shard,
     threads: Option<usize>,
-) -> Result<()> {
+) -> Result<PartWriter> {
     let (writer, done) = PartWriter::open(part, header, "--output")?;
-    let rows: Vec<usize> = (shard.index..grid.parameters.len())
+    let all: Vec<usize> = (shard.index..grid.parameters.len())
         .step_by(shard.count)
+        .collect();
+    let rows: Vec<usize> = all
+        .iter()
+        .copied()
         .filter(|row| !done.contains(row))
         .collect();
+    if !done.is_empty() {
+        note(&format!(
+            "resuming: {} of {} rows already in {}, {} left to compute",
+            all.len() - rows.len(),
+            all.len(),
+            part.display(),
+            rows.len()
+        ));
+    }
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(threads) = threads {
         pool = pool.num_threads(threads);
@@ -335,7 +362,8 @@ fn fill_part(
     pool.install(|| {
         rows.par_iter()
             .try_for_each(|&row| writer.append(&row_line(grid, row)?))
-    })
+    })?;
+    Ok(writer)
 }
 
 /// `drumroll grid` without `merge`.
@@ -348,7 +376,7 @@ fn compute(args: &GridRunArgs) -> Result<()> {
     };
     match shard {
         Some(shard) => {
-            fill_part(&grid, &header, output, shard, args.threads)?;
+            drop(fill_part(&grid, &header, output, shard, args.threads)?);
             print_stdout(&format!(
                 "shard {}/{}: rows {}, {}, ... of {} in {}\n",
                 shard.index,
@@ -365,10 +393,11 @@ fn compute(args: &GridRunArgs) -> Result<()> {
             part_name.push(".part");
             let part = PathBuf::from(part_name);
             let whole = Shard { index: 0, count: 1 };
-            fill_part(&grid, &header, &part, whole, args.threads)?;
-            assemble(std::slice::from_ref(&part), &output)?;
+            let writer = fill_part(&grid, &header, &part, whole, args.threads)?;
+            assemble_locked(std::slice::from_ref(&part), &output)?;
             std::fs::remove_file(&part)
                 .with_context(|| format!("cannot remove {}", part.display()))?;
+            drop(writer);
             print_stdout(&format!(
                 "{} rows x {} separations written to {}\n",
                 grid.parameters.len(),

@@ -14,6 +14,8 @@ use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use crate::file_lock::{lock_exclusive, lock_shared};
+use crate::grid_row::GridShape;
 use crate::output::write_atomically_with;
 
 /// Where one row's line lies in a part file.
@@ -23,6 +25,8 @@ struct RowLine {
     offset: u64,
     /// Its length in bytes, the newline included.
     length: u64,
+    /// Its line number in the file, from 1.
+    number: usize,
 }
 
 /// What a part file holds: its header line, the complete row lines by row index, and the
@@ -43,16 +47,35 @@ impl PartContent {
     }
 }
 
-/// Read a part file: its header and the position of every complete row line. A last line
-/// without its newline (a run killed while writing it) is left out; any other line that is
-/// not a row object with a `row` index is an error naming the file and the line.
+/// How to recover from a damaged line `number` of the part `path`.
+fn recovery(path: &Path, number: usize) -> String {
+    format!(
+        "the other lines are intact: delete line {number} (`sed -i '{number}d' {path}`) and \
+         rerun the same command to compute that row again, or remove the file to start afresh",
+        path = path.display()
+    )
+}
+
+/// Read a part file: its header and the position of every complete row line, each checked
+/// against the header ([`GridShape::check_row`]: checksum, index, parameter value, cells). A
+/// last line without its newline (a run killed while writing it) is left out. A damaged line
+/// is an error naming the file, the line, what is wrong and how to recover; the same row twice
+/// is kept once when the lines are identical and an error naming both lines otherwise.
 pub fn read_part(path: &Path) -> Result<PartContent> {
     let file = File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    read_part_from(file, path)
+}
+
+/// [`read_part`] on an open file (read from its start).
+fn read_part_from(mut file: File, path: &Path) -> Result<PartContent> {
+    file.seek(SeekFrom::Start(0))
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let mut reader = BufReader::new(file);
     let mut line = Vec::new();
     let mut offset = 0u64;
     let mut header = None;
-    let mut rows = BTreeMap::new();
+    let mut shape = None;
+    let mut rows: BTreeMap<usize, RowLine> = BTreeMap::new();
     let mut number = 0usize;
     loop {
         line.clear();
@@ -64,31 +87,62 @@ pub fn read_part(path: &Path) -> Result<PartContent> {
             break;
         }
         number += 1;
-        let value: Value = serde_json::from_slice(&line).with_context(|| {
-            format!(
-                "{} line {number}: not a JSON object (not a drumroll grid file?)",
-                path.display()
-            )
-        })?;
-        if header.is_none() {
+        let Ok(text) = std::str::from_utf8(&line[..line.len() - 1]) else {
+            bail!(
+                "{} line {number}: not UTF-8 text (a damaged line); {}",
+                path.display(),
+                recovery(path, number)
+            );
+        };
+        let Some(grid) = &shape else {
+            let value: Value = serde_json::from_str(text).with_context(|| {
+                format!(
+                    "{} line 1: not a JSON object (not a drumroll grid file?)",
+                    path.display()
+                )
+            })?;
             if value.get("inputs").is_none() {
                 bail!(
                     "{} line 1: not a drumroll grid header (no `inputs`)",
                     path.display()
                 );
             }
-            header = Some(
-                String::from_utf8(line.clone())
-                    .with_context(|| format!("{} line 1: not UTF-8", path.display()))?,
-            );
-        } else {
-            let Some(row) = value.get("row").and_then(Value::as_u64) else {
-                bail!(
-                    "{} line {number}: not a grid row (no `row`)",
+            shape = Some(GridShape::of_header(text).map_err(|reason| {
+                anyhow::anyhow!(
+                    "{} line 1: {reason} (not a drumroll grid file?)",
                     path.display()
+                )
+            })?);
+            header = Some(format!("{text}\n"));
+            offset += length;
+            continue;
+        };
+        let row = grid.check_row(text).map_err(|reason| {
+            anyhow::anyhow!(
+                "{} line {number}: {reason}; {}",
+                path.display(),
+                recovery(path, number)
+            )
+        })?;
+        match rows.get(&row) {
+            None => {
+                rows.insert(
+                    row,
+                    RowLine {
+                        offset,
+                        length,
+                        number,
+                    },
                 );
-            };
-            rows.insert(row as usize, RowLine { offset, length });
+            }
+            Some(first) if read_line(path, *first)? == line => {}
+            Some(first) => bail!(
+                "{} lines {} and {number} both hold row {row}, with different contents; \
+                 delete one of them (`sed -i '{number}d' {}` keeps the first) and rerun",
+                path.display(),
+                first.number,
+                path.display()
+            ),
         }
         offset += length;
     }
@@ -99,7 +153,8 @@ pub fn read_part(path: &Path) -> Result<PartContent> {
     })
 }
 
-/// A part file open for appending rows, shared by the threads that compute them.
+/// A part file open for appending rows under an exclusive lock ([`lock_exclusive`]), shared by
+/// the threads that compute them.
 #[derive(Debug)]
 pub struct PartWriter {
     path: PathBuf,
@@ -107,43 +162,52 @@ pub struct PartWriter {
 }
 
 impl PartWriter {
-    /// Open `path` for the rows of a grid with `header` (newline included): a new file gets
-    /// the header; an existing one must have been made with the same header (else an error
-    /// naming `option` and the file), loses a truncated last line, and its rows are returned
-    /// as done.
+    /// Open `path` for the rows of a grid with `header` (newline included), locked against a
+    /// second writer (an error naming `option`, the file and the other process): a new file
+    /// gets the header; an existing one must have been made with the same header (else an
+    /// error naming `option` and the file), loses a truncated last line, and its rows (each
+    /// checked, [`read_part`]) are returned as done.
     pub fn open(path: &Path, header: &str, option: &str) -> Result<(Self, BTreeSet<usize>)> {
-        let (file, done) = if path.exists() {
-            let content = read_part(path)
-                .with_context(|| format!("{option} {}: cannot resume", path.display()))?;
-            if content.header.as_deref().is_some_and(|h| h != header) {
-                bail!(
-                    "{option} {}: the file holds rows of a grid with other inputs ({}); \
-                     remove it or choose another file",
-                    path.display(),
-                    header_difference(content.header.as_deref().unwrap_or_default(), header)
-                );
-            }
-            let file = OpenOptions::new()
-                .write(true)
-                .open(path)
-                .with_context(|| format!("cannot open {} to append", path.display()))?;
+        let file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(path)
+            .with_context(|| format!("{option} {}: cannot open it", path.display()))?;
+        lock_exclusive(&file, path, option)?;
+        if !same_file(&file, path) {
+            bail!(
+                "{option} {}: the file was removed or replaced while this run opened it (by \
+                 another run finishing?); run again",
+                path.display()
+            );
+        }
+        let reading = file
+            .try_clone()
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let content = read_part_from(reading, path)
+            .with_context(|| format!("{option} {}: cannot resume", path.display()))?;
+        if content.header.as_deref().is_some_and(|h| h != header) {
+            bail!(
+                "{option} {}: the file holds rows of a grid with other inputs ({}); \
+                 remove it or choose another file",
+                path.display(),
+                header_difference(content.header.as_deref().unwrap_or_default(), header)
+            );
+        }
+        let mut file = file;
+        if content.header.is_none() {
+            // New, or killed before its header was written: start the file afresh.
+            file.set_len(0)
+                .and_then(|()| file.seek(SeekFrom::Start(0)).map(|_| ()))
+                .and_then(|()| file.write_all(header.as_bytes()))
+                .and_then(|()| file.flush())
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        } else {
             file.set_len(content.complete_length)
                 .with_context(|| format!("cannot truncate {}", path.display()))?;
-            let mut file = file;
-            if content.header.is_none() {
-                // Killed before its header was written: start the file afresh.
-                file.write_all(header.as_bytes())
-                    .with_context(|| format!("cannot write {}", path.display()))?;
-            }
-            (file, content.row_indices())
-        } else {
-            let mut file = File::create(path)
-                .with_context(|| format!("{option} {}: cannot create", path.display()))?;
-            file.write_all(header.as_bytes())
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            (file, BTreeSet::new())
-        };
-        let mut file = file;
+        }
         file.seek(SeekFrom::End(0))
             .with_context(|| format!("cannot append to {}", path.display()))?;
         Ok((
@@ -151,7 +215,7 @@ impl PartWriter {
                 path: path.to_path_buf(),
                 file: Mutex::new(file),
             },
-            done,
+            content.row_indices(),
         ))
     }
 
@@ -165,6 +229,22 @@ impl PartWriter {
             .and_then(|()| file.flush())
             .with_context(|| format!("cannot write {}", self.path.display()))
     }
+}
+
+/// Whether the open `file` is still the file at `path` (not removed or replaced meanwhile).
+#[cfg(unix)]
+fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Whether the open `file` is still the file at `path`: assumed on this platform.
+#[cfg(not(unix))]
+fn same_file(_file: &File, path: &Path) -> bool {
+    path.exists()
 }
 
 /// The number of rows of the grid a header describes (`inputs.options.steps`).
@@ -182,11 +262,26 @@ pub fn row_count(header: &str, path: &Path) -> Result<usize> {
         })
 }
 
-/// Write the map file `output` (atomically) from `parts`: the header, then every row in row
-/// order, each line copied byte for byte from the part that holds it. Refuses parts whose
-/// headers differ (naming the parts and the first differing key), a row held twice with
-/// different content, and rows that no part holds (naming them).
+/// Write the map file `output` (atomically) from `parts`, each read under a shared lock (a
+/// part still being written by a shard is refused, naming its process): the header, then
+/// every row in row order, each line copied byte for byte from the part that holds it.
+/// Refuses parts whose headers differ (naming the parts and the first differing key), damaged
+/// rows ([`read_part`]), a row held twice with different content, and rows that no part holds
+/// (naming them).
 pub fn assemble(parts: &[PathBuf], output: &Path) -> Result<()> {
+    let mut locks = Vec::with_capacity(parts.len());
+    for path in parts {
+        let file = File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+        lock_shared(&file, path, "part")?;
+        locks.push(file);
+    }
+    let result = assemble_locked(parts, output);
+    drop(locks);
+    result
+}
+
+/// [`assemble`] of parts the caller holds locked (a single run's own work file).
+pub fn assemble_locked(parts: &[PathBuf], output: &Path) -> Result<()> {
     let Some(first) = parts.first() else {
         bail!("no part file given");
     };
@@ -221,12 +316,6 @@ pub fn assemble(parts: &[PathBuf], output: &Path) -> Result<()> {
     let mut holder: BTreeMap<usize, (usize, RowLine)> = BTreeMap::new();
     for (part, content) in contents.iter().enumerate() {
         for (&row, &line) in &content.rows {
-            if row >= rows {
-                bail!(
-                    "part {}: row {row} is outside the grid's {rows} rows",
-                    parts[part].display()
-                );
-            }
             match holder.get(&row) {
                 None => {
                     holder.insert(row, (part, line));
@@ -236,9 +325,13 @@ pub fn assemble(parts: &[PathBuf], output: &Path) -> Result<()> {
                     let b = read_line(&parts[part], line)?;
                     if a != b {
                         bail!(
-                            "row {row} differs between parts {} and {}",
+                            "row {row} differs between parts {} (line {}) and {} (line {}); \
+                             delete it from one of them (or remove that part and rerun its \
+                             shard)",
                             parts[other].display(),
-                            parts[part].display()
+                            other_line.number,
+                            parts[part].display(),
+                            line.number
                         );
                     }
                 }
@@ -248,10 +341,11 @@ pub fn assemble(parts: &[PathBuf], output: &Path) -> Result<()> {
     let missing: Vec<usize> = (0..rows).filter(|row| !holder.contains_key(row)).collect();
     if !missing.is_empty() {
         bail!(
-            "rows missing from the parts: {} ({} of the grid's {rows} rows; rerun the shards \
-             that hold them, which resume where they stopped)",
+            "rows missing from the parts: {} ({} of the grid's {rows} rows, in none of {}; rerun \
+             the shards that hold them, which resume where they stopped)",
             list_rows(&missing),
-            missing.len()
+            missing.len(),
+            list_parts(parts)
         );
     }
     write_atomically_with(output, |writer| {
@@ -272,6 +366,20 @@ fn read_line(path: &Path, line: RowLine) -> Result<Vec<u8>> {
     file.read_exact(&mut bytes)
         .with_context(|| format!("cannot read {} (changed while merging?)", path.display()))?;
     Ok(bytes)
+}
+
+/// Part file names as a short list: the first 5, then how many more.
+fn list_parts(parts: &[PathBuf]) -> String {
+    let shown: Vec<String> = parts
+        .iter()
+        .take(5)
+        .map(|part| part.display().to_string())
+        .collect();
+    let mut text = shown.join(", ");
+    if parts.len() > 5 {
+        text.push_str(&format!(", ... ({} more)", parts.len() - 5));
+    }
+    text
 }
 
 /// Row indices as a short list: the first 20, then how many more.

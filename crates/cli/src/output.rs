@@ -23,6 +23,7 @@ pub fn check_writable(path: &Path, option: &str) -> Result<()> {
     probe_name.push(file_name);
     probe_name.push(format!(".{}.probe", std::process::id()));
     let probe = path.with_file_name(probe_name);
+    remove_stale_temporaries(path);
     match std::fs::OpenOptions::new()
         .write(true)
         .create_new(true)
@@ -58,7 +59,10 @@ pub fn print_stdout(text: &str) -> Result<()> {
 
 /// Write `content` to `path` atomically: into `path` + a temporary suffix in the same
 /// directory, flushed and synced, then renamed to `path`. On any error the temporary file is
-/// removed and the target is left as it was.
+/// removed and the target is left as it was. Every output file of every command is written by
+/// this function (or [`write_atomically_with`], or streamed by [`StreamedFile`]); two
+/// commands writing the same path leave one complete file, and a killed one the old file or
+/// none.
 pub fn write_atomically(path: &Path, content: &[u8]) -> Result<()> {
     write_atomically_with(path, |writer| {
         writer.write_all(content)?;
@@ -79,6 +83,7 @@ pub fn write_atomically_with(
     let mut temporary_name = file_name.to_os_string();
     temporary_name.push(format!(".{}.partial", std::process::id()));
     let temporary = path.with_file_name(temporary_name);
+    remove_stale_temporaries(path);
     let result = (|| -> Result<()> {
         let file = std::fs::File::create(&temporary)?;
         let mut writer = BufWriter::new(file);
@@ -95,6 +100,49 @@ pub fn write_atomically_with(
     result
 }
 
+/// Remove the temporary files `<path>.<PID>.partial` (and the probes `.<name>.<PID>.probe` of
+/// [`check_writable`]) that killed runs left beside `path` (Linux: those whose process no
+/// longer runs, `/proc/<PID>` absent); elsewhere nothing.
+fn remove_stale_temporaries(path: &Path) {
+    if !cfg!(target_os = "linux") || !Path::new("/proc/self").exists() {
+        return;
+    }
+    let (Some(name), Some(directory)) = (path.file_name(), path.parent()) else {
+        return;
+    };
+    let directory = if directory.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        directory
+    };
+    let mut prefix = name.to_os_string();
+    prefix.push(".");
+    let Some(prefix) = prefix.to_str().map(str::to_owned) else {
+        return;
+    };
+    let Ok(entries) = std::fs::read_dir(directory) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(pid) = file_name.to_str().and_then(|n| {
+            n.strip_prefix(prefix.as_str())
+                .and_then(|rest| rest.strip_suffix(".partial"))
+                .or_else(|| {
+                    n.strip_prefix('.')
+                        .and_then(|n| n.strip_prefix(prefix.as_str()))
+                        .and_then(|rest| rest.strip_suffix(".probe"))
+                })
+                .and_then(|pid| pid.parse::<u32>().ok())
+        }) else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
 /// Append one CSV row to `text`: `first` (the row's label column), then the value of each of
 /// `columns` as a key of the JSON object `value` (numbers and strings as JSON prints them, empty
 /// for `null`), and a newline. The CSV columns are thus the JSON keys (docs/output-schema.md).
@@ -108,4 +156,61 @@ pub fn push_csv_row(text: &mut String, first: &str, value: &serde_json::Value, c
         }
     }
     text.push('\n');
+}
+
+/// An output file written while it is computed (an approach sweep's `--out`): the lines go to
+/// `<path>.part`, held under an exclusive lock ([`crate::file_lock::lock_exclusive`]) so that
+/// a second run on the same path refuses at once, and [`StreamedFile::finish`] renames it to
+/// `path`. A killed run thus leaves the old `path` (or none) and a `.part` file, which the
+/// next run on the same path starts afresh.
+#[derive(Debug)]
+pub struct StreamedFile {
+    file: std::fs::File,
+    part: std::path::PathBuf,
+    path: std::path::PathBuf,
+}
+
+impl StreamedFile {
+    /// Open `<path>.part` (the value of `option`), locked and emptied.
+    pub fn create(path: &Path, option: &str) -> Result<Self> {
+        let mut part_name = path.as_os_str().to_os_string();
+        part_name.push(".part");
+        let part = std::path::PathBuf::from(part_name);
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&part)
+            .with_context(|| format!("{option} {}: cannot create it", part.display()))?;
+        crate::file_lock::lock_exclusive(&file, &part, option)?;
+        file.set_len(0)
+            .with_context(|| format!("cannot write {}", part.display()))?;
+        Ok(Self {
+            file,
+            part,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// The `.part` file the lines go to until [`StreamedFile::finish`].
+    pub fn part(&self) -> &Path {
+        &self.part
+    }
+
+    /// Append `line` (newline included) in one write, flushed to the file.
+    pub fn write_line(&mut self, line: &str) -> Result<()> {
+        self.file
+            .write_all(line.as_bytes())
+            .and_then(|()| self.file.flush())
+            .with_context(|| format!("cannot write {}", self.part.display()))
+    }
+
+    /// Sync the `.part` file and rename it to the output path (the lock goes with the file
+    /// and is released when `self` is dropped).
+    pub fn finish(self) -> Result<()> {
+        self.file
+            .sync_all()
+            .and_then(|()| std::fs::rename(&self.part, &self.path))
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
 }

@@ -237,12 +237,14 @@ fn bad_options_are_refused_with_the_option_named() {
     }
 }
 
-/// A run killed mid-sweep leaves a file of complete records: every line whole (one write per
-/// record), the header first, rows in order.
+/// A run killed mid-sweep leaves no `--out` file, and its records so far in `--out` + `.part`
+/// (docs/guide/concurrency.md): every line whole (one write per record), the header first,
+/// rows in order.
 #[test]
 fn a_killed_run_leaves_only_complete_records() {
     let directory = tempfile::tempdir().expect("temporary directory");
     let out = directory.path().join("killed.csv");
+    let streamed = directory.path().join("killed.csv.part");
     // 11 nm -> 0 at 1 nm/s: ~100,000 cycles, far more than runs before the kill.
     let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("drumroll"))
         .args(["approach", "--from", "11", "--to", "0", "--out"])
@@ -253,13 +255,18 @@ fn a_killed_run_leaves_only_complete_records() {
     // Wait until some records are there, then kill the process (SIGKILL: no clean-up).
     let start = std::time::Instant::now();
     // (Rows of about 250 bytes with the four harmonics.)
-    while std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0) < 60_000 {
+    while std::fs::metadata(&streamed).map(|m| m.len()).unwrap_or(0) < 60_000 {
         assert!(start.elapsed().as_secs() < 60, "no records within a minute");
+        assert!(
+            child.try_wait().expect("status").is_none(),
+            "finished before the kill"
+        );
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     child.kill().expect("killed");
     child.wait().expect("reaped");
-    let text = std::fs::read_to_string(&out).expect("records file");
+    assert!(!out.exists(), "a killed sweep writes no --out file");
+    let text = std::fs::read_to_string(&streamed).expect("records file");
     assert!(text.ends_with('\n'), "the last record is complete");
     let mut lines = text.lines();
     assert_eq!(

@@ -6,6 +6,18 @@
 //! every rejection must name the file or option, the field and the allowed range (or the
 //! expected type or fields).
 //!
+//! Sizes a file sets are drawn past their limits: a cantilever file has up to 60 modes
+//! (`afm::MAX_MODES` is 50; a model of more than [`MAX_ORBIT_MODES`] modes is built and checked
+//! but not integrated, so that an input stays quick). Files may start with a UTF-8 byte-order
+//! mark, and a case file's references may be `.` or a name that is no file.
+//!
+//! To cover a new input file (a scan line file, a measurement CSV, a new contact law's sample
+//! object): add a generator beside [`cantilever_text`] (clean values near typical ones, and
+//! when not clean the malformed, extreme and wrong-typed values of [`json_number`] and
+//! [`json_name`]), a field of [`Input`] for it, write it in [`run_one`] next to `lever.json`,
+//! and push it through the command's own parsing and checks there, with [`check_rejection`]
+//! on every refusal.
+//!
 //! `cargo test --release -p drumroll --test fuzz_inputs` runs [`DEFAULT_CASES`] inputs;
 //! `DRUMROLL_FUZZ_CASES=100000 cargo test --release -p drumroll --test fuzz_inputs -- --nocapture`
 //! is the long run (it prints the count, the rejections and the slowest input).
@@ -24,6 +36,9 @@ const DEFAULT_CASES: u32 = 2000;
 /// The longest one input may take, steady orbit and continuation included: a hang shows
 /// as a failure. The caps below keep a capped run well under it.
 const MAX_TIME_PER_INPUT: Duration = Duration::from_secs(10);
+
+/// The most modes a generated model is integrated with (more: built and checked only).
+const MAX_ORBIT_MODES: usize = 4;
 
 /// `drumroll simulate`'s options, parsed as the binary parses them.
 #[derive(Debug, Parser)]
@@ -105,11 +120,15 @@ fn object(fields: Vec<(&'static str, Option<String>)>, extra: bool) -> String {
     format!("{{{}}}", members.join(", "))
 }
 
-/// Damage a file's text: cut it short or put a stray character in it.
+/// Damage a file's text: cut it short, put a stray character in it, or (accepted) start it
+/// with a UTF-8 byte-order mark.
 fn corrupt(text: String, damage: Option<(u8, usize)>) -> String {
     let Some((kind, at)) = damage else {
         return text;
     };
+    if kind % 7 == 6 {
+        return format!("\u{feff}{text}");
+    }
     let at = at % (text.len() + 1);
     let at = (0..=at)
         .rev()
@@ -122,7 +141,25 @@ fn corrupt(text: String, damage: Option<(u8, usize)>) -> String {
     }
 }
 
-/// A cantilever file's text: up to four modes near the Biolever's and beyond.
+/// `count` valid modes: `f_n = 9.3 n^2` kHz, `k_n = 0.036 n^4` N/m (above the typical range
+/// from mode 13 on), ratios 1.
+fn many_modes(count: usize) -> String {
+    (1..=count)
+        .map(|n| {
+            let n = n as f64;
+            format!(
+                "{{\"stiffness_n_per_m\": {}, \"frequency_khz\": {}, \"quality_factor\": 1.2, \
+                 \"optical_sensitivity\": 1, \"force_ratio\": 1}}",
+                0.036 * n.powi(4),
+                9.3 * n * n
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A cantilever file's text: up to four modes near the Biolever's and beyond, or (rarely)
+/// 5 to 60 valid modes, past the limit of 50.
 fn cantilever_text(clean: bool) -> BoxedStrategy<String> {
     let typical_modes = [
         (0.036, 9.3, 1.2, 1.0, 1.0),
@@ -173,10 +210,14 @@ fn cantilever_text(clean: bool) -> BoxedStrategy<String> {
         json_number(0.3, clean),
         json_name(vec!["lever"], clean),
         any::<bool>(),
+        prop::option::weighted(0.05, 5usize..=60),
     )
         .prop_map(
-            move |(count, m0, m1, m2, m3, radius, mass, modulus, poisson, name, extra)| {
-                let modes = [m0, m1, m2, m3][..count].join(", ");
+            move |(count, m0, m1, m2, m3, radius, mass, modulus, poisson, name, extra, many)| {
+                let modes = match many {
+                    Some(many) => many_modes(many),
+                    None => [m0, m1, m2, m3][..count].join(", "),
+                };
                 object(
                     vec![
                         ("name", name),
@@ -218,7 +259,14 @@ fn sample_text(clean: bool) -> BoxedStrategy<String> {
 fn case_text(clean: bool) -> BoxedStrategy<String> {
     (
         json_name(
-            vec!["lever.json", "biolever", "maclever", "missing.json"],
+            vec![
+                "lever.json",
+                "biolever",
+                "maclever",
+                "missing.json",
+                ".",
+                "lever",
+            ],
             clean,
         ),
         json_name(
@@ -345,6 +393,7 @@ struct Tally {
     orbits: u64,
     orbit_failures: u64,
     diagrams: u64,
+    many_modes: u64,
     slowest: Duration,
 }
 
@@ -518,6 +567,15 @@ fn run_one(input: &Input, dir: &Path, tally: &mut Tally) -> Result<(), TestCaseE
         }
     };
     tally.models += 1;
+    if model.mode_count() > MAX_ORBIT_MODES {
+        tally.many_modes += 1;
+        prop_assert!(
+            model.mode_count() <= afm::MAX_MODES,
+            "{} modes",
+            model.mode_count()
+        );
+        return Ok(());
+    }
     let settings = capped_orbit_settings();
     if let Some(z) = simulate.z {
         let allowed = drumroll::option_ranges::separation_for(model.free_amplitude_nm()).check(z);
@@ -619,12 +677,14 @@ fn generated_inputs_never_panic_hang_or_leave_files_and_every_rejection_is_named
     let tally = tally.into_inner();
     println!(
         "fuzz_inputs: {} inputs in {:.1} s: {} refused by clap, {} refused by the checks, {} \
-         models, {} orbits ({} failed within the caps), {} diagrams; slowest input {:?}",
+         models ({} of more than {MAX_ORBIT_MODES} modes, not integrated), {} orbits ({} failed \
+         within the caps), {} diagrams; slowest input {:?}",
         tally.inputs,
         started.elapsed().as_secs_f64(),
         tally.refused_by_clap,
         tally.refused,
         tally.models,
+        tally.many_modes,
         tally.orbits,
         tally.orbit_failures,
         tally.diagrams,

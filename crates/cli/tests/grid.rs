@@ -3,7 +3,7 @@
 //! bad options are refused by name, and the regime boundaries agree with `continue`.
 
 mod common;
-use common::{drumroll, json_of, number};
+use common::{drumroll, json_of, number, reseal};
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -133,7 +133,7 @@ fn a_killed_shard_resumes_where_it_stopped() {
 
     // A kill: the last row line cut in half, and a row (row 0 of the kept ones) marked so that
     // its recomputation would show.
-    let kept_row = lines[1].replacen("\"cells\"", "\"kept\":true,\"cells\"", 1);
+    let kept_row = reseal(&lines[1].replacen("\"cells\"", "\"kept\":true,\"cells\"", 1));
     let cut = &lines[4][..lines[4].len() / 2];
     let killed = format!("{}{}{}{}{}", lines[0], kept_row, lines[2], lines[3], cut);
     std::fs::write(&part, &killed).expect("truncate");

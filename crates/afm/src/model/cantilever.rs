@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::AfmError;
 use crate::model::eigenmode::Eigenmode;
-use crate::validation::{check_all, check_name, invalid, ranges, warnings_of, NumericField};
+use crate::validation::{check_all, check_name, gathered_warnings, invalid, ranges, NumericField};
 
 /// The tip's Young's modulus the paper uses, GPa (its note 15).
 pub const DEFAULT_TIP_YOUNGS_MODULUS_GPA: f64 = 130.0;
@@ -18,6 +18,12 @@ fn default_tip_youngs_modulus() -> f64 {
 fn default_poisson_ratio() -> f64 {
     DEFAULT_POISSON_RATIO
 }
+
+/// The most eigenmodes a cantilever may have (MODEL.md section 6): the cost of an orbit grows
+/// steeply with `N` (100 modes: about 30 s for one `simulate`; 1000: minutes and 830 MB), and
+/// as many as
+/// `drumroll cantilever` tabulates (`beam::MAX_MODES`).
+pub const MAX_MODES: usize = 50;
 
 /// A cantilever with a spherical tip and N eigenmodes (MODEL.md sections 1 and 6).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -57,6 +63,17 @@ impl Cantilever {
                 field: "modes".to_string(),
                 value: "[]".to_string(),
                 allowed: "at least one eigenmode".to_string(),
+            });
+        }
+        if self.modes.len() > MAX_MODES {
+            return Err(AfmError::InvalidField {
+                file: file.to_string(),
+                field: "modes".to_string(),
+                value: format!("a list of {} modes", self.modes.len()),
+                allowed: format!(
+                    "1 to {MAX_MODES} eigenmodes (the cost of an orbit grows steeply with N: \
+                     100 modes take about 30 s for one orbit, 1000 minutes and 830 MB)"
+                ),
             });
         }
         for (index, mode) in self.modes.iter().enumerate() {
@@ -107,12 +124,14 @@ impl Cantilever {
 
     /// The plausibility warnings of every field (valid values outside the range typical of
     /// AFM, with the likely unit mistake), naming `file` and the field.
+    /// Warnings of one kind (the same field of several modes) are gathered into one line with
+    /// their count and range of values.
     pub fn warnings(&self, file: &str) -> Vec<String> {
-        let mut warnings = warnings_of(file, &self.numeric_fields());
+        let mut fields = self.numeric_fields();
         for (index, mode) in self.modes.iter().enumerate() {
-            warnings.extend(mode.warnings(file, index));
+            fields.extend(mode.numeric_fields(index));
         }
-        warnings
+        gathered_warnings(file, &fields)
     }
 
     /// The drive frequencies the model accepts for this cantilever, kHz: from `f_1 / 100` (far
