@@ -5,7 +5,7 @@
 pub mod ideal;
 pub mod line;
 pub mod materials;
-
+pub mod pi;
 pub mod pixel;
 pub mod setpoint_branch;
 pub mod settings;

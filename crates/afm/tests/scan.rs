@@ -1,0 +1,177 @@
+//! The scans of MODEL.md section 12 against independent references: the direct amplitude-ratio
+//! solve (`find_amplitude_ratio`, its own approach branch and Illinois refinement) at the
+//! setpoint on each material, and the exact geometry of heights.
+
+use afm::scan::ideal::ideal_scan;
+use afm::scan::line::ScanLine;
+use afm::scan::pi::{pi_scan, PiSettings};
+use afm::scan::pixel::ScanDirection;
+use afm::scan::settings::{ScanDirections, ScanSettings};
+use afm::{builtin_case, find_amplitude_ratio, AmplitudeRatioSearch, SteadyOrbitSettings, TappingModel};
+
+/// The paper's experiment: MAClever in water at 3.3 kHz, A0 = 20 nm.
+const CASE: &str = "maclever-membrane-experiment";
+const SETPOINT: f64 = 0.8;
+
+fn line(text: &str) -> ScanLine {
+    ScanLine::parse("test line", text, None).expect("a valid line")
+}
+
+/// `Z` at the setpoint on `sample` by the direct solve.
+fn setpoint_z(sample: &str) -> f64 {
+    let mut case = builtin_case(CASE).unwrap();
+    case.sample = afm::builtin_sample(sample).unwrap();
+    let model = TappingModel::from_case(&case).unwrap();
+    let search = AmplitudeRatioSearch::new(SETPOINT).unwrap();
+    find_amplitude_ratio(&model, &search, &SteadyOrbitSettings::default())
+        .unwrap()
+        .z_nm
+}
+
+#[test]
+fn uniform_sample_with_a_step_reads_the_orbit_at_the_setpoint_and_the_step() {
+    // One material, a 4 nm step at x = 50 nm (sharp): Z is that of the setpoint orbit on every
+    // pixel (the direct solve, to its 1e-9 nm tolerance), and the measured height is h.
+    let line = line(
+        r#"{"segments": [
+            {"from_nm": 0, "to_nm": 50, "height_nm": 0, "sample": "mica"},
+            {"from_nm": 50, "to_nm": 100, "height_nm": 4, "sample": "mica"}]}"#,
+    );
+    let case = builtin_case(CASE).unwrap();
+    let settings = ScanSettings {
+        directions: ScanDirections::Both,
+        ..ScanSettings::new(SETPOINT, 8)
+    };
+    let pixels = ideal_scan(&case, &line, &settings).unwrap();
+    assert_eq!(pixels.len(), 16);
+    let z = setpoint_z("mica");
+    for pixel in &pixels {
+        assert!((pixel.z_nm - z).abs() < 2e-9, "Z {} vs {z}", pixel.z_nm);
+        assert!((pixel.amplitude_ratio - SETPOINT).abs() < 1e-6);
+        let h = if pixel.x_nm < 50.0 { 0.0 } else { 4.0 };
+        assert_eq!(pixel.height_true_nm, h);
+        assert!((pixel.height_nm - h).abs() < 1e-9, "{pixel:?}");
+        assert!(pixel.jump.is_none());
+        assert_eq!(pixel.stable, Some(true));
+    }
+    assert!(pixels[..8].iter().all(|p| p.direction == ScanDirection::Trace));
+    assert!(pixels[8..].iter().all(|p| p.direction == ScanDirection::Retrace));
+}
+
+#[test]
+fn two_materials_at_equal_height_read_the_difference_of_their_setpoint_separations() {
+    let line = line(
+        r#"{"segments": [
+            {"from_nm": 0, "to_nm": 50, "height_nm": 0, "sample": "mica"},
+            {"from_nm": 50, "to_nm": 100, "height_nm": 0, "sample": "purple-membrane-film"}]}"#,
+    );
+    let case = builtin_case(CASE).unwrap();
+    let pixels = ideal_scan(&case, &line, &ScanSettings::new(SETPOINT, 4)).unwrap();
+    let (z_mica, z_film) = (setpoint_z("mica"), setpoint_z("purple-membrane-film"));
+    // Both refined to 1e-9 nm in Z: the difference to 2e-9 nm plus rounding.
+    for pixel in &pixels[2..] {
+        assert!(
+            (pixel.height_nm - (z_film - z_mica)).abs() < 3e-9,
+            "{} vs {}",
+            pixel.height_nm,
+            z_film - z_mica
+        );
+        assert_eq!(pixel.sample, "purple-membrane-film");
+    }
+    assert!(pixels[0].height_nm.abs() < 1e-12);
+}
+
+#[test]
+fn edge_width_ramps_the_true_height_linearly() {
+    let line = line(
+        r#"{"edge_width_nm": 10, "segments": [
+            {"from_nm": 0, "to_nm": 50, "height_nm": 0, "sample": "mica"},
+            {"from_nm": 50, "to_nm": 100, "height_nm": 6, "sample": "soft"}]}"#,
+    );
+    // Exact: a line from (45, 0) to (55, 6).
+    for (x, h) in [(40.0, 0.0), (45.0, 0.0), (47.5, 1.5), (50.0, 3.0), (54.0, 5.4), (55.0, 6.0), (90.0, 6.0)] {
+        assert!((line.height_at(x) - h).abs() < 1e-12, "h({x}) = {}", line.height_at(x));
+    }
+    assert_eq!(line.materials[line.material_at(49.9)].name, "mica");
+    assert_eq!(line.materials[line.material_at(50.0)].name, "soft");
+}
+
+#[test]
+fn bad_line_files_name_the_field_and_the_range() {
+    let cases = [
+        (r#"{"segments": []}"#, "segments"),
+        (
+            r#"{"segments": [{"from_nm": 0, "to_nm": -1, "height_nm": 0, "sample": "mica"}]}"#,
+            "segments[0].to_nm",
+        ),
+        (
+            r#"{"segments": [{"from_nm": 0, "to_nm": 10, "height_nm": 0, "sample": "mica"},
+                              {"from_nm": 12, "to_nm": 20, "height_nm": 0, "sample": "mica"}]}"#,
+            "segments[1].from_nm",
+        ),
+        (
+            r#"{"segments": [{"from_nm": 0, "to_nm": 10, "height_nm": 0, "sample": "glass"}]}"#,
+            "segments[0].sample",
+        ),
+        (
+            r#"{"edge_width_nm": 20, "segments": [{"from_nm": 0, "to_nm": 10, "height_nm": 0, "sample": "mica"}]}"#,
+            "edge_width_nm",
+        ),
+        (
+            r#"{"segments": [{"from_nm": 0, "to_nm": 10, "height_nm": 1e9, "sample": "mica"}]}"#,
+            "segments[0].height_nm",
+        ),
+        (
+            r#"{"segments": [{"from_nm": 0, "to_nm": 10, "height": 0, "sample": "mica"}]}"#,
+            "segments[0]",
+        ),
+        (
+            r#"{"segments": [{"from_nm": 0, "to_nm": 10, "height_nm": 0,
+                "sample": {"name": "x", "youngs_modulus_gpa": -3}}]}"#,
+            "youngs_modulus_gpa",
+        ),
+        (
+            r#"{"segments": [{"from_nm": 0, "to_nm": 10, "height_nm": 0, "sample": "missing.json"}]}"#,
+            "cannot read",
+        ),
+    ];
+    for (text, field) in cases {
+        let error = ScanLine::parse("bad.json", text, None).unwrap_err().to_string();
+        assert!(error.contains("bad.json"), "{error}");
+        assert!(error.contains(field), "{field}: {error}");
+    }
+}
+
+#[test]
+fn the_builtin_line_is_the_paper_setting() {
+    let line = ScanLine::builtin("membrane-patch").unwrap();
+    assert_eq!(line.materials.len(), 2);
+    assert_eq!(line.height_at(200.0), 6.0);
+    assert_eq!(line.materials[line.material_at(200.0)].name, "purple-membrane-film");
+    assert!(ScanLine::find("no-such-line").unwrap_err().to_string().contains("membrane-patch"));
+}
+
+#[test]
+fn a_slow_pi_scan_converges_to_the_ideal_feedback() {
+    // The paper's line: mica, a 6 nm film patch, mica; 16 pixels of 25 nm, ~40 drive cycles
+    // each. Away from the edges (the pixels holding a ramp or a change of material and the
+    // one after it) the loop has settled: Z within 0.05 nm of the ideal feedback's.
+    let line = ScanLine::builtin("membrane-patch").unwrap();
+    let case = builtin_case(CASE).unwrap();
+    let settings = ScanSettings::new(SETPOINT, 16);
+    let mut pi = PiSettings::for_case(&case).unwrap();
+    pi.scan_rate_nm_per_s = 2000.0;
+    let ideal = ideal_scan(&case, &line, &settings).unwrap();
+    let timed = pi_scan(&case, &line, &settings, &pi).unwrap();
+    assert_eq!(timed.len(), 16);
+    for (a, b) in ideal.iter().zip(&timed) {
+        assert_eq!(a.index, b.index);
+        let near_edge = [100.0, 300.0]
+            .iter()
+            .any(|edge| (a.x_nm - edge).abs() < 2.0 * 25.0);
+        if !near_edge {
+            assert!((a.z_nm - b.z_nm).abs() < 0.05, "x = {}: {} vs {}", a.x_nm, a.z_nm, b.z_nm);
+            assert!((b.amplitude_ratio - SETPOINT).abs() < 0.01);
+        }
+    }
+}
