@@ -21,6 +21,8 @@ pub mod option_ranges;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod scan;
+pub mod scan_plot;
 pub mod shell;
 pub mod simulate;
 pub mod theory;
