@@ -254,8 +254,9 @@ pub fn line_json(line: &ScanLine) -> Value {
             "from_nm": s.from_nm,
             "to_nm": s.to_nm,
             "height_nm": s.height_nm,
-            "sample": line.materials[s.material],
+            "sample": line.materials[s.material].name,
         })).collect::<Vec<_>>(),
+        "materials": line.materials,
     })
 }
 

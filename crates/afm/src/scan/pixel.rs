@@ -84,7 +84,9 @@ pub struct ScanPixel {
     pub multiplicity: usize,
     /// Whether the orbit attracts (`None` for a time-domain scan).
     pub stable: Option<bool>,
-    /// The jump the feedback made on the way to this pixel, if any.
+    /// The jump the feedback made on the way to this pixel, if any (not serialised: the
+    /// command line writes `jumped` and `jump_from_z_nm`).
+    #[serde(skip)]
     pub jump: Option<BranchJump>,
 }
 
