@@ -311,3 +311,42 @@ fn a_fast_pi_scan_off_a_step_tracks_as_a_brute_force_loop_does() {
     let after_step = scanned.iter().find(|p| p.x_nm > 20.0).unwrap();
     assert!(after_step.height_error_nm > 1.0, "{after_step:?}");
 }
+
+#[test]
+fn engaging_past_the_fold_near_first_contact_is_marked_as_a_jump() {
+    // The MAClever on mica is bistable just below first contact: its approach branch folds
+    // back at Z = 19.99584 nm (A/A0 = 0.999834) and forward again at 19.99820 nm (0.998662).
+    // A setpoint of 0.998 lies only on the lower stable part: engaging from above, the
+    // feedback walks down the upper part to its fold and jumps. The fold as located by the
+    // diagram's special-point search (a bisection on its test function, independent of the
+    // branch points the walk uses) bounds where the jump starts: within one branch step.
+    // Back from the film, the cantilever lands on the lower part directly: no jump. A
+    // setpoint inside the gap between the folds' A/A0 (0.9992) has no stable orbit: the scan
+    // stops with an error that says so.
+    let case = builtin_case("maclever-mica").unwrap();
+    let model = TappingModel::from_case(&case).unwrap();
+    let diagram = afm::approach_diagram(&model, &afm::DiagramSettings::approach(&model)).unwrap();
+    let fold = diagram
+        .special_points
+        .iter()
+        .find(|p| p.label == "fold")
+        .expect("the first fold")
+        .z_nm;
+    let step = model.free_amplitude_nm() / 250.0;
+    let line = line(
+        r#"{"segments": [
+            {"from_nm": 0, "to_nm": 20, "height_nm": 0, "sample": "mica"},
+            {"from_nm": 20, "to_nm": 40, "height_nm": 0, "sample": "purple-membrane-film"},
+            {"from_nm": 40, "to_nm": 60, "height_nm": 0, "sample": "mica"}]}"#,
+    );
+    let pixels = ideal_scan(&case, &line, &ScanSettings::new(0.998, 3)).unwrap();
+    let jump = pixels[0].jump.expect("the engagement jumps at the fold");
+    assert!(jump.from_z_nm >= fold && jump.from_z_nm - fold < step, "{jump:?} vs {fold}");
+    assert!(jump.from_amplitude_ratio > 0.998);
+    assert!((pixels[0].amplitude_ratio - 0.998).abs() < 1e-6);
+    assert!(pixels[1].jump.is_none() && pixels[2].jump.is_none());
+    assert!((pixels[2].z_nm - pixels[0].z_nm).abs() < 2e-9);
+
+    let error = ideal_scan(&case, &line, &ScanSettings::new(0.9992, 3)).unwrap_err().to_string();
+    assert!(error.contains("jumped") && error.contains("mica"), "{error}");
+}
