@@ -135,7 +135,7 @@ pub struct ScanArgs {
 impl ScanArgs {
     /// The case: `--case` (default maclever-membrane-experiment) or `--cantilever` with
     /// `--a0`, overrides applied; its sample is the line's first material.
-    fn case(&self, line: &ScanLine) -> Result<Case> {
+    pub fn case(&self, line: &ScanLine) -> Result<Case> {
         if let Some(a0) = self.a0 {
             option_ranges::A0.check(a0)?;
         }
@@ -173,7 +173,7 @@ impl ScanArgs {
     }
 
     /// The scan settings, every option checked.
-    fn settings(&self) -> Result<ScanSettings> {
+    pub fn settings(&self) -> Result<ScanSettings> {
         OptionRange::new(
             "--setpoint",
             Interval {
@@ -200,7 +200,7 @@ impl ScanArgs {
     }
 
     /// The PI settings for `case`, every option checked.
-    fn pi(&self, case: &Case) -> Result<PiSettings> {
+    pub fn pi(&self, case: &Case) -> Result<PiSettings> {
         OptionRange::new("--gain-p", Interval::closed(0.0, 100.0, "nm/nm")).check(self.gain_p)?;
         OptionRange::new("--gain-i", Interval::closed(0.0, 1e4, "1/ms")).check(self.gain_i)?;
         OptionRange::new("--scan-rate", Interval::positive(1e9, "nm/s")).check(self.scan_rate)?;
@@ -260,35 +260,27 @@ pub fn line_json(line: &ScanLine) -> Value {
     })
 }
 
-/// Run `drumroll scan`.
-pub fn run(args: &ScanArgs) -> Result<()> {
-    let plot_path = args
-        .plot
-        .as_ref()
-        .map(|p| FigureFile::new(p, "--plot"))
-        .transpose()?;
-    if let Some(path) = &args.out {
-        check_writable(path, "--out")?;
-    }
-    let line = ScanLine::find(&args.line).with_context(|| format!("--line {}", args.line))?;
-    let case = args.case(&line)?;
-    let settings = args.settings()?;
-    let model = TappingModel::from_case(&case)?;
-    let total = (settings.pixels * settings.directions.passes().len()) as u64;
-    let mut progress = Progress::new(total, "{wide_bar} {human_pos}/{human_len} pixels, {eta} left");
-    let mut tick = |done: usize| {
-        progress.update(done as u64, String::new);
-        false
-    };
+/// The pixels of the scan of `line` with the cantilever, drive and A0 of `case`, `settings`
+/// and the PI options of `args`, and the `inputs` object of the output; `progress` is told
+/// the pixels done after each and stops the scan by answering `true`. Shared with the Python
+/// module's `Case.scan`.
+pub fn scan_pixels(
+    args: &ScanArgs,
+    case: &Case,
+    line: &ScanLine,
+    settings: &ScanSettings,
+    progress: &mut dyn FnMut(usize) -> bool,
+) -> Result<(Vec<ScanPixel>, Value)> {
+    let model = TappingModel::from_case(case)?;
     let (pixels, integration, feedback_options) = match args.feedback {
         Feedback::Ideal => (
-            ideal_scan_until(&case, &line, &settings, &mut tick)?,
+            ideal_scan_until(case, line, settings, progress)?,
             settings.orbit.integration.clone(),
             json!({ "feedback": "ideal" }),
         ),
         Feedback::Pi => {
-            let pi = args.pi(&case)?;
-            let pixels = pi_scan_until(&case, &line, &settings, &pi, &mut tick)?;
+            let pi = args.pi(case)?;
+            let pixels = pi_scan_until(case, line, settings, &pi, progress)?;
             (
                 pixels,
                 pi.integration.clone(),
@@ -302,7 +294,6 @@ pub fn run(args: &ScanArgs) -> Result<()> {
             )
         }
     };
-    progress.finish();
     let mut options = json!({
         "line": args.line,
         "setpoint": settings.setpoint,
@@ -315,7 +306,30 @@ pub fn run(args: &ScanArgs) -> Result<()> {
     }
     let mut orbit_settings = settings.orbit.clone();
     orbit_settings.integration = integration;
-    let inputs = orbit_inputs_json("scan", options, &case, &model, &orbit_settings);
+    let inputs = orbit_inputs_json("scan", options, case, &model, &orbit_settings);
+    Ok((pixels, inputs))
+}
+
+/// Run `drumroll scan`.
+pub fn run(args: &ScanArgs) -> Result<()> {
+    let plot_path = args
+        .plot
+        .as_ref()
+        .map(|p| FigureFile::new(p, "--plot"))
+        .transpose()?;
+    if let Some(path) = &args.out {
+        check_writable(path, "--out")?;
+    }
+    let line = ScanLine::find(&args.line).with_context(|| format!("--line {}", args.line))?;
+    let case = args.case(&line)?;
+    let settings = args.settings()?;
+    let total = (settings.pixels * settings.directions.passes().len()) as u64;
+    let mut progress = Progress::new(total, "{wide_bar} {human_pos}/{human_len} pixels, {eta} left");
+    let (pixels, inputs) = scan_pixels(args, &case, &line, &settings, &mut |done| {
+        progress.update(done as u64, String::new);
+        false
+    })?;
+    progress.finish();
     let text = if args.json {
         let value = json!({
             "inputs": inputs,
