@@ -22,6 +22,7 @@ pub mod output;
 pub mod plot;
 pub mod progress;
 pub mod scan;
+pub mod scan_image;
 pub mod scan_plot;
 pub mod shell;
 pub mod simulate;

@@ -7,6 +7,7 @@ use afm::scan::ideal::ideal_scan_until;
 use afm::scan::line::ScanLine;
 use afm::scan::pi::{pi_scan_until, PiSettings};
 use afm::scan::pixel::ScanPixel;
+use afm::scan::raster::ScanRaster;
 use afm::scan::settings::{ScanDirections, ScanSettings, MAX_PIXELS};
 use afm::validation::Interval;
 use afm::{fixtures, Case, TappingModel};
@@ -20,6 +21,7 @@ use crate::option_ranges::{self, OptionRange};
 use crate::output::{check_writable, print_stdout, push_csv_row, write_atomically};
 use crate::plot::{render_svg, FigureFile};
 use crate::progress::{note, Progress};
+use crate::scan_image::{image_maps_svg, ImageMap};
 use crate::scan_plot::scan_panels;
 
 /// The built-in line scanned when none is named.
@@ -79,6 +81,11 @@ pub struct ScanArgs {
     /// from_nm, to_nm, height_nm and a sample name, file or object; optional edge_width_nm).
     #[arg(long, value_name = "NAME|FILE", default_value = DEFAULT_LINE)]
     pub line: String,
+    /// A 2-D sample instead of --line: a raster file (JSON: row_spacing_nm and rows, each a
+    /// line object, line name or line file); every row is scanned as a line, and --plot draws
+    /// images of height, phase and impacts per period.
+    #[arg(long, value_name = "FILE", conflicts_with = "line")]
+    pub raster: Option<PathBuf>,
     /// A built-in case or case file: its cantilever, drive and A0 (its sample is replaced by
     /// the line's). Default: maclever-membrane-experiment.
     #[arg(long, value_name = "NAME|FILE", conflicts_with = "cantilever")]
@@ -320,6 +327,9 @@ pub fn run(args: &ScanArgs) -> Result<()> {
     if let Some(path) = &args.out {
         check_writable(path, "--out")?;
     }
+    if let Some(raster) = &args.raster {
+        return run_raster(args, raster, plot_path);
+    }
     let line = ScanLine::find(&args.line).with_context(|| format!("--line {}", args.line))?;
     let case = args.case(&line)?;
     let settings = args.settings()?;
@@ -358,6 +368,108 @@ pub fn run(args: &ScanArgs) -> Result<()> {
     }
     if pixels.is_empty() {
         bail!("the scan produced no pixels");
+    }
+    Ok(())
+}
+
+/// `drumroll scan --raster FILE`: every row scanned as a line (the case and settings of the
+/// first row), the pixels tagged with `row` and `y_nm`; `--plot` draws the trace's images.
+fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Result<()> {
+    let raster = ScanRaster::load(path).with_context(|| format!("--raster {}", path.display()))?;
+    let case = args.case(&raster.rows[0])?;
+    let settings = args.settings()?;
+    let total = (settings.pixels * settings.directions.passes().len() * raster.rows.len()) as u64;
+    let mut progress = Progress::new(total, "{wide_bar} {human_pos}/{human_len} pixels, {eta} left");
+    let mut rows: Vec<Vec<ScanPixel>> = Vec::with_capacity(raster.rows.len());
+    let mut inputs = Value::Null;
+    for line in &raster.rows {
+        let before = rows.iter().map(Vec::len).sum::<usize>() as u64;
+        let (pixels, row_inputs) = scan_pixels(args, &case, line, &settings, &mut |done| {
+            progress.update(before + done as u64, String::new);
+            false
+        })?;
+        rows.push(pixels);
+        inputs = row_inputs;
+    }
+    progress.finish();
+    inputs["options"]["raster"] = json!(path.display().to_string());
+    let tagged = |row: usize, pixel: &ScanPixel| {
+        let mut value = pixel_json(pixel);
+        value["row"] = json!(row);
+        value["y_nm"] = json!(row as f64 * raster.row_spacing_nm);
+        value
+    };
+    let text = if args.json {
+        let value = json!({
+            "inputs": inputs,
+            "raster": {
+                "name": raster.name,
+                "description": raster.description,
+                "row_spacing_nm": raster.row_spacing_nm,
+                "rows": raster.rows.iter().map(line_json).collect::<Vec<_>>(),
+            },
+            "pixels": rows.iter().enumerate().flat_map(|(j, row)| row.iter().map(move |p| (j, p)))
+                .map(|(j, p)| tagged(j, p)).collect::<Vec<_>>(),
+        });
+        format!("{}\n", serde_json::to_string(&value)?)
+    } else {
+        let mut columns = vec!["row", "y_nm"];
+        columns.extend(CSV_COLUMNS);
+        let mut text = String::from("direction,");
+        text.push_str(&columns.join(","));
+        text.push_str(&crate::approach::harmonic_columns(settings.orbit.harmonics));
+        text.push('\n');
+        for (j, row) in rows.iter().enumerate() {
+            for pixel in row {
+                let mut line = String::new();
+                push_csv_row(&mut line, pixel.direction.name(), &tagged(j, pixel), &columns);
+                line.pop();
+                for harmonic in &pixel.harmonics {
+                    line.push_str(&format!(",{},{}", harmonic.amplitude_nm, harmonic.phase_deg));
+                }
+                line.push('\n');
+                text.push_str(&line);
+            }
+        }
+        text
+    };
+    match &args.out {
+        Some(out) => {
+            write_atomically(out, text.as_bytes())?;
+            note(&format!("pixels: {}", out.display()));
+        }
+        None => print_stdout(&text)?,
+    }
+    if let Some(figure) = plot_path {
+        let map = |title: &str, value: fn(&ScanPixel) -> f64| ImageMap {
+            title: title.to_string(),
+            values: rows
+                .iter()
+                .map(|row| {
+                    let mut values = vec![f64::NAN; settings.pixels];
+                    // The first pass of each row (the trace unless only retrace is asked).
+                    let first = row.first().map(|p| p.direction);
+                    for pixel in row.iter().filter(|p| Some(p.direction) == first) {
+                        values[pixel.index] = value(pixel);
+                    }
+                    values
+                })
+                .collect(),
+        };
+        let maps = [
+            map("measured height (nm)", |p| p.height_nm),
+            map("phase (deg)", |p| p.phase_deg),
+            map("impacts per period", |p| p.impacts_per_period),
+        ];
+        // Physical proportions: the longer side 360 SVG pixels.
+        let first = &raster.rows[0];
+        let pixel_width = (first.end_nm() - first.start_nm()) / settings.pixels as f64;
+        let extent = (first.end_nm() - first.start_nm())
+            .max(raster.rows.len() as f64 * raster.row_spacing_nm);
+        let scale = 360.0 / extent;
+        let cell = (pixel_width * scale, raster.row_spacing_nm * scale);
+        figure.write(&image_maps_svg(&raster.name, &maps, cell))?;
+        note(&format!("images: {}", figure.path.display()));
     }
     Ok(())
 }

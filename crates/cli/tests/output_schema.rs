@@ -281,7 +281,13 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
             "--json",
         ]),
     ];
-    printed.extend(check(&schema, "`drumroll scan` (CSV, `--json`)", &scanned));
+    let disc = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/rasters/membrane-disc.json");
+    let rastered = [one(&["scan", "--raster", disc, "--pixels", "3", "--json"])];
+    printed.extend(check(
+        &schema,
+        "`drumroll scan` (CSV, `--json`)",
+        &[scanned.concat(), rastered.concat()],
+    ));
 
     // grid, JSON Lines: the header line, then rows with approach, retract and bistable.
     let directory = tempfile::tempdir().expect("temporary directory");

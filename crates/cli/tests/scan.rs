@@ -82,3 +82,43 @@ fn bad_input_names_the_option_or_the_field_and_writes_nothing() {
         assert!(!out.exists(), "{args:?} left {}", out.display());
     }
 }
+
+#[test]
+fn a_raster_scans_every_row_and_draws_the_images() {
+    // The round membrane patch: every row of 4 pixels, the film where the row crosses it,
+    // and the three images in one PNG.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let image = directory.path().join("disc.png");
+    let disc = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/rasters/membrane-disc.json");
+    let value = json_of(&["scan", "--raster", disc, "--pixels", "4", "--plot", image.to_str().unwrap()]);
+    let pixels = value["pixels"].as_array().expect("pixels");
+    assert_eq!(pixels.len(), 9 * 4);
+    for pixel in pixels {
+        let y = number(pixel, "y_nm");
+        assert_eq!(y, 50.0 * number(pixel, "row"));
+        // On the disc (radius 150 nm about (200, 200)) the sample is the film.
+        let (x, r) = (number(pixel, "x_nm"), 150.0);
+        let inside = (x - 200.0).powi(2) + (y - 200.0).powi(2) < (r - 30.0) * (r - 30.0);
+        if inside {
+            assert_eq!(pixel["sample"], "purple-membrane-film", "{pixel}");
+        }
+    }
+    let bytes = std::fs::read(&image).expect("image");
+    assert_eq!(&bytes[1..4], b"PNG");
+
+    // Rows of different lengths are refused, naming the row.
+    let bad = directory.path().join("bad.json");
+    std::fs::write(
+        &bad,
+        r#"{"row_spacing_nm": 10, "rows": [
+            {"segments": [{"from_nm": 0, "to_nm": 10, "height_nm": 0, "sample": "mica"}]},
+            {"segments": [{"from_nm": 0, "to_nm": 20, "height_nm": 0, "sample": "mica"}]}]}"#,
+    )
+    .expect("raster");
+    let output = drumroll()
+        .args(["scan", "--raster", bad.to_str().unwrap()])
+        .output()
+        .expect("runs");
+    assert_eq!(output.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("rows[1]"));
+}

@@ -77,6 +77,7 @@ pub fn compute_scan<'py>(
     };
     let args = ScanArgs {
         line: line_name,
+        raster: None,
         case: None,
         cantilever: None,
         a0: None,

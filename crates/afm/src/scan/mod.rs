@@ -7,5 +7,6 @@ pub mod line;
 pub mod materials;
 pub mod pi;
 pub mod pixel;
+pub mod raster;
 pub mod setpoint_branch;
 pub mod settings;
