@@ -57,8 +57,12 @@ fn uniform_sample_with_a_step_reads_the_orbit_at_the_setpoint_and_the_step() {
         assert!(pixel.jump.is_none());
         assert_eq!(pixel.stable, Some(true));
     }
-    assert!(pixels[..8].iter().all(|p| p.direction == ScanDirection::Trace));
-    assert!(pixels[8..].iter().all(|p| p.direction == ScanDirection::Retrace));
+    assert!(pixels[..8]
+        .iter()
+        .all(|p| p.direction == ScanDirection::Trace));
+    assert!(pixels[8..]
+        .iter()
+        .all(|p| p.direction == ScanDirection::Retrace));
 }
 
 #[test]
@@ -92,8 +96,20 @@ fn edge_width_ramps_the_true_height_linearly() {
             {"from_nm": 50, "to_nm": 100, "height_nm": 6, "sample": "soft"}]}"#,
     );
     // Exact: a line from (45, 0) to (55, 6).
-    for (x, h) in [(40.0, 0.0), (45.0, 0.0), (47.5, 1.5), (50.0, 3.0), (54.0, 5.4), (55.0, 6.0), (90.0, 6.0)] {
-        assert!((line.height_at(x) - h).abs() < 1e-12, "h({x}) = {}", line.height_at(x));
+    for (x, h) in [
+        (40.0, 0.0),
+        (45.0, 0.0),
+        (47.5, 1.5),
+        (50.0, 3.0),
+        (54.0, 5.4),
+        (55.0, 6.0),
+        (90.0, 6.0),
+    ] {
+        assert!(
+            (line.height_at(x) - h).abs() < 1e-12,
+            "h({x}) = {}",
+            line.height_at(x)
+        );
     }
     assert_eq!(line.materials[line.material_at(49.9)].name, "mica");
     assert_eq!(line.materials[line.material_at(50.0)].name, "soft");
@@ -139,7 +155,9 @@ fn bad_line_files_name_the_field_and_the_range() {
         ),
     ];
     for (text, field) in cases {
-        let error = ScanLine::parse("bad.json", text, None).unwrap_err().to_string();
+        let error = ScanLine::parse("bad.json", text, None)
+            .unwrap_err()
+            .to_string();
         assert!(error.contains("bad.json"), "{error}");
         assert!(error.contains(field), "{field}: {error}");
     }
@@ -150,8 +168,14 @@ fn the_builtin_line_is_the_paper_setting() {
     let line = ScanLine::builtin("membrane-patch").unwrap();
     assert_eq!(line.materials.len(), 2);
     assert_eq!(line.height_at(200.0), 6.0);
-    assert_eq!(line.materials[line.material_at(200.0)].name, "purple-membrane-film");
-    assert!(ScanLine::find("no-such-line").unwrap_err().to_string().contains("membrane-patch"));
+    assert_eq!(
+        line.materials[line.material_at(200.0)].name,
+        "purple-membrane-film"
+    );
+    assert!(ScanLine::find("no-such-line")
+        .unwrap_err()
+        .to_string()
+        .contains("membrane-patch"));
 }
 
 #[test]
@@ -173,7 +197,13 @@ fn a_slow_pi_scan_converges_to_the_ideal_feedback() {
             .iter()
             .any(|edge| (a.x_nm - edge).abs() < 2.0 * 25.0);
         if !near_edge {
-            assert!((a.z_nm - b.z_nm).abs() < 0.05, "x = {}: {} vs {}", a.x_nm, a.z_nm, b.z_nm);
+            assert!(
+                (a.z_nm - b.z_nm).abs() < 0.05,
+                "x = {}: {} vs {}",
+                a.x_nm,
+                a.z_nm,
+                b.z_nm
+            );
             assert!((b.amplitude_ratio - SETPOINT).abs() < 0.01);
         }
     }
@@ -214,7 +244,10 @@ fn brute_force_pi(
     let mut readings = Vec::new();
     for k in 0..cycles {
         let (x0, x1) = (start + k as f64 * travel, start + (k + 1) as f64 * travel);
-        let (z0, z1) = (base_start - line.height_at(x0), base_end - line.height_at(x1));
+        let (z0, z1) = (
+            base_start - line.height_at(x0),
+            base_end - line.height_at(x1),
+        );
         model
             .set_separation(Separation::Ramp {
                 z0_nm: z0,
@@ -292,7 +325,15 @@ fn a_fast_pi_scan_off_a_step_tracks_as_a_brute_force_loop_does() {
     let mut pi = PiSettings::for_case(&case).unwrap();
     pi.scan_rate_nm_per_s = 40.0 / (cycles as f64 * model.period_us() * 1e-6);
     let scanned = pi_scan(&case, &line, &ScanSettings::new(SETPOINT, pixels), &pi).unwrap();
-    let reference = brute_force_pi(&model, &line, cycles, SETPOINT, pi.gain_p, pi.gain_i_per_ms, 20_000);
+    let reference = brute_force_pi(
+        &model,
+        &line,
+        cycles,
+        SETPOINT,
+        pi.gain_p,
+        pi.gain_i_per_ms,
+        20_000,
+    );
     for (pixel, cycles) in scanned.iter().zip(reference.chunks(cycles_per_pixel)) {
         // A pixel reads the mean Z and the amplitude of the mean Fourier coefficients.
         let mean = |f: fn(&(f64, f64, f64)) -> f64| {
@@ -300,7 +341,12 @@ fn a_fast_pi_scan_off_a_step_tracks_as_a_brute_force_loop_does() {
         };
         let z = mean(|c| c.0);
         let ratio = mean(|c| c.1).hypot(mean(|c| c.2));
-        assert!((pixel.z_nm - z).abs() < 2e-5, "x = {}: Z {} vs {z}", pixel.x_nm, pixel.z_nm);
+        assert!(
+            (pixel.z_nm - z).abs() < 2e-5,
+            "x = {}: Z {} vs {z}",
+            pixel.x_nm,
+            pixel.z_nm
+        );
         assert!(
             (pixel.amplitude_ratio - ratio).abs() < 1e-6,
             "x = {}: A/A0 {} vs {ratio}",
@@ -341,12 +387,20 @@ fn engaging_past_the_fold_near_first_contact_is_marked_as_a_jump() {
     );
     let pixels = ideal_scan(&case, &line, &ScanSettings::new(0.998, 3)).unwrap();
     let jump = pixels[0].jump.expect("the engagement jumps at the fold");
-    assert!(jump.from_z_nm >= fold && jump.from_z_nm - fold < step, "{jump:?} vs {fold}");
+    assert!(
+        jump.from_z_nm >= fold && jump.from_z_nm - fold < step,
+        "{jump:?} vs {fold}"
+    );
     assert!(jump.from_amplitude_ratio > 0.998);
     assert!((pixels[0].amplitude_ratio - 0.998).abs() < 1e-6);
     assert!(pixels[1].jump.is_none() && pixels[2].jump.is_none());
     assert!((pixels[2].z_nm - pixels[0].z_nm).abs() < 2e-9);
 
-    let error = ideal_scan(&case, &line, &ScanSettings::new(0.9992, 3)).unwrap_err().to_string();
-    assert!(error.contains("jumped") && error.contains("mica"), "{error}");
+    let error = ideal_scan(&case, &line, &ScanSettings::new(0.9992, 3))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("jumped") && error.contains("mica"),
+        "{error}"
+    );
 }

@@ -108,7 +108,10 @@ pub fn listing() -> Result<String> {
         )?;
         writeln!(s, "  {:<30} {}", "", sample.description)?;
     }
-    writeln!(s, "\nscan lines (drumroll scan --line NAME; MODEL.md section 12):")?;
+    writeln!(
+        s,
+        "\nscan lines (drumroll scan --line NAME; MODEL.md section 12):"
+    )?;
     for name in fixtures::line_names() {
         let line = afm::scan::line::ScanLine::builtin(name)?;
         let segments: Vec<String> = line

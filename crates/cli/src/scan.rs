@@ -119,10 +119,20 @@ pub struct ScanArgs {
     pub gain_i: f64,
     /// PI: the tip's speed along the line, nm/s, in (0, 1e9]; at least one drive cycle per
     /// pixel.
-    #[arg(long, value_name = "NM_PER_S", default_value_t = 100.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "NM_PER_S",
+        default_value_t = 100.0,
+        allow_negative_numbers = true
+    )]
     pub scan_rate: f64,
     /// PI: the lock-in's output time constant, ms, in [0, 10000] (0: each cycle's reading).
-    #[arg(long, value_name = "MS", default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "MS",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
     pub lockin_time_constant: f64,
     /// The harmonics n = 1..N of u per pixel, N in [1, 20].
     #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
@@ -149,8 +159,7 @@ impl ScanArgs {
         let mut case = match &self.cantilever {
             Some(name) => {
                 let path = Path::new(name);
-                let cantilever = if path.extension().is_some_and(|e| e == "json") || path.exists()
-                {
+                let cantilever = if path.extension().is_some_and(|e| e == "json") || path.exists() {
                     fixtures::load_cantilever(path)?
                 } else {
                     fixtures::builtin_cantilever(name)?
@@ -189,8 +198,8 @@ impl ScanArgs {
             },
         )
         .check(self.setpoint)?;
-        let pixels =
-            OptionRange::new("--pixels", Interval::closed(1.0, MAX_PIXELS as f64, "")).count(self.pixels)?;
+        let pixels = OptionRange::new("--pixels", Interval::closed(1.0, MAX_PIXELS as f64, ""))
+            .count(self.pixels)?;
         let harmonics = OptionRange::new(
             "--harmonics",
             Interval::closed(1.0, afm::orbit::lockin::MAX_LOCKIN_HARMONICS as f64, ""),
@@ -240,10 +249,18 @@ pub fn scan_csv(pixels: &[ScanPixel], harmonics: usize) -> String {
     text.push('\n');
     for pixel in pixels {
         let mut row = String::new();
-        push_csv_row(&mut row, pixel.direction.name(), &pixel_json(pixel), CSV_COLUMNS);
+        push_csv_row(
+            &mut row,
+            pixel.direction.name(),
+            &pixel_json(pixel),
+            CSV_COLUMNS,
+        );
         row.pop();
         for harmonic in &pixel.harmonics {
-            row.push_str(&format!(",{},{}", harmonic.amplitude_nm, harmonic.phase_deg));
+            row.push_str(&format!(
+                ",{},{}",
+                harmonic.amplitude_nm, harmonic.phase_deg
+            ));
         }
         row.push('\n');
         text.push_str(&row);
@@ -334,7 +351,10 @@ pub fn run(args: &ScanArgs) -> Result<()> {
     let case = args.case(&line)?;
     let settings = args.settings()?;
     let total = (settings.pixels * settings.directions.passes().len()) as u64;
-    let mut progress = Progress::new(total, "{wide_bar} {human_pos}/{human_len} pixels, {eta} left");
+    let mut progress = Progress::new(
+        total,
+        "{wide_bar} {human_pos}/{human_len} pixels, {eta} left",
+    );
     let (pixels, inputs) = scan_pixels(args, &case, &line, &settings, &mut |done| {
         progress.update(done as u64, String::new);
         false
@@ -359,7 +379,9 @@ pub fn run(args: &ScanArgs) -> Result<()> {
     }
     let jumps = pixels.iter().filter(|p| p.jump.is_some()).count();
     if jumps > 0 {
-        note(&format!("the feedback jumped between branches at {jumps} pixel(s) (column `jumped`)"));
+        note(&format!(
+            "the feedback jumped between branches at {jumps} pixel(s) (column `jumped`)"
+        ));
     }
     if let Some(path) = plot_path {
         let panels = scan_panels(&line.name, &pixels);
@@ -379,7 +401,10 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
     let case = args.case(&raster.rows[0])?;
     let settings = args.settings()?;
     let total = (settings.pixels * settings.directions.passes().len() * raster.rows.len()) as u64;
-    let mut progress = Progress::new(total, "{wide_bar} {human_pos}/{human_len} pixels, {eta} left");
+    let mut progress = Progress::new(
+        total,
+        "{wide_bar} {human_pos}/{human_len} pixels, {eta} left",
+    );
     let mut rows: Vec<Vec<ScanPixel>> = Vec::with_capacity(raster.rows.len());
     let mut inputs = Value::Null;
     for line in &raster.rows {
@@ -422,10 +447,18 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
         for (j, row) in rows.iter().enumerate() {
             for pixel in row {
                 let mut line = String::new();
-                push_csv_row(&mut line, pixel.direction.name(), &tagged(j, pixel), &columns);
+                push_csv_row(
+                    &mut line,
+                    pixel.direction.name(),
+                    &tagged(j, pixel),
+                    &columns,
+                );
                 line.pop();
                 for harmonic in &pixel.harmonics {
-                    line.push_str(&format!(",{},{}", harmonic.amplitude_nm, harmonic.phase_deg));
+                    line.push_str(&format!(
+                        ",{},{}",
+                        harmonic.amplitude_nm, harmonic.phase_deg
+                    ));
                 }
                 line.push('\n');
                 text.push_str(&line);

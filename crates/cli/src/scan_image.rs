@@ -52,7 +52,12 @@ pub fn image_maps_svg(title: &str, maps: &[ImageMap], cell: (f64, f64)) -> Strin
     );
     for (index, map) in maps.iter().enumerate() {
         let left = margin + index as f64 * (map_width + margin);
-        let finite = map.values.iter().flatten().copied().filter(|v| v.is_finite());
+        let finite = map
+            .values
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|v| v.is_finite());
         let (low, high) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
             (l.min(v), h.max(v))
         });
@@ -67,7 +72,11 @@ pub fn image_maps_svg(title: &str, maps: &[ImageMap], cell: (f64, f64)) -> Strin
             let top = header + (rows - 1 - row) as f64 * cell.1;
             for (column, &value) in values.iter().enumerate() {
                 let fill = if value.is_finite() {
-                    let s = if high > low { (value - low) / (high - low) } else { 0.5 };
+                    let s = if high > low {
+                        (value - low) / (high - low)
+                    } else {
+                        0.5
+                    };
                     let (r, g, b) = colour(s);
                     format!("rgb({r},{g},{b})")
                 } else {

@@ -41,9 +41,10 @@ pub fn scan_panels(line: &str, pixels: &[ScanPixel]) -> Vec<Panel> {
     };
     let mut heights = vec![Series {
         label: String::from("true"),
-        points: pass(pixels.first().map_or(ScanDirection::Trace, |p| p.direction), |p| {
-            p.height_true_nm
-        }),
+        points: pass(
+            pixels.first().map_or(ScanDirection::Trace, |p| p.direction),
+            |p| p.height_true_nm,
+        ),
         stroke: Stroke::Dotted,
         colour: 2,
     }];
@@ -60,6 +61,10 @@ pub fn scan_panels(line: &str, pixels: &[ScanPixel]) -> Vec<Panel> {
         panel("true and measured height", "height (nm)", heights),
         phase,
         impacts,
-        panel("peak force", "peak force (nN)", passes(|p| p.peak_force_nn, 0)),
+        panel(
+            "peak force",
+            "peak force (nN)",
+            passes(|p| p.peak_force_nn, 0),
+        ),
     ]
 }

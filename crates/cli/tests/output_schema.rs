@@ -281,7 +281,10 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
             "--json",
         ]),
     ];
-    let disc = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/rasters/membrane-disc.json");
+    let disc = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/rasters/membrane-disc.json"
+    );
     let rastered = [one(&["scan", "--raster", disc, "--pixels", "3", "--json"])];
     printed.extend(check(
         &schema,

@@ -30,7 +30,11 @@ fn the_paper_line_reads_the_film_lower_than_it_is_in_csv_json_and_figure() {
         .arg(&figure)
         .output()
         .expect("runs");
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let text = std::fs::read_to_string(&csv).expect("CSV");
     let mut lines = text.lines();
     let header = lines.next().expect("header");
@@ -64,7 +68,10 @@ fn bad_input_names_the_option_or_the_field_and_writes_nothing() {
         (&["--line", "no-such-line"], "membrane-patch"),
         (&["--line", bad_line], "segments[1].from_nm"),
         (&["--feedback", "pi", "--gain-p", "-1"], "--gain-p"),
-        (&["--feedback", "pi", "--scan-rate", "1e7"], "scan_rate_nm_per_s"),
+        (
+            &["--feedback", "pi", "--scan-rate", "1e7"],
+            "scan_rate_nm_per_s",
+        ),
         (&["--harmonics", "50"], "--harmonics"),
     ];
     for (args, expected) in cases {
@@ -89,8 +96,19 @@ fn a_raster_scans_every_row_and_draws_the_images() {
     // and the three images in one PNG.
     let directory = tempfile::tempdir().expect("temporary directory");
     let image = directory.path().join("disc.png");
-    let disc = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/rasters/membrane-disc.json");
-    let value = json_of(&["scan", "--raster", disc, "--pixels", "4", "--plot", image.to_str().unwrap()]);
+    let disc = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/rasters/membrane-disc.json"
+    );
+    let value = json_of(&[
+        "scan",
+        "--raster",
+        disc,
+        "--pixels",
+        "4",
+        "--plot",
+        image.to_str().unwrap(),
+    ]);
     let pixels = value["pixels"].as_array().expect("pixels");
     assert_eq!(pixels.len(), 9 * 4);
     for pixel in pixels {

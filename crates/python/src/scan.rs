@@ -2,7 +2,9 @@
 //! 12), as a table of pixels whose columns are the CLI's CSV columns.
 
 use afm::scan::line::ScanLine;
-use drumroll::scan::{line_json, pixel_json, scan_pixels, Direction, Feedback, ScanArgs, CSV_COLUMNS};
+use drumroll::scan::{
+    line_json, pixel_json, scan_pixels, Direction, Feedback, ScanArgs, CSV_COLUMNS,
+};
 use pyo3::prelude::*;
 use serde_json::Value;
 use std::sync::Arc;
@@ -54,7 +56,9 @@ pub fn compute_scan<'py>(
     line: &Bound<'py, PyAny>,
     options: &ScanOptions,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let line_name = line.extract::<String>().unwrap_or_else(|_| String::from("(dict)"));
+    let line_name = line
+        .extract::<String>()
+        .unwrap_or_else(|_| String::from("(dict)"));
     let line = line_of(line)?;
     let feedback = match options.feedback.as_str() {
         "ideal" => Feedback::Ideal,

@@ -163,9 +163,10 @@ impl ScanLine {
             ),
         )?;
         let name = raw.name.unwrap_or_else(|| {
-            Path::new(file)
-                .file_stem()
-                .map_or_else(|| String::from("line"), |s| s.to_string_lossy().into_owned())
+            Path::new(file).file_stem().map_or_else(
+                || String::from("line"),
+                |s| s.to_string_lossy().into_owned(),
+            )
         });
         Ok(Self {
             name,
@@ -304,7 +305,9 @@ fn resolve_sample(
             }
             let full = base.map_or_else(|| path.to_path_buf(), |b| b.join(path));
             load_sample(&full).map_err(|error| match error {
-                AfmError::Io { file, source } => not_found(format!(" (cannot read {file}: {source})")),
+                AfmError::Io { file, source } => {
+                    not_found(format!(" (cannot read {file}: {source})"))
+                }
                 other => other,
             })
         }

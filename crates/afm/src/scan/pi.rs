@@ -68,7 +68,12 @@ impl PiSettings {
     /// Check every field (errors name the field and its allowed range).
     pub fn validate(&self) -> Result<(), AfmError> {
         const FILE: &str = "PI settings";
-        check(FILE, "gain_p", self.gain_p, Interval::closed(0.0, 100.0, "nm/nm"))?;
+        check(
+            FILE,
+            "gain_p",
+            self.gain_p,
+            Interval::closed(0.0, 100.0, "nm/nm"),
+        )?;
         check(
             FILE,
             "gain_i_per_ms",
@@ -144,7 +149,10 @@ pub fn pi_scan_until(
         cycles_in_pixel[pixel_of(start + (k as f64 + 0.5) * travel)] += 1;
     }
     let centres = line.pixel_centres(settings.pixels);
-    let harmonics = settings.orbit.harmonics.min(crate::orbit::lockin::MAX_LOCKIN_HARMONICS);
+    let harmonics = settings
+        .orbit
+        .harmonics
+        .min(crate::orbit::lockin::MAX_LOCKIN_HARMONICS);
     let mut lockins: Vec<CycleLockIn> = models
         .iter()
         .map(|m| CycleLockIn::with_harmonics(m, harmonics))

@@ -104,9 +104,10 @@ impl ScanRaster {
             rows.push(line);
         }
         let name = raw.name.unwrap_or_else(|| {
-            Path::new(file)
-                .file_stem()
-                .map_or_else(|| String::from("raster"), |s| s.to_string_lossy().into_owned())
+            Path::new(file).file_stem().map_or_else(
+                || String::from("raster"),
+                |s| s.to_string_lossy().into_owned(),
+            )
         });
         Ok(Self {
             name,

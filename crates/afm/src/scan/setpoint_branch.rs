@@ -200,10 +200,7 @@ impl SetpointBranch {
             return Err(self.not_reached(&format!(
                 "no stable orbit of the approach branch lies at Z = {z_nm:.6} nm (the branch \
                  spans Z in [{:.6}, {:.6}] nm)",
-                points
-                    .iter()
-                    .map(|p| p.z_nm)
-                    .fold(f64::INFINITY, f64::min),
+                points.iter().map(|p| p.z_nm).fold(f64::INFINITY, f64::min),
                 points[0].z_nm
             )));
         };
@@ -242,7 +239,8 @@ impl SetpointBranch {
                 let point = &points[index];
                 // A point behind the entry in Z (the entry lies inside its interval) is skipped.
                 let ahead = (point.z_nm - entry.orbit.z_nm) * z_sign >= 0.0;
-                if ahead && (point.amplitude_ratio - ratio).signum() != (cursor_ratio - ratio).signum()
+                if ahead
+                    && (point.amplitude_ratio - ratio).signum() != (cursor_ratio - ratio).signum()
                 {
                     let near = match cursor {
                         Some(c) => steady_orbit_in(
@@ -261,7 +259,11 @@ impl SetpointBranch {
                         &self.settings,
                         workspace,
                     )?;
-                    let (above, below) = if z_sign < 0.0 { (near, far) } else { (far, near) };
+                    let (above, below) = if z_sign < 0.0 {
+                        (near, far)
+                    } else {
+                        (far, near)
+                    };
                     let orbit = refine_ratio_bracket(
                         &self.model,
                         &self.search,
@@ -276,7 +278,11 @@ impl SetpointBranch {
                     cursor = Some(index);
                     cursor_ratio = point.amplitude_ratio;
                 }
-                let at_end = if forward { index == last } else { index == first };
+                let at_end = if forward {
+                    index == last
+                } else {
+                    index == first
+                };
                 if at_end {
                     break;
                 }
