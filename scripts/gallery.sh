@@ -28,4 +28,6 @@ mkdir -p "$out"
 "$DRUMROLL" --quiet approach --case biolever-mica --from 10.2 --to 0 --rate 4 --retract \
     --plot "$out/approach.svg" > /dev/null
 "$DRUMROLL" --quiet map --case biolever-mica --vary a0 --from 5 --to 20 --plot "$out/map.svg" > /dev/null
+"$DRUMROLL" --quiet scan --feedback pi --scan-rate 2000 --pixels 128 --direction both \
+    --plot "$out/scan.svg" > /dev/null
 ls -l "$out"

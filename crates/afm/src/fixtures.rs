@@ -54,6 +54,8 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "maclever-membrane-film"),
 ];
 
+const LINES: &[Embedded] = &[embedded!("lines", "membrane-patch")];
+
 fn names(table: &[Embedded]) -> Vec<&'static str> {
     table.iter().map(|entry| entry.name).collect()
 }
@@ -76,6 +78,20 @@ pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }
 
+/// The names of the built-in scan lines (`membrane-patch`; MODEL.md section 12).
+pub fn line_names() -> Vec<&'static str> {
+    names(LINES)
+}
+
+/// The built-in scan line `name`: its path in the repository and its JSON text (parsed by
+/// `crate::scan::line::ScanLine`), `None` for an unknown name.
+pub fn builtin_line_text(name: &str) -> Option<(&'static str, &'static str)> {
+    LINES
+        .iter()
+        .find(|entry| entry.name == name)
+        .map(|entry| (entry.path, entry.text))
+}
+
 fn find<'a>(
     table: &'a [Embedded],
     kind: &'static str,
@@ -89,6 +105,12 @@ fn find<'a>(
             name: name.to_string(),
             known: names(table).join(", "),
         })
+}
+
+/// Parse JSON `text` of `file` into `T`; a syntax or schema error names the file and the
+/// field it is in.
+pub(crate) fn parse_json<T: DeserializeOwned>(file: &str, text: &str) -> Result<T, AfmError> {
+    parse(file, text)
 }
 
 /// Parse a JSON file's text; a UTF-8 byte-order mark at its start (written by some Windows
@@ -133,12 +155,14 @@ pub fn parse_case_file(file: &str, text: &str) -> Result<CaseFile, AfmError> {
 
 /// A built-in fixture file as shipped: its kind (`case`, `cantilever` or `sample`), its path
 /// in the repository (`fixtures/cases/biolever-mica.json`, ...) and its JSON text, for a user
-/// to copy and edit. Cases are searched first, then cantilevers, then samples.
+/// to copy and edit. Cases are searched first, then cantilevers, then samples, then scan
+/// lines (kind `line`).
 pub fn builtin_file(name: &str) -> Option<(&'static str, &'static str, &'static str)> {
     [
         ("case", CASES),
         ("cantilever", CANTILEVERS),
         ("sample", SAMPLES),
+        ("line", LINES),
     ]
     .into_iter()
     .find_map(|(kind, table)| {

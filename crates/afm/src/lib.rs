@@ -25,6 +25,7 @@ mod json_path;
 pub mod map;
 pub mod model;
 pub mod orbit;
+pub mod scan;
 pub mod sweep;
 pub mod theory;
 pub mod validation;

@@ -20,8 +20,8 @@ pub struct CasesArgs {
 /// Subcommands of `drumroll cases`.
 #[derive(Debug, Clone, Subcommand)]
 pub enum CasesCommand {
-    /// Print the JSON file of a built-in case, cantilever or sample: save it, edit it, and pass
-    /// its path to --case, --cantilever or --sample.
+    /// Print the JSON file of a built-in case, cantilever, sample or scan line: save it, edit
+    /// it, and pass its path to --case, --cantilever, --sample or --line.
     Show {
         /// A built-in name (`drumroll cases` lists them).
         name: String,
@@ -41,7 +41,8 @@ pub fn run(args: &CasesArgs) -> Result<()> {
 pub fn show(name: &str) -> Result<String> {
     let Some((_, _, text)) = fixtures::builtin_file(name) else {
         bail!(
-            "cases show {name}: no built-in case, cantilever or sample of that name; known: {}",
+            "cases show {name}: no built-in case, cantilever, sample or scan line of that name; \
+             known: {}",
             known_names()
         );
     };
@@ -56,6 +57,7 @@ fn known_names() -> String {
     let mut names = fixtures::case_names();
     names.extend(fixtures::cantilever_names());
     names.extend(fixtures::sample_names());
+    names.extend(fixtures::line_names());
     names.join(", ")
 }
 
@@ -108,8 +110,29 @@ pub fn listing() -> Result<String> {
     }
     writeln!(
         s,
+        "\nscan lines (drumroll scan --line NAME; MODEL.md section 12):"
+    )?;
+    for name in fixtures::line_names() {
+        let line = afm::scan::line::ScanLine::builtin(name)?;
+        let segments: Vec<String> = line
+            .segments
+            .iter()
+            .map(|segment| {
+                format!(
+                    "{} {} nm at {} nm",
+                    line.materials[segment.material].name,
+                    segment.to_nm - segment.from_nm,
+                    segment.height_nm
+                )
+            })
+            .collect();
+        writeln!(s, "  {name:<30} {}", segments.join(", "))?;
+        writeln!(s, "  {:<30} {}", "", line.description)?;
+    }
+    writeln!(
+        s,
         "\n`drumroll cases show NAME` prints a file to copy and edit; pass the edited file's path \
-         to --case, --cantilever or --sample (fields and ranges: MODEL.md)."
+         to --case, --cantilever, --sample or --line (fields and ranges: MODEL.md)."
     )?;
     Ok(s)
 }

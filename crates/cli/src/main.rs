@@ -38,6 +38,10 @@ enum Command {
     /// A time-domain approach (and retract) sweep at a constant rate, read by a lock-in once
     /// per drive cycle (or block of cycles); the records stream out as CSV or JSON Lines.
     Approach(drumroll::approach::ApproachArgs),
+    /// A tapping-mode scan line with amplitude feedback over a heterogeneous sample (a line
+    /// file of segments): ideal feedback along the orbit branches, or a time-domain PI loop;
+    /// per pixel the measured height, phase, impacts, forces and dissipation.
+    Scan(drumroll::scan::ScanArgs),
     /// The paper's approximate theory (Eqs. 3-4, lambda_1..3, the ring-down criterion) beside
     /// the same quantities measured on the simulated steady orbit at one Z or A/A0.
     Theory(drumroll::theory::TheoryArgs),
@@ -65,6 +69,7 @@ fn main() -> ExitCode {
         Command::Continue(args) => drumroll::continue_diagram::run(args),
         Command::Map(args) => drumroll::map::run(args),
         Command::Approach(args) => drumroll::approach::run(args),
+        Command::Scan(args) => drumroll::scan::run(args),
         Command::Theory(args) => drumroll::theory::run(args),
         Command::Grid(args) => drumroll::grid::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),

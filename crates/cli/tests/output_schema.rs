@@ -266,6 +266,32 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
         &[lines],
     ));
 
+    // scan: the ideal feedback and the PI loop over the paper's line (null where the time
+    // domain reads nothing).
+    let scanned = [
+        one(&["scan", "--pixels", "4", "--direction", "both", "--json"]),
+        one(&[
+            "scan",
+            "--pixels",
+            "4",
+            "--feedback",
+            "pi",
+            "--scan-rate",
+            "4000",
+            "--json",
+        ]),
+    ];
+    let disc = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/rasters/membrane-disc.json"
+    );
+    let rastered = [one(&["scan", "--raster", disc, "--pixels", "3", "--json"])];
+    printed.extend(check(
+        &schema,
+        "`drumroll scan` (CSV, `--json`)",
+        &[scanned.concat(), rastered.concat()],
+    ));
+
     // grid, JSON Lines: the header line, then rows with approach, retract and bistable.
     let directory = tempfile::tempdir().expect("temporary directory");
     let map = directory.path().join("map.jsonl");

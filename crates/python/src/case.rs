@@ -292,6 +292,48 @@ impl Case {
         crate::approach::compute_approach(py, &self.resolved, &options)
     }
 
+    /// An image line with amplitude feedback, as `drumroll scan` (MODEL.md section 12): the
+    /// case's cantilever, drive and A0 over `line` (a built-in line name, a line file path, or
+    /// a dict in the line files' format), `pixels` pixels at the setpoint A/A0 `setpoint`,
+    /// `feedback` `"ideal"` (steady orbits followed along their branches, jumps marked) or
+    /// `"pi"` (the time-domain loop: `gain_p` nm/nm, `gain_i_per_ms` 1/ms,
+    /// `scan_rate_nm_per_s`, `lockin_time_constant_ms`), `direction` `"trace"`, `"retrace"`
+    /// or `"both"`. Returns a pandas DataFrame (dict of numpy arrays without pandas), one row
+    /// per pixel with the CLI's CSV columns (`height_nm`, `z_nm`, `phase_deg`,
+    /// `impacts_per_period`, ...); `attrs["inputs"]` and `attrs["line"]` as in `--json`.
+    /// Runs without the GIL; Ctrl-C stops it and raises KeyboardInterrupt.
+    #[pyo3(signature = (line=None, *, setpoint=0.8, pixels=64, feedback="ideal", direction="trace", gain_p=0.2, gain_i_per_ms=0.5, scan_rate_nm_per_s=100.0, lockin_time_constant_ms=0.0, harmonics=4))]
+    #[allow(clippy::too_many_arguments)]
+    fn scan<'py>(
+        &self,
+        py: Python<'py>,
+        line: Option<&Bound<'py, PyAny>>,
+        setpoint: f64,
+        pixels: i64,
+        feedback: &str,
+        direction: &str,
+        gain_p: f64,
+        gain_i_per_ms: f64,
+        scan_rate_nm_per_s: f64,
+        lockin_time_constant_ms: f64,
+        harmonics: i64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let options = crate::scan::ScanOptions {
+            setpoint,
+            pixels,
+            feedback: feedback.to_string(),
+            direction: direction.to_string(),
+            gain_p,
+            gain_i_per_ms,
+            scan_rate_nm_per_s,
+            lockin_time_constant_ms,
+            harmonics,
+        };
+        let default = pyo3::types::PyString::new(py, "membrane-patch");
+        let line = line.cloned().unwrap_or_else(|| default.into_any());
+        crate::scan::compute_scan(py, &self.resolved, &line, &options)
+    }
+
     /// The impact-regime map, as `drumroll map`: every special point of the case's approach
     /// diagram (G_n, fold, period doubling; or those named in `labels`) continued as a curve
     /// over the parameter `vary` (`"a0"` nm, `"drive-frequency"` kHz, `"sample-modulus"` GPa,

@@ -14,6 +14,7 @@ pub mod interrupt;
 pub mod orbit;
 pub mod regime_map;
 pub mod resolved;
+pub mod scan;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

@@ -104,13 +104,15 @@ pub fn find_amplitude_ratio(
     };
     let above = orbit_at(above.z_nm, &above.state)?;
     let below = orbit_at(below.z_nm, &below.state)?;
-    refine(model, search, settings, above, below, workspace)
+    refine_ratio_bracket(model, search, settings, above, below, workspace)
 }
 
 /// Refine the bracket `above` (A/A0 > R) / `below` (A/A0 <= R) by the Illinois method on Z,
 /// each orbit started from the cubic Hermite interpolation of the bracket's two orbits
-/// ([`hermite_state`]), or from the end nearer in Z if one of them has no tangent.
-fn refine(
+/// ([`hermite_state`]), or from the end nearer in Z if one of them has no tangent. `above`
+/// must lie at the larger `Z`; errors when the bracket holds a jump of `A/A0` (a fold). Also
+/// the ideal scan's last step onto its setpoint (`crate::scan`).
+pub(crate) fn refine_ratio_bracket(
     model: &TappingModel,
     search: &AmplitudeRatioSearch,
     settings: &SteadyOrbitSettings,

@@ -256,8 +256,6 @@ pub struct Sweep {
     rate_nm_per_us: f64,
     /// `|dZ|` per drive cycle, nm.
     z_step_nm: f64,
-    /// Drive period, us.
-    period: f64,
     /// Cycles in each direction.
     cycles_per_leg: u64,
     /// `Z` at the end of the approach (the retract's start), nm.
@@ -324,7 +322,6 @@ impl Sweep {
             model,
             rate_nm_per_us,
             z_step_nm,
-            period,
             cycles_per_leg,
             settings,
             cycles_done: 0,
@@ -465,28 +462,50 @@ impl Sweep {
     /// state, and return the lock-in's reading of it.
     fn run_cycle(&mut self, separation: Separation) -> Result<CycleReading, AfmError> {
         self.model.set_separation(separation)?;
-        let mut solver = Solver::with_workspace(
+        integrate_cycle(
             &self.model,
-            0.0,
-            &self.state,
-            Sensitivity::None,
-            self.settings.integration.clone(),
-            std::mem::take(&mut self.workspace),
-        )?;
-        self.lockin.begin(&self.model, &self.state);
-        loop {
-            let outcome = solver.step(self.period)?;
-            self.lockin.observe(&solver, &outcome);
-            if matches!(outcome, StepOutcome::EndTime) {
-                break;
-            }
-        }
-        let reading = self.lockin.finish(&self.model, solver.state());
-        self.state.copy_from_slice(solver.state());
-        self.workspace = solver.into_workspace();
-        debug_assert_eq!(self.state.len(), self.model.dim());
-        Ok(reading)
+            &self.settings.integration,
+            &mut self.state,
+            &mut self.workspace,
+            &mut self.lockin,
+        )
     }
+}
+
+/// Integrate one drive cycle (local time `[0, T]`) of `model` under its separation law from
+/// `state` (replaced by the state at the cycle's end), and return `lockin`'s reading of it
+/// (MODEL.md section 4). The solver's buffers are taken from `workspace` and given back, so
+/// that a sequence of cycles allocates nothing. Shared by the sweep and the time-domain scan
+/// (`crate::scan`).
+pub fn integrate_cycle(
+    model: &TappingModel,
+    integration: &Settings,
+    state: &mut [f64],
+    workspace: &mut SolverWorkspace,
+    lockin: &mut CycleLockIn,
+) -> Result<CycleReading, AfmError> {
+    let period = model.period_us();
+    let mut solver = Solver::with_workspace(
+        model,
+        0.0,
+        state,
+        Sensitivity::None,
+        integration.clone(),
+        std::mem::take(workspace),
+    )?;
+    lockin.begin(model, state);
+    loop {
+        let outcome = solver.step(period)?;
+        lockin.observe(&solver, &outcome);
+        if matches!(outcome, StepOutcome::EndTime) {
+            break;
+        }
+    }
+    let reading = lockin.finish(model, solver.state());
+    state.copy_from_slice(solver.state());
+    *workspace = solver.into_workspace();
+    debug_assert_eq!(state.len(), model.dim());
+    Ok(reading)
 }
 
 impl Iterator for Sweep {
