@@ -18,16 +18,17 @@ use serde::Serialize;
 use crate::error::AfmError;
 use crate::fit::measurement::{noise_sigma, MeasuredPoint};
 
-/// The exponent of the kink term `(c - Z)_+^beta`: a grazing with Hertz contact changes the
-/// observables as the 3/2 power of the distance past it (MODEL.md section 13.2).
-pub const KINK_EXPONENT: f64 = 1.5;
+/// The rounding widths tried when a kink is located, as fractions of the window's `Z` span: the
+/// kink term is a hinge whose slope change builds up linearly over the width `epsilon` below
+/// the onset `c` (a grazing's new impact grows from zero depth; MODEL.md section 13.2).
+pub const KINK_ROUNDING: [f64; 7] = [0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3];
 
 /// How transitions are searched for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DetectionSettings {
     /// Family-wise false-alarm probability on a smooth curve (default 0.01). In `(0, 0.5]`.
     pub significance: f64,
-    /// Rows on each side of a candidate in its window; 0 picks `clamp(n / 40, 12, 60)`.
+    /// Rows on each side of a candidate in its window; 0 picks `clamp(n / 25, 12, 80)`.
     pub half_window: usize,
 }
 
@@ -138,19 +139,45 @@ fn rss(design: &DMatrix<f64>, y: &DVector<f64>) -> f64 {
     }
 }
 
-/// The design matrix over rows `rows` of `z` centred at `c`: `1, u, u^2` (u scaled to the
-/// window) and, by `extra`, the kink `(c - Z)_+^{3/2}` or the step `H(c - Z)`.
-fn design(z: &[f64], c: f64, extra: Option<TransitionKind>) -> DMatrix<f64> {
+/// The term added to the smooth null at `c`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Extra {
+    /// The rounded hinge of width `epsilon` (a fraction of the window's span): with
+    /// `s = (c - Z) / span`, `0` above `c`, `s^2 / (2 epsilon)` for `0 < s < epsilon`, then
+    /// `s - epsilon / 2` (a sharp hinge for `epsilon = 0`).
+    Hinge(f64),
+    /// The step `H(c - Z)`.
+    Step,
+}
+
+/// The design matrix over the window's `z` centred at `c`: `1, u, u^2` (u scaled to the
+/// window) and, if any, the `extra` term (a hinge also frees the curvature below `c`:
+/// `(c - Z)_+^2`).
+fn design(z: &[f64], c: f64, extra: Option<Extra>) -> DMatrix<f64> {
     let scale = (z[0] - z[z.len() - 1]).abs().max(1e-300);
-    let columns = 3 + usize::from(extra.is_some());
+    let columns = match extra {
+        None => 3,
+        Some(Extra::Step) => 4,
+        Some(Extra::Hinge(_)) => 5,
+    };
     DMatrix::from_fn(z.len(), columns, |i, j| {
         let u = (z[i] - c) / scale;
         match j {
             0 => 1.0,
             1 => u,
             2 => u * u,
+            4 => u.min(0.0).powi(2),
             _ => match extra {
-                Some(TransitionKind::Kink) => (-u).max(0.0).powf(KINK_EXPONENT),
+                Some(Extra::Hinge(epsilon)) => {
+                    let s = -u;
+                    if s <= 0.0 {
+                        0.0
+                    } else if s < epsilon {
+                        s * s / (2.0 * epsilon)
+                    } else {
+                        s - 0.5 * epsilon
+                    }
+                }
                 _ => {
                     if u < 0.0 {
                         1.0
@@ -165,10 +192,10 @@ fn design(z: &[f64], c: f64, extra: Option<TransitionKind>) -> DMatrix<f64> {
 
 /// The drop of `chi^2` (both signals) from the quadratic null to the null plus `kind` at `c`
 /// over the window's rows, and the alternative's `chi^2`.
-fn statistic(signals: &Signals, range: std::ops::Range<usize>, c: f64, kind: TransitionKind) -> (f64, f64) {
+fn statistic(signals: &Signals, range: std::ops::Range<usize>, c: f64, extra: Extra) -> (f64, f64) {
     let z = &signals.z[range.clone()];
     let null = design(z, c, None);
-    let alternative = design(z, c, Some(kind));
+    let alternative = design(z, c, Some(extra));
     let (mut drop, mut chi2) = (0.0, 0.0);
     for values in &signals.values {
         let y = DVector::from_column_slice(&values[range.clone()]);
@@ -194,7 +221,7 @@ pub fn detect_transitions(
     sorted.sort_by(|a, b| b.z_nm.total_cmp(&a.z_nm));
     let n = sorted.len();
     let w = if settings.half_window == 0 {
-        (n / 40).clamp(12, 60)
+        (n / 25).clamp(12, 80)
     } else {
         settings.half_window
     };
@@ -219,15 +246,18 @@ pub fn detect_transitions(
     };
     // Candidate g lies between rows g and g + 1, window rows g + 1 - w ..= g + w.
     let candidates: Vec<usize> = (w - 1..n - w).collect();
-    let tests = 2 * candidates.len();
+    let tests = (KINK_ROUNDING.len() + 1) * candidates.len();
     let threshold = 2.0 * (tests as f64 / settings.significance).ln();
     let scores: Vec<(f64, TransitionKind)> = candidates
         .iter()
         .map(|&g| {
             let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
             let range = g + 1 - w..g + w + 1;
-            let (kink, _) = statistic(&signals, range.clone(), c, TransitionKind::Kink);
-            let (jump, _) = statistic(&signals, range, c, TransitionKind::Jump);
+            let kink = KINK_ROUNDING
+                .iter()
+                .map(|&epsilon| statistic(&signals, range.clone(), c, Extra::Hinge(epsilon)).0)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let (jump, _) = statistic(&signals, range, c, Extra::Step);
             if jump > kink {
                 (jump, TransitionKind::Jump)
             } else {
@@ -235,14 +265,15 @@ pub fn detect_transitions(
             }
         })
         .collect();
-    // Local maxima above the threshold, at least a window apart, strongest first.
+    // Local maxima above the threshold, strongest first; a candidate whose window holds a
+    // stronger chosen one (within 2 w rows) is that one's shadow.
     let mut order: Vec<usize> = (0..candidates.len())
         .filter(|&k| scores[k].0 > threshold)
         .collect();
     order.sort_by(|&a, &b| scores[b].0.total_cmp(&scores[a].0));
     let mut chosen: Vec<usize> = Vec::new();
     for k in order {
-        if chosen.iter().all(|&c| c.abs_diff(k) > w) {
+        if chosen.iter().all(|&c| c.abs_diff(k) > 2 * w) {
             chosen.push(k);
         }
     }
@@ -285,18 +316,23 @@ pub fn detect_transitions(
     })
 }
 
-/// The kink's `Z` and 1-sigma uncertainty: the minimum of the alternative's `chi^2` over the
-/// position `c` on a fine grid across the middle half of the window, and the half width of
-/// the interval where `chi^2 <= min + 1` (profile likelihood).
+/// The kink's onset `Z` and its 1-sigma uncertainty: the alternative's `chi^2`, minimised over
+/// the rounding width ([`KINK_ROUNDING`]), profiled over the onset `c` on a grid across the
+/// middle of the window; the onset is the minimum, the uncertainty the half width of the
+/// interval where `chi^2 <= min + 1` (profile likelihood).
 fn kink_profile(signals: &Signals, range: std::ops::Range<usize>, g: usize, w: usize) -> (f64, f64) {
     let z = &signals.z;
     let high = z[(g + 1).saturating_sub(w / 2).max(range.start)];
     let low = z[(g + w / 2).min(range.end - 1)];
-    let steps = 400;
+    let steps = 200;
     let profile: Vec<(f64, f64)> = (0..=steps)
         .map(|s| {
             let c = high + (low - high) * s as f64 / steps as f64;
-            (c, statistic(signals, range.clone(), c, TransitionKind::Kink).1)
+            let chi2 = KINK_ROUNDING
+                .iter()
+                .map(|&epsilon| statistic(signals, range.clone(), c, Extra::Hinge(epsilon)).1)
+                .fold(f64::INFINITY, f64::min);
+            (c, chi2)
         })
         .collect();
     let (best, minimum) = profile
