@@ -21,9 +21,12 @@ fn fit_seed(case: &Case, seed: u64) -> (FitResult, [f64; 4]) {
         ..SyntheticInstrument::default()
     };
     let points = synthetic_approach(&branch, model.free_amplitude_nm(), &instrument);
-    let measurement =
-        Measurement::parse(&to_csv(&points, &[]), "synthetic.csv", &MeasurementOptions::default())
-            .unwrap();
+    let measurement = Measurement::parse(
+        &to_csv(&points, &[]),
+        "synthetic.csv",
+        &MeasurementOptions::default(),
+    )
+    .unwrap();
     // The fit starts from a modulus 1.6 times too high.
     let mut start = case.clone();
     start.sample.youngs_modulus_gpa *= 1.6;
@@ -47,7 +50,9 @@ fn fit_seed(case: &Case, seed: u64) -> (FitResult, [f64; 4]) {
 fn within(result: &FitResult, truth: &[f64; 4], k: f64) -> [bool; 4] {
     let mut out = [false; 4];
     for (i, p) in result.parameters.iter().enumerate() {
-        out[i] = p.stderr.is_some_and(|s| (p.value - truth[i]).abs() <= k * s);
+        out[i] = p
+            .stderr
+            .is_some_and(|s| (p.value - truth[i]).abs() <= k * s);
     }
     out
 }
@@ -71,7 +76,11 @@ fn one_seed_recovers_the_truth_within_three_sigma() {
         let (result, truth) = fit_seed(&case, seed);
         assert!(result.converged, "{}", result.termination);
         for (i, ok) in within(&result, &truth, 3.0).iter().enumerate() {
-            assert!(ok, "seed {seed}: {:?} vs truth {}", result.parameters[i], truth[i]);
+            assert!(
+                ok,
+                "seed {seed}: {:?} vs truth {}",
+                result.parameters[i], truth[i]
+            );
         }
         assert!(
             (0.8..1.25).contains(&result.reduced_chi2),
@@ -108,7 +117,12 @@ fn coverage_over_twenty_seeds() {
             result
                 .parameters
                 .iter()
-                .map(|p| format!("{} = {:.4} +- {:.4}", p.name, p.value, p.stderr.unwrap_or(f64::NAN)))
+                .map(|p| format!(
+                    "{} = {:.4} +- {:.4}",
+                    p.name,
+                    p.value,
+                    p.stderr.unwrap_or(f64::NAN)
+                ))
                 .collect::<Vec<_>>()
                 .join(", "),
             result.reduced_chi2,

@@ -265,7 +265,9 @@ impl Problem<'_> {
         let a0 = model.free_amplitude_nm();
         let mut settings = DiagramSettings::approach(&model);
         settings.min_amplitude_ratio = 0.0;
-        settings.z_limit_nm = self.z_floor.clamp(-0.95 * a0, 0.9 * model.grazing_separation_nm());
+        settings.z_limit_nm = self
+            .z_floor
+            .clamp(-0.95 * a0, 0.9 * model.grazing_separation_nm());
         let branch = Rc::new(FollowedBranch::new(approach_diagram(&model, &settings)?));
         let mut cache = self.cache.borrow_mut();
         if cache.len() > 64 {
@@ -345,7 +347,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        self.residuals_at(&self.theta).map_err(|e| self.note(e)).ok()
+        self.residuals_at(&self.theta)
+            .map_err(|e| self.note(e))
+            .ok()
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
@@ -423,8 +427,16 @@ pub fn fit_measurement(
     let zs: Vec<f64> = points.iter().map(|p| p.z_nm).collect();
     let ratios: Vec<f64> = amplitudes.iter().map(|a| a / a0).collect();
     let model_z: Vec<f64> = start.diagram.points.iter().map(|p| p.z_nm).collect();
-    let model_ratio: Vec<f64> = start.diagram.points.iter().map(|p| p.amplitude_ratio).collect();
-    let z_offset = match (crossing(&zs, &ratios, 0.9), crossing(&model_z, &model_ratio, 0.9)) {
+    let model_ratio: Vec<f64> = start
+        .diagram
+        .points
+        .iter()
+        .map(|p| p.amplitude_ratio)
+        .collect();
+    let z_offset = match (
+        crossing(&zs, &ratios, 0.9),
+        crossing(&model_z, &model_ratio, 0.9),
+    ) {
         (Some(data), Some(model)) => data - model,
         _ => zs[0] - start.z_top(),
     };
@@ -462,7 +474,10 @@ pub fn fit_measurement(
         cache: RefCell::new(HashMap::new()),
         failure: RefCell::new(None),
     };
-    let patience = settings.max_evaluations.div_ceil(parameters.len() + 1).max(1);
+    let patience = settings
+        .max_evaluations
+        .div_ceil(parameters.len() + 1)
+        .max(1);
     let (problem, report) = LevenbergMarquardt::new()
         .with_patience(patience)
         .with_ftol(1e-7)
@@ -506,8 +521,16 @@ pub fn fit_measurement(
     let mut fitted = Vec::new();
     for (k, parameter) in parameters.iter().enumerate() {
         let raw = covariance[(k, k)].max(0.0).sqrt();
-        let value = if parameter.logarithmic() { theta[k].exp() } else { theta[k] };
-        let mut stderr = if parameter.logarithmic() { value * raw } else { raw };
+        let value = if parameter.logarithmic() {
+            theta[k].exp()
+        } else {
+            theta[k]
+        };
+        let mut stderr = if parameter.logarithmic() {
+            value * raw
+        } else {
+            raw
+        };
         if *parameter == FitParameter::AmplitudeCalibration {
             // The data fix the true A0 = A0_measured / c: the error of the measured A0 is the
             // calibration's too.

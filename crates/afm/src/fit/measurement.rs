@@ -62,7 +62,12 @@ impl LengthUnit {
                     ))
                 }
             },
-            _ => return Err(invalid(format!("{text:?}"), "one of nm, um, m, V (with --invols)")),
+            _ => {
+                return Err(invalid(
+                    format!("{text:?}"),
+                    "one of nm, um, m, V (with --invols)",
+                ))
+            }
         };
         if invols_nm_per_v.is_some() && !matches!(unit, Self::Volt(_)) {
             return Err(invalid(
@@ -225,8 +230,8 @@ impl Measurement {
     /// column, fewer than [`MIN_ROWS`] valid rows, amplitudes that the unit makes implausible
     /// (`A0` outside `[0.01, 10000]` nm), no free part.
     pub fn parse(text: &str, source: &str, options: &MeasurementOptions) -> Result<Self, AfmError> {
-        let error = |line: usize, field: &str, value: String, allowed: String| {
-            AfmError::InvalidField {
+        let error =
+            |line: usize, field: &str, value: String, allowed: String| AfmError::InvalidField {
                 file: if line > 0 {
                     format!("{source} line {line}")
                 } else {
@@ -235,14 +240,15 @@ impl Measurement {
                 field: field.to_string(),
                 value,
                 allowed,
-            }
-        };
+            };
         if matches!(options.z_unit, LengthUnit::Volt(_)) {
             return Err(error(
                 0,
                 "--z-unit",
                 String::from("V"),
-                String::from("nm, um or m (convert a piezo voltage with the scanner's sensitivity first)"),
+                String::from(
+                    "nm, um or m (convert a piezo voltage with the scanner's sensitivity first)",
+                ),
             ));
         }
         let mut lines = text
@@ -251,7 +257,12 @@ impl Measurement {
             .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
             .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
         let (header_line, header) = lines.next().ok_or_else(|| {
-            error(0, "header", String::from("none"), String::from("a header line naming the columns, then one row per point"))
+            error(
+                0,
+                "header",
+                String::from("none"),
+                String::from("a header line naming the columns, then one row per point"),
+            )
         })?;
         let separator = if header.contains('\t') {
             '\t'
@@ -282,16 +293,27 @@ impl Measurement {
             index_of(&options.amplitude_column)?,
             index_of(&options.phase_column)?,
         ];
-        let column_names = [&options.z_column, &options.amplitude_column, &options.phase_column];
+        let column_names = [
+            &options.z_column,
+            &options.amplitude_column,
+            &options.phase_column,
+        ];
         let scale = [
             options.z_unit.nm_per_unit(),
             options.amplitude_unit.nm_per_unit(),
-            if options.phase_in_radians { 180.0 / std::f64::consts::PI } else { 1.0 },
+            if options.phase_in_radians {
+                180.0 / std::f64::consts::PI
+            } else {
+                1.0
+            },
         ];
         let mut rows: Vec<MeasuredPoint> = Vec::new();
         let mut bad_rows: Vec<BadRow> = Vec::new();
         for (line, text) in lines {
-            let fields: Vec<&str> = text.split(separator).map(|s| s.trim().trim_matches('"')).collect();
+            let fields: Vec<&str> = text
+                .split(separator)
+                .map(|s| s.trim().trim_matches('"'))
+                .collect();
             let mut values = [0.0; 3];
             let mut fault: Option<BadRow> = None;
             for k in 0..3 {
@@ -299,7 +321,11 @@ impl Measurement {
                     fault = Some(BadRow {
                         line,
                         column: Some(column_names[k].clone()),
-                        reason: format!("the row has {} fields, the header {}", fields.len(), names.len()),
+                        reason: format!(
+                            "the row has {} fields, the header {}",
+                            fields.len(),
+                            names.len()
+                        ),
                     });
                     break;
                 };
@@ -332,12 +358,17 @@ impl Measurement {
                 }),
             }
         }
-        let (approach, retract, unordered) = split_sweeps(rows, &mut bad_rows, &column_names[0].clone());
+        let (approach, retract, unordered) =
+            split_sweeps(rows, &mut bad_rows, &column_names[0].clone());
         if approach.len() < MIN_ROWS {
             return Err(error(
                 0,
                 "rows",
-                format!("{} valid approach rows ({} bad rows)", approach.len(), bad_rows.len()),
+                format!(
+                    "{} valid approach rows ({} bad rows)",
+                    approach.len(),
+                    bad_rows.len()
+                ),
                 format!("at least {MIN_ROWS} valid rows on the approach"),
             ));
         }
@@ -346,7 +377,12 @@ impl Measurement {
                 if !(a0.is_finite() && a0 > 0.0) {
                     return Err(error(0, "--a0", a0.to_string(), String::from("> 0, nm")));
                 }
-                (a0, 0.0, FreeAmplitudeSource::Given, count_free_rows(&approach, a0))
+                (
+                    a0,
+                    0.0,
+                    FreeAmplitudeSource::Given,
+                    count_free_rows(&approach, a0),
+                )
             }
             None => {
                 let (a0, stderr, count) = free_amplitude(&approach).ok_or_else(|| {
@@ -367,7 +403,9 @@ impl Measurement {
                 0,
                 &options.amplitude_column,
                 format!("A0 = {a0_nm:e} nm"),
-                String::from("A0 in [0.01, 10000] nm: check --amplitude-unit (nm, um, m, V with --invols)"),
+                String::from(
+                    "A0 in [0.01, 10000] nm: check --amplitude-unit (nm, um, m, V with --invols)",
+                ),
             ));
         }
         Ok(Self {
@@ -399,8 +437,22 @@ fn split_sweeps(
         return (rows, Vec::new(), false);
     }
     let steps: Vec<f64> = rows.windows(2).map(|w| w[1].z_nm - w[0].z_nm).collect();
-    let signs: Vec<i8> = steps.iter().map(|s| if *s > 0.0 { 1 } else if *s < 0.0 { -1 } else { 0 }).collect();
-    let changes = signs.windows(2).filter(|w| w[0] != w[1] && w[0] != 0 && w[1] != 0).count();
+    let signs: Vec<i8> = steps
+        .iter()
+        .map(|s| {
+            if *s > 0.0 {
+                1
+            } else if *s < 0.0 {
+                -1
+            } else {
+                0
+            }
+        })
+        .collect();
+    let changes = signs
+        .windows(2)
+        .filter(|w| w[0] != w[1] && w[0] != 0 && w[1] != 0)
+        .count();
     if changes as f64 > 0.1 * steps.len() as f64 {
         let mut sorted = rows;
         sorted.sort_by(|a, b| b.z_nm.total_cmp(&a.z_nm));
@@ -433,7 +485,11 @@ fn split_sweeps(
         let approach = keep_strict(approach, -1.0, bad_rows, z_column);
         (approach, retract, false)
     } else {
-        let direction = if rows[n - 1].z_nm < rows[0].z_nm { -1.0 } else { 1.0 };
+        let direction = if rows[n - 1].z_nm < rows[0].z_nm {
+            -1.0
+        } else {
+            1.0
+        };
         let mut approach = keep_strict(rows, direction, bad_rows, z_column);
         if direction > 0.0 {
             approach.reverse();
@@ -481,7 +537,10 @@ pub fn noise_sigma(values: &[f64]) -> f64 {
     if values.len() < 3 {
         return 0.0;
     }
-    let mut second: Vec<f64> = values.windows(3).map(|w| w[0] - 2.0 * w[1] + w[2]).collect();
+    let mut second: Vec<f64> = values
+        .windows(3)
+        .map(|w| w[0] - 2.0 * w[1] + w[2])
+        .collect();
     let centre = median(&mut second);
     let mut deviations: Vec<f64> = second.iter().map(|d| (d - centre).abs()).collect();
     1.4826 * median(&mut deviations) / 6f64.sqrt()
@@ -527,5 +586,8 @@ fn free_amplitude(approach: &[MeasuredPoint]) -> Option<(f64, f64, usize)> {
 fn count_free_rows(approach: &[MeasuredPoint], a0: f64) -> usize {
     let amplitudes: Vec<f64> = approach.iter().map(|p| p.amplitude_nm).collect();
     let tolerance = (4.0 * noise_sigma(&amplitudes)).max(0.005 * a0);
-    amplitudes.iter().take_while(|a| (*a - a0).abs() <= tolerance).count()
+    amplitudes
+        .iter()
+        .take_while(|a| (*a - a0).abs() <= tolerance)
+        .count()
 }

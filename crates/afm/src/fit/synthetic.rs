@@ -88,8 +88,11 @@ pub fn synthetic_approach(
             MeasuredPoint {
                 line: i + 2,
                 z_nm: z + instrument.z_offset_nm,
-                amplitude_nm: reported_a0 * (ratio + instrument.amplitude_noise_fraction * gaussian(&mut rng)),
-                phase_deg: phase + instrument.phase_offset_deg + instrument.phase_noise_deg * gaussian(&mut rng),
+                amplitude_nm: reported_a0
+                    * (ratio + instrument.amplitude_noise_fraction * gaussian(&mut rng)),
+                phase_deg: phase
+                    + instrument.phase_offset_deg
+                    + instrument.phase_noise_deg * gaussian(&mut rng),
             }
         })
         .collect()
@@ -104,7 +107,10 @@ pub fn to_csv(points: &[MeasuredPoint], comments: &[String]) -> String {
     }
     text.push_str("z_nm,amplitude_nm,phase_deg\n");
     for p in points {
-        text.push_str(&format!("{:.5},{:.5},{:.4}\n", p.z_nm, p.amplitude_nm, p.phase_deg));
+        text.push_str(&format!(
+            "{:.5},{:.5},{:.4}\n",
+            p.z_nm, p.amplitude_nm, p.phase_deg
+        ));
     }
     text
 }

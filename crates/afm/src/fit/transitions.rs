@@ -320,7 +320,12 @@ pub fn detect_transitions(
 /// the rounding width ([`KINK_ROUNDING`]), profiled over the onset `c` on a grid across the
 /// middle of the window; the onset is the minimum, the uncertainty the half width of the
 /// interval where `chi^2 <= min + 1` (profile likelihood).
-fn kink_profile(signals: &Signals, range: std::ops::Range<usize>, g: usize, w: usize) -> (f64, f64) {
+fn kink_profile(
+    signals: &Signals,
+    range: std::ops::Range<usize>,
+    g: usize,
+    w: usize,
+) -> (f64, f64) {
     let z = &signals.z;
     let high = z[(g + 1).saturating_sub(w / 2).max(range.start)];
     let low = z[(g + w / 2).min(range.end - 1)];
@@ -352,12 +357,20 @@ fn kink_profile(signals: &Signals, range: std::ops::Range<usize>, g: usize, w: u
 }
 
 /// `A/A0` and phase of the window's null (quadratic) fit on the upper side at `z`.
-fn smooth_value(signals: &Signals, range: std::ops::Range<usize>, z: f64, sigma: [f64; 2]) -> (f64, f64) {
+fn smooth_value(
+    signals: &Signals,
+    range: std::ops::Range<usize>,
+    z: f64,
+    sigma: [f64; 2],
+) -> (f64, f64) {
     let rows: Vec<usize> = range.filter(|&i| signals.z[i] >= z).collect();
     let zs: Vec<f64> = rows.iter().map(|&i| signals.z[i]).collect();
     if zs.len() < 3 {
         let i = rows.last().copied().unwrap_or(0);
-        return (signals.values[0][i] * sigma[0], signals.values[1][i] * sigma[1]);
+        return (
+            signals.values[0][i] * sigma[0],
+            signals.values[1][i] * sigma[1],
+        );
     }
     let d = design(&zs, z, None);
     let mut out = [0.0; 2];
