@@ -10,9 +10,12 @@ use clap::Args;
 use serde_json::{json, Map, Value};
 use std::path::PathBuf;
 
+use crate::fit_figure::fit_panels;
 use crate::measurement_args::MeasurementArgs;
 use crate::model_args::ModelArgs;
 use crate::output::{check_writable, print_stdout, push_csv_row, write_atomically};
+use crate::plot::file::FigureFile;
+use crate::plot::render_svg;
 
 /// Options of `drumroll fit`.
 #[derive(Debug, Clone, Args)]
@@ -43,6 +46,10 @@ pub struct FitArgs {
     /// CSV file.
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
+    /// Draw the data, the fitted branch, the detected transitions (T1, T2, ...) and the fitted
+    /// G_n against A/A0 and against Z, with the residuals; .svg, .png or .pdf.
+    #[arg(long, value_name = "FILE.svg|png|pdf")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Run `drumroll fit`.
@@ -54,6 +61,11 @@ pub fn run(args: &FitArgs) -> Result<()> {
     if let Some(path) = &args.csv {
         check_writable(path, "--csv")?;
     }
+    let figure = args
+        .plot
+        .as_ref()
+        .map(|path| FigureFile::new(path, "--plot"))
+        .transpose()?;
     if !(1..=10_000).contains(&args.max_evaluations) {
         anyhow::bail!(
             "command line: field `--max-evaluations` = {} is invalid; allowed: [1, 10000]",
@@ -81,9 +93,16 @@ pub fn run(args: &FitArgs) -> Result<()> {
     }
     // Each fitted G_n with the nearest detected transition, and their distance in units of the
     // transition's sigma.
+    let (z_low, z_high) = measurement
+        .approach
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.z_nm), hi.max(p.z_nm))
+        });
     let matched: Vec<Value> = result
         .grazing
         .iter()
+        .filter(|g| g.label.starts_with('G') && (z_low..=z_high).contains(&g.z_nm))
         .filter_map(|g| {
             let (index, t) = detection.transitions.iter().enumerate().min_by(|a, b| {
                 (a.1.z_nm - g.z_nm)
@@ -132,6 +151,15 @@ pub fn run(args: &FitArgs) -> Result<()> {
             push_csv_row(&mut text, &point["line"].to_string(), point, &columns);
         }
         write_atomically(path, text.as_bytes())?;
+    }
+    if let Some(figure) = figure {
+        let panels = fit_panels(
+            &case.name,
+            measurement.a0_nm,
+            &result,
+            &detection.transitions,
+        );
+        figure.write(&render_svg(&panels, 2, 2, (640, 480))?)?;
     }
     if args.json {
         let object = json!({

@@ -12,6 +12,7 @@ pub mod detect;
 pub mod digits;
 pub mod exit_status;
 pub mod fit;
+pub mod fit_figure;
 pub mod grid;
 pub mod grid_file;
 pub mod grid_overlay;
