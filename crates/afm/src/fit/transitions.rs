@@ -7,10 +7,10 @@
 //! quadratic in `Z` (the smooth null), and by the quadratic plus a kink term
 //! `(c - Z)_+^{3/2}` (the shape of a grazing with Hertz contact) or plus a step `H(c - Z)`,
 //! for `A/A0` and phase together, each weighted by its noise (from second differences). The
-//! drop of `chi^2` from the null is `chi^2` with 2 degrees of freedom on a smooth curve with
-//! white Gaussian noise; its tail is `exp(-T/2)`, and over `M` tests (two per gap) the
-//! Bonferroni bound `M exp(-T/2)` bounds the probability that any test on a smooth curve
-//! exceeds `T`. A transition is reported where that bound is below the significance level.
+//! drop `T` of `chi^2` from the null is `chi^2` with 4 (kink: hinge and curvature below `c`
+//! per signal) or 2 (jump) degrees of freedom on a smooth curve with white Gaussian noise, and
+//! over `M` tests the Bonferroni bound `M P(T)` bounds the probability that any test on a
+//! smooth curve exceeds its `T`. A transition is reported where that bound is below the significance level.
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -100,8 +100,9 @@ pub struct Transition {
     pub phase_deg: f64,
     /// Kink or jump.
     pub kind: TransitionKind,
-    /// The family-wise false-alarm probability `min(1, M exp(-T/2))` of its statistic: the
-    /// chance that a smooth curve gives one as large anywhere (smaller is more significant).
+    /// The family-wise false-alarm probability `min(1, M P(T))` of its statistic, `P` the tail
+    /// of `chi^2` with 4 (kink) or 2 (jump) degrees of freedom: the chance that a smooth curve
+    /// gives one as large anywhere (smaller is more significant).
     pub significance: f64,
     /// The statistic `T` (drop of `chi^2` from the smooth null).
     pub statistic: f64,
@@ -118,7 +119,8 @@ pub struct Detection {
     pub half_window: usize,
     /// Tests made (`M`).
     pub tests: usize,
-    /// The threshold on `T`, `2 ln(M / significance)`.
+    /// The threshold on a jump's `T`, `2 ln(M / significance)` (a kink's is higher: its tail
+    /// is `exp(-T/2) (1 + T/2)`).
     pub threshold: f64,
     /// The transitions by decreasing `Z`.
     pub transitions: Vec<Transition>,
@@ -248,7 +250,10 @@ pub fn detect_transitions(
     let candidates: Vec<usize> = (w - 1..n - w).collect();
     let tests = (KINK_ROUNDING.len() + 1) * candidates.len();
     let threshold = 2.0 * (tests as f64 / settings.significance).ln();
-    let scores: Vec<(f64, TransitionKind)> = candidates
+    // Per candidate: the larger alternative's statistic, its kind and its single-test tail
+    // probability (kink: chi^2 with 4 degrees of freedom, the hinge and the free curvature for
+    // each signal; jump: chi^2 with 2).
+    let scores: Vec<(f64, TransitionKind, f64)> = candidates
         .iter()
         .map(|&g| {
             let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
@@ -258,19 +263,21 @@ pub fn detect_transitions(
                 .map(|&epsilon| statistic(&signals, range.clone(), c, Extra::Hinge(epsilon)).0)
                 .fold(f64::NEG_INFINITY, f64::max);
             let (jump, _) = statistic(&signals, range, c, Extra::Step);
-            if jump > kink {
-                (jump, TransitionKind::Jump)
+            let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
+            let jump_tail = (-0.5 * jump).exp();
+            if jump_tail < kink_tail {
+                (jump, TransitionKind::Jump, jump_tail)
             } else {
-                (kink, TransitionKind::Kink)
+                (kink, TransitionKind::Kink, kink_tail)
             }
         })
         .collect();
     // Local maxima above the threshold, strongest first; a candidate whose window holds a
     // stronger chosen one (within 2 w rows) is that one's shadow.
     let mut order: Vec<usize> = (0..candidates.len())
-        .filter(|&k| scores[k].0 > threshold)
+        .filter(|&k| tests as f64 * scores[k].2 < settings.significance)
         .collect();
-    order.sort_by(|&a, &b| scores[b].0.total_cmp(&scores[a].0));
+    order.sort_by(|&a, &b| scores[a].2.total_cmp(&scores[b].2));
     let mut chosen: Vec<usize> = Vec::new();
     for k in order {
         if chosen.iter().all(|&c| c.abs_diff(k) > 2 * w) {
@@ -281,7 +288,7 @@ pub fn detect_transitions(
         .into_iter()
         .map(|k| {
             let g = candidates[k];
-            let (score, kind) = scores[k];
+            let (score, kind, tail) = scores[k];
             let range = g + 1 - w..g + w + 1;
             let (z_nm, z_uncertainty_nm) = match kind {
                 TransitionKind::Jump => (
@@ -297,7 +304,7 @@ pub fn detect_transitions(
                 amplitude_ratio: ratio,
                 phase_deg: phase,
                 kind,
-                significance: (tests as f64 * (-0.5 * score).exp()).min(1.0),
+                significance: (tests as f64 * tail).min(1.0),
                 statistic: score,
             }
         })
