@@ -1,10 +1,11 @@
 //! `drumroll detect`: the transitions (kinks and jumps) of a measured approach curve with their
 //! Z, 1-sigma uncertainty, A/A0, phase and significance (MODEL.md section 13.2).
 
-use afm::fit::transitions::{detect_transitions, DetectionSettings};
+use afm::fit::measurement::Measurement;
+use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings};
 use anyhow::Result;
 use clap::Args;
-use serde_json::json;
+use serde_json::{json, Value};
 
 use crate::measurement_args::MeasurementArgs;
 use crate::output::print_stdout;
@@ -30,6 +31,23 @@ pub struct DetectArgs {
     pub json: bool,
 }
 
+/// The JSON of `drumroll detect --json` (docs/output-schema.md): `A0`, the noise, the test
+/// counts and threshold, the bad rows and the transitions.
+pub fn detect_json(measurement: &Measurement, detection: &Detection, significance: f64) -> Value {
+    json!({
+        "a0_nm": detection.a0_nm,
+        "a0_stderr_nm": measurement.a0_stderr_nm,
+        "noise": detection.noise,
+        "significance_level": significance,
+        "tests": detection.tests,
+        "threshold": detection.threshold,
+        "half_window": detection.half_window,
+        "rows": measurement.approach.len(),
+        "bad_rows": measurement.bad_rows,
+        "transitions": detection.transitions,
+    })
+}
+
 /// Run `drumroll detect`.
 ///
 /// # Errors
@@ -43,18 +61,7 @@ pub fn run(args: &DetectArgs) -> Result<()> {
     settings.validate("command line")?;
     let detection = detect_transitions(&measurement.approach, measurement.a0_nm, &settings)?;
     if args.json {
-        let object = json!({
-            "a0_nm": detection.a0_nm,
-            "a0_stderr_nm": measurement.a0_stderr_nm,
-            "noise": detection.noise,
-            "significance_level": args.significance,
-            "tests": detection.tests,
-            "threshold": detection.threshold,
-            "half_window": detection.half_window,
-            "rows": measurement.approach.len(),
-            "bad_rows": measurement.bad_rows,
-            "transitions": detection.transitions,
-        });
+        let object = detect_json(&measurement, &detection, args.significance);
         print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;
     } else {
         let mut text = format!(

@@ -3,8 +3,9 @@
 //! correlations, the fitted grazing points in data coordinates and their match with the
 //! detected transitions, and the contrast observables at every measured point.
 
-use afm::fit::least_squares::{fit_measurement, FitParameter, FitSettings};
-use afm::fit::transitions::{detect_transitions, DetectionSettings};
+use afm::fit::least_squares::{fit_measurement, FitParameter, FitResult, FitSettings};
+use afm::fit::measurement::Measurement;
+use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings};
 use anyhow::Result;
 use clap::Args;
 use serde_json::{json, Map, Value};
@@ -52,45 +53,14 @@ pub struct FitArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// Run `drumroll fit`.
-///
-/// # Errors
-/// A bad file or option, a model that cannot be built or continued.
-pub fn run(args: &FitArgs) -> Result<()> {
-    let case = args.model.case()?;
-    if let Some(path) = &args.csv {
-        check_writable(path, "--csv")?;
-    }
-    let figure = args
-        .plot
-        .as_ref()
-        .map(|path| FigureFile::new(path, "--plot"))
-        .transpose()?;
-    if !(1..=10_000).contains(&args.max_evaluations) {
-        anyhow::bail!(
-            "command line: field `--max-evaluations` = {} is invalid; allowed: [1, 10000]",
-            args.max_evaluations
-        );
-    }
-    let modes = case.cantilever.mode_count();
-    let parameters = args
-        .fit
-        .split(',')
-        .filter(|s| !s.trim().is_empty())
-        .map(|name| FitParameter::parse(name, modes))
-        .collect::<Result<Vec<_>, _>>()?;
-    let measurement = args.measurement.read(args.model.a0)?;
-    let mut settings = FitSettings::new(parameters);
-    settings.max_evaluations = args.max_evaluations;
-    let result = fit_measurement(&case, &measurement, &settings)?;
-    let detection = detect_transitions(
-        &measurement.approach,
-        measurement.a0_nm,
-        &DetectionSettings::default(),
-    )?;
-    for warning in &result.warnings {
-        eprintln!("drumroll: warning: {warning}");
-    }
+/// The JSON of `drumroll fit --json` (docs/output-schema.md) for `result`, with `detection`'s
+/// transitions and their match with the fitted `G_n`.
+pub fn fit_json(
+    case_name: &str,
+    measurement: &Measurement,
+    result: &FitResult,
+    detection: &Detection,
+) -> Value {
     // Each fitted G_n with the nearest detected transition, and their distance in units of the
     // transition's sigma.
     let (z_low, z_high) = measurement
@@ -131,6 +101,72 @@ pub fn run(args: &FitArgs) -> Result<()> {
         .iter()
         .map(|p| serde_json::to_value(p).expect("plain numbers"))
         .collect();
+    json!({
+        "data": measurement.source,
+        "case": case_name,
+        "a0_nm": measurement.a0_nm,
+        "parameters": parameters,
+        "names": result.parameters.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
+        "correlations": result.correlations,
+        "residual_rms": {
+            "amplitude_nm": result.residual_rms_amplitude_nm,
+            "phase_deg": result.residual_rms_phase_deg,
+        },
+        "reduced_chi2": result.reduced_chi2,
+        "noise": { "amplitude_nm": result.noise[0], "phase_deg": result.noise[1] },
+        "grazing": result.grazing,
+        "transitions": detection.transitions,
+        "matched": matched,
+        "evaluations": result.evaluations,
+        "termination": result.termination,
+        "converged": result.converged,
+        "warnings": result.warnings,
+        "bad_rows": measurement.bad_rows,
+        "points": points,
+    })
+}
+
+/// Run `drumroll fit`.
+///
+/// # Errors
+/// A bad file or option, a model that cannot be built or continued.
+pub fn run(args: &FitArgs) -> Result<()> {
+    let case = args.model.case()?;
+    if let Some(path) = &args.csv {
+        check_writable(path, "--csv")?;
+    }
+    let figure = args
+        .plot
+        .as_ref()
+        .map(|path| FigureFile::new(path, "--plot"))
+        .transpose()?;
+    if !(1..=10_000).contains(&args.max_evaluations) {
+        anyhow::bail!(
+            "command line: field `--max-evaluations` = {} is invalid; allowed: [1, 10000]",
+            args.max_evaluations
+        );
+    }
+    let modes = case.cantilever.mode_count();
+    let parameters = args
+        .fit
+        .split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|name| FitParameter::parse(name, modes))
+        .collect::<Result<Vec<_>, _>>()?;
+    let measurement = args.measurement.read(args.model.a0)?;
+    let mut settings = FitSettings::new(parameters);
+    settings.max_evaluations = args.max_evaluations;
+    let result = fit_measurement(&case, &measurement, &settings)?;
+    let detection = detect_transitions(
+        &measurement.approach,
+        measurement.a0_nm,
+        &DetectionSettings::default(),
+    )?;
+    let object = fit_json(&case.name, &measurement, &result, &detection);
+    for warning in &result.warnings {
+        eprintln!("drumroll: warning: {warning}");
+    }
+    let points = object["points"].as_array().cloned().unwrap_or_default();
     if let Some(path) = &args.csv {
         let columns = [
             "z_nm",
@@ -162,29 +198,6 @@ pub fn run(args: &FitArgs) -> Result<()> {
         figure.write(&render_svg(&panels, 2, 2, (640, 480))?)?;
     }
     if args.json {
-        let object = json!({
-            "data": measurement.source,
-            "case": case.name,
-            "a0_nm": measurement.a0_nm,
-            "parameters": parameters,
-            "names": result.parameters.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
-            "correlations": result.correlations,
-            "residual_rms": {
-                "amplitude_nm": result.residual_rms_amplitude_nm,
-                "phase_deg": result.residual_rms_phase_deg,
-            },
-            "reduced_chi2": result.reduced_chi2,
-            "noise": { "amplitude_nm": result.noise[0], "phase_deg": result.noise[1] },
-            "grazing": result.grazing,
-            "transitions": detection.transitions,
-            "matched": matched,
-            "evaluations": result.evaluations,
-            "termination": result.termination,
-            "converged": result.converged,
-            "warnings": result.warnings,
-            "bad_rows": measurement.bad_rows,
-            "points": points,
-        });
         print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;
     } else {
         let mut text = format!(
