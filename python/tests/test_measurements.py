@@ -35,11 +35,11 @@ def test_bad_files_raise_value_errors_naming_the_column(tmp_path):
 def test_fit_equals_the_cli_and_recovers_the_offset():
     measurement = drumroll.Measurement.from_csv(str(FIXTURE))
     case = drumroll.Case("maclever-mica-experiment")
-    result = case.fit(measurement, fit=["z-offset", "phase-offset"])
+    result = case.fit(measurement, fit=["z-offset", "amplitude-calibration", "phase-offset"])
     theirs = json.loads(
         run_cli(
             "fit", "--data", str(FIXTURE), "--case", "maclever-mica-experiment",
-            "--fit", "z-offset,phase-offset", "--json",
+            "--fit", "z-offset,amplitude-calibration,phase-offset", "--json",
         ).stdout
     )
     assert result.to_dict() == theirs
