@@ -20,6 +20,7 @@
 pub mod contact;
 pub mod diagram;
 pub mod error;
+pub mod fit;
 pub mod fixtures;
 mod json_path;
 pub mod map;

@@ -52,6 +52,12 @@ enum Command {
     /// The Euler-Bernoulli modal table of a cantilever with a point tip mass, and a cantilever
     /// file built from measured k_1, frequencies and quality factors.
     Cantilever(drumroll::cantilever::CantileverArgs),
+    /// The transitions of a measured approach curve: kinks (a grazing G_n) and jumps, each
+    /// with its Z, 1-sigma uncertainty, A/A0, phase and significance (MODEL.md section 13).
+    Detect(drumroll::detect::DetectArgs),
+    /// Fit the model's approach branch to a measured curve: piezo offset, amplitude
+    /// calibration, phase offset, sample modulus, ... with standard errors (MODEL.md section 13).
+    Fit(drumroll::fit::FitArgs),
     /// The built-in cases, cantilevers and samples with their key parameters; `cases show NAME`
     /// prints one file to copy and edit.
     Cases(drumroll::cases::CasesArgs),
@@ -74,6 +80,8 @@ fn main() -> ExitCode {
         Command::Grid(args) => drumroll::grid::run(args),
         Command::Cantilever(args) => drumroll::cantilever::run(args),
         Command::Cases(args) => drumroll::cases::run(args),
+        Command::Detect(args) => drumroll::detect::run(args),
+        Command::Fit(args) => drumroll::fit::run(args),
         Command::Completions(args) => drumroll::shell::completions(args, Cli::command()),
         Command::Man(args) => drumroll::shell::man(args, Cli::command()),
     };

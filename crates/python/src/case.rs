@@ -256,6 +256,21 @@ impl Case {
         crate::diagram::compute_diagram(py, &self.resolved, &options)
     }
 
+    /// Fit this case's approach branch to `measurement` (a `drumroll.Measurement`) over the
+    /// parameters in `fit` (`z-offset`, `amplitude-calibration`, `phase-offset`,
+    /// `sample-modulus`, `tip-radius`, ...), as `drumroll fit` (MODEL.md section 13.3):
+    /// a `drumroll.FitResult`. Runs without the GIL.
+    #[pyo3(signature = (measurement, *, fit=vec![String::from("z-offset"), String::from("phase-offset"), String::from("sample-modulus")], max_evaluations=40))]
+    fn fit(
+        &self,
+        py: Python<'_>,
+        measurement: &crate::measurement::Measurement,
+        fit: Vec<String>,
+        max_evaluations: usize,
+    ) -> PyResult<crate::measurement::FitResult> {
+        crate::measurement::fit_case(py, &self.resolved, measurement, fit, max_evaluations)
+    }
+
     /// A time-domain approach sweep as in the lab, as `drumroll approach`: Z falls from
     /// `from_nm` (default 0.2 nm above first contact) to `to_nm` (nm, default 0) at
     /// `rate_nm_per_s` (nm/s, default the paper's 1), read by a lock-in over blocks of

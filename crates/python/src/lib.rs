@@ -11,6 +11,7 @@ pub mod convert;
 pub mod diagram;
 pub mod errors;
 pub mod interrupt;
+pub mod measurement;
 pub mod orbit;
 pub mod regime_map;
 pub mod resolved;
@@ -70,6 +71,8 @@ fn drumroll_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<orbit::Orbit>()?;
     m.add_class::<diagram::Diagram>()?;
     m.add_class::<regime_map::RegimeMap>()?;
+    m.add_class::<measurement::Measurement>()?;
+    m.add_class::<measurement::FitResult>()?;
     m.add_function(wrap_pyfunction!(cases, m)?)?;
     m.add_function(wrap_pyfunction!(orbit::_restore_orbit, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

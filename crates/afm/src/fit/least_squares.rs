@@ -1,0 +1,631 @@
+//! Fitting the model's followed approach branch to a measured curve (MODEL.md section 13.3):
+//! weighted least squares of the measured amplitude and phase over the piezo offset, the
+//! amplitude calibration, the phase offset and any of the map's case parameters, by
+//! Levenberg-Marquardt (the `levenberg-marquardt` crate), with standard errors and correlations
+//! from the Jacobian at the optimum (MODEL.md section 13.4).
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::rc::Rc;
+
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::storage::Owned;
+use nalgebra::{DMatrix, DVector, Dyn};
+use serde::Serialize;
+
+use crate::diagram::bifurcation_diagram::{approach_diagram, DiagramPoint, DiagramSettings};
+use crate::error::AfmError;
+use crate::fit::followed_branch::{FollowedBranch, Reading};
+use crate::fit::measurement::{noise_sigma, MeasuredPoint, Measurement};
+use crate::map::parameter_axis::ParameterAxis;
+use crate::model::case::Case;
+use crate::model::TappingModel;
+
+/// A fitted quantity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FitParameter {
+    /// `z_offset`, nm: drumroll's `Z = Z_data - z_offset` (`z-offset`).
+    ZOffset,
+    /// `c`: the instrument reports `c A` and `c A0` (`amplitude-calibration`).
+    AmplitudeCalibration,
+    /// `phase_data = phase + offset`, degrees (`phase-offset`).
+    PhaseOffset,
+    /// A case parameter of the regime map (`sample-modulus`, `tip-radius`, ...).
+    Case(ParameterAxis),
+}
+
+impl FitParameter {
+    /// Parse a `--fit` name: `z-offset`, `amplitude-calibration`, `phase-offset`, or a name of
+    /// [`crate::map::parameter_axis::PARAMETER_NAMES`] other than `a0` (the free amplitude is
+    /// the measured one over the calibration).
+    ///
+    /// # Errors
+    /// [`AfmError::InvalidField`] naming `--fit` and the allowed names.
+    pub fn parse(name: &str, modes: usize) -> Result<Self, AfmError> {
+        match name.trim() {
+            "z-offset" => Ok(Self::ZOffset),
+            "amplitude-calibration" => Ok(Self::AmplitudeCalibration),
+            "phase-offset" => Ok(Self::PhaseOffset),
+            other => match ParameterAxis::parse(other, modes) {
+                Ok(ParameterAxis::FreeAmplitude) | Err(_) => Err(AfmError::InvalidField {
+                    file: String::from("command line"),
+                    field: String::from("--fit"),
+                    value: format!("{other:?}"),
+                    allowed: format!(
+                        "a comma-separated list of z-offset, amplitude-calibration, phase-offset, drive-frequency, sample-modulus, tip-radius, quality-factor-N, stiffness-N (N from 1 to {modes})"
+                    ),
+                }),
+                Ok(axis) => Ok(Self::Case(axis)),
+            },
+        }
+    }
+
+    /// The output key: `z_offset_nm`, `amplitude_calibration`, `phase_offset_deg`,
+    /// `sample_modulus_gpa`, `tip_radius_nm`, `drive_frequency_khz`, `quality_factor_N`,
+    /// `stiffness_N_n_per_m`.
+    pub fn key(self) -> String {
+        match self {
+            Self::ZOffset => String::from("z_offset_nm"),
+            Self::AmplitudeCalibration => String::from("amplitude_calibration"),
+            Self::PhaseOffset => String::from("phase_offset_deg"),
+            Self::Case(axis) => match axis {
+                ParameterAxis::SampleModulus => String::from("sample_modulus_gpa"),
+                ParameterAxis::TipRadius => String::from("tip_radius_nm"),
+                ParameterAxis::DriveFrequency => String::from("drive_frequency_khz"),
+                ParameterAxis::QualityFactor(n) => format!("quality_factor_{n}"),
+                ParameterAxis::Stiffness(n) => format!("stiffness_{n}_n_per_m"),
+                ParameterAxis::FreeAmplitude => String::from("a0_nm"),
+            },
+        }
+    }
+
+    /// Whether the fit works in the logarithm of the value (positive scale parameters).
+    fn logarithmic(self) -> bool {
+        matches!(self, Self::AmplitudeCalibration | Self::Case(_))
+    }
+}
+
+/// How a fit is made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitSettings {
+    /// The fitted quantities (at least one, no repeats).
+    pub parameters: Vec<FitParameter>,
+    /// Relative step of the forward differences in the logarithm of the model's parameters
+    /// (default 0.01).
+    pub difference_step: f64,
+    /// Largest number of residual evaluations of Levenberg-Marquardt (default 40).
+    pub max_evaluations: usize,
+}
+
+impl FitSettings {
+    /// The defaults for `parameters`.
+    pub fn new(parameters: Vec<FitParameter>) -> Self {
+        Self {
+            parameters,
+            difference_step: 0.01,
+            max_evaluations: 40,
+        }
+    }
+}
+
+/// A fitted value with its standard error.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FittedValue {
+    /// The output key (see [`FitParameter::key`]).
+    pub name: String,
+    /// The value at the optimum, in the key's unit.
+    pub value: f64,
+    /// Its standard error (1 sigma, from the Jacobian with the residuals' scale); `None` if
+    /// the data cannot determine it.
+    pub stderr: Option<f64>,
+    /// The starting value.
+    pub initial: f64,
+}
+
+/// A grazing point of the fitted model, in data coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FittedGrazing {
+    /// `G1`, `G2`, ... or `fold`.
+    pub label: String,
+    /// `Z` in data coordinates (`Z + z_offset`), nm.
+    pub z_nm: f64,
+    /// `A/A0` there.
+    pub amplitude_ratio: f64,
+    /// The phase there as the instrument shows it (with the offset), degrees.
+    pub phase_deg: f64,
+}
+
+/// One measured point with the fitted model there (contrast observables of MODEL.md section
+/// 10, on the followed branch).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FittedPoint {
+    /// Line in the file.
+    pub line: usize,
+    /// Data `Z`, nm.
+    pub z_nm: f64,
+    /// Measured amplitude, nm.
+    pub amplitude_nm: f64,
+    /// Measured phase, degrees.
+    pub phase_deg: f64,
+    /// drumroll's separation `Z = z_nm - z_offset`, nm.
+    pub separation_nm: f64,
+    /// The model's amplitude as the instrument reports it (`A/A0` times the measured `A0`), nm.
+    pub model_amplitude_nm: f64,
+    /// The model's phase plus the offset, degrees.
+    pub model_phase_deg: f64,
+    /// The model's impacts per period.
+    pub impacts_per_period: f64,
+    /// The model's peak force, nN.
+    pub peak_force_nn: f64,
+    /// The energy dissipated in the sample per period, eV.
+    pub dissipated_ev: f64,
+    /// The virial, eV.
+    pub virial_ev: f64,
+    /// The largest indentation, nm.
+    pub max_indentation_nm: f64,
+    /// The mean indentation in contact, nm.
+    pub mean_indentation_nm: f64,
+}
+
+/// The result of a fit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitResult {
+    /// The fitted values, in the order asked.
+    pub parameters: Vec<FittedValue>,
+    /// Their correlation matrix, in the same order (`None` entries: undetermined).
+    pub correlations: Vec<Vec<Option<f64>>>,
+    /// RMS of the amplitude residuals, nm.
+    pub residual_rms_amplitude_nm: f64,
+    /// RMS of the phase residuals, degrees.
+    pub residual_rms_phase_deg: f64,
+    /// `chi^2` per degree of freedom with the noise estimated from second differences.
+    pub reduced_chi2: f64,
+    /// The noise used as weights: amplitude nm, phase degrees.
+    pub noise: [f64; 2],
+    /// The fitted model's grazing points and folds on its approach.
+    pub grazing: Vec<FittedGrazing>,
+    /// The measured approach with the fitted model.
+    pub points: Vec<FittedPoint>,
+    /// Residual evaluations made.
+    pub evaluations: usize,
+    /// Why Levenberg-Marquardt stopped.
+    pub termination: String,
+    /// Whether it stopped at a converged optimum.
+    pub converged: bool,
+    /// Warnings (undetermined parameters, a poor fit).
+    pub warnings: Vec<String>,
+}
+
+/// The cached followed branches, by the model's parameter values (bit patterns).
+type BranchCache = HashMap<Vec<u64>, Rc<FollowedBranch>>;
+
+/// The least-squares problem: residuals of amplitude (weighted by its noise) then of phase.
+struct Problem<'a> {
+    case: &'a Case,
+    measured_a0: f64,
+    points: &'a [MeasuredPoint],
+    parameters: &'a [FitParameter],
+    fixed: Fixed,
+    sigma: [f64; 2],
+    step: f64,
+    z_floor: f64,
+    theta: DVector<f64>,
+    cache: RefCell<BranchCache>,
+    failure: RefCell<Option<AfmError>>,
+}
+
+/// Values of the parameters that are not fitted.
+#[derive(Debug, Clone, Copy)]
+struct Fixed {
+    z_offset: f64,
+    calibration: f64,
+    phase_offset: f64,
+}
+
+/// The full set of values of a parameter vector.
+struct Values {
+    z_offset: f64,
+    calibration: f64,
+    phase_offset: f64,
+    case: Vec<(ParameterAxis, f64)>,
+}
+
+impl Problem<'_> {
+    fn values(&self, theta: &DVector<f64>) -> Values {
+        let mut values = Values {
+            z_offset: self.fixed.z_offset,
+            calibration: self.fixed.calibration,
+            phase_offset: self.fixed.phase_offset,
+            case: Vec::new(),
+        };
+        for (k, p) in self.parameters.iter().enumerate() {
+            match p {
+                FitParameter::ZOffset => values.z_offset = theta[k],
+                FitParameter::AmplitudeCalibration => values.calibration = theta[k].exp(),
+                FitParameter::PhaseOffset => values.phase_offset = theta[k],
+                FitParameter::Case(axis) => values.case.push((*axis, theta[k].exp())),
+            }
+        }
+        values
+    }
+
+    /// The followed branch of the model at `values` (cached).
+    fn branch(&self, values: &Values) -> Result<Rc<FollowedBranch>, AfmError> {
+        let mut key: Vec<u64> = vec![values.calibration.to_bits()];
+        key.extend(values.case.iter().map(|(_, v)| v.to_bits()));
+        if let Some(branch) = self.cache.borrow().get(&key) {
+            return Ok(branch.clone());
+        }
+        let mut case = self.case.clone();
+        case.free_amplitude_nm = self.measured_a0 / values.calibration;
+        for (axis, value) in &values.case {
+            case = axis.apply(&case, *value, "fit")?;
+        }
+        let model = TappingModel::from_case(&case)?;
+        let a0 = model.free_amplitude_nm();
+        let mut settings = DiagramSettings::approach(&model);
+        settings.min_amplitude_ratio = 0.0;
+        settings.z_limit_nm = self
+            .z_floor
+            .clamp(-0.95 * a0, 0.9 * model.grazing_separation_nm());
+        let branch = Rc::new(FollowedBranch::new(approach_diagram(&model, &settings)?));
+        let mut cache = self.cache.borrow_mut();
+        if cache.len() > 64 {
+            cache.clear();
+        }
+        cache.insert(key, branch.clone());
+        Ok(branch)
+    }
+
+    fn residuals_at(&self, theta: &DVector<f64>) -> Result<DVector<f64>, AfmError> {
+        let values = self.values(theta);
+        let branch = self.branch(&values)?;
+        let n = self.points.len();
+        let mut r = DVector::zeros(2 * n);
+        for (i, p) in self.points.iter().enumerate() {
+            let z = p.z_nm - values.z_offset;
+            let ratio = branch.value(z, |d| d.amplitude_ratio).value;
+            let phase = branch.value(z, |d| d.phase_deg).value;
+            r[i] = (p.amplitude_nm - self.measured_a0 * ratio) / self.sigma[0];
+            r[n + i] = (p.phase_deg - phase - values.phase_offset) / self.sigma[1];
+        }
+        Ok(r)
+    }
+
+    fn jacobian_at(&self, theta: &DVector<f64>) -> Result<DMatrix<f64>, AfmError> {
+        let n = self.points.len();
+        let values = self.values(theta);
+        let base = self.residuals_at(theta)?;
+        let branch = self.branch(&values)?;
+        let mut jacobian = DMatrix::zeros(2 * n, self.parameters.len());
+        for (k, p) in self.parameters.iter().enumerate() {
+            match p {
+                FitParameter::ZOffset => {
+                    for (i, point) in self.points.iter().enumerate() {
+                        let z = point.z_nm - values.z_offset;
+                        let ratio = branch.value(z, |d| d.amplitude_ratio).slope;
+                        let phase = branch.value(z, |d| d.phase_deg).slope;
+                        jacobian[(i, k)] = self.measured_a0 * ratio / self.sigma[0];
+                        jacobian[(n + i, k)] = phase / self.sigma[1];
+                    }
+                }
+                FitParameter::PhaseOffset => {
+                    for i in 0..n {
+                        jacobian[(n + i, k)] = -1.0 / self.sigma[1];
+                    }
+                }
+                _ => {
+                    let mut shifted = theta.clone();
+                    shifted[k] += self.step;
+                    let r = self.residuals_at(&shifted)?;
+                    jacobian.set_column(k, &((r - &base) / self.step));
+                }
+            }
+        }
+        Ok(jacobian)
+    }
+
+    fn note(&self, error: AfmError) {
+        let mut failure = self.failure.borrow_mut();
+        if failure.is_none() {
+            *failure = Some(error);
+        }
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.theta.copy_from(x);
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.theta.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        self.residuals_at(&self.theta)
+            .map_err(|e| self.note(e))
+            .ok()
+    }
+
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        self.jacobian_at(&self.theta).map_err(|e| self.note(e)).ok()
+    }
+}
+
+/// The `Z` (nm) where `ratio(Z)` first falls below `level` going down from the top of a curve
+/// sorted by decreasing `Z`, from a running median of 5 (robust to noise).
+fn crossing(z: &[f64], ratio: &[f64], level: f64) -> Option<f64> {
+    (2..ratio.len().saturating_sub(2)).find_map(|i| {
+        let mut window = ratio[i - 2..=i + 2].to_vec();
+        window.sort_by(f64::total_cmp);
+        (window[2] < level).then_some(z[i])
+    })
+}
+
+/// Fit the followed approach branch of `case` to `measurement`'s approach over
+/// `settings.parameters` (MODEL.md section 13.3); parameters not fitted stay at `z_offset` from
+/// aligning `A/A0 = 0.9`, `c = 1`, the phase offset that matches the free phase, and the
+/// case's values.
+///
+/// # Errors
+/// [`AfmError::InvalidField`] for an empty or repeated parameter list; a model error if the
+/// model cannot be built or continued at the starting values.
+pub fn fit_measurement(
+    case: &Case,
+    measurement: &Measurement,
+    settings: &FitSettings,
+) -> Result<FitResult, AfmError> {
+    let parameters = &settings.parameters;
+    if parameters.is_empty()
+        || (0..parameters.len()).any(|i| parameters[..i].contains(&parameters[i]))
+    {
+        return Err(AfmError::InvalidField {
+            file: String::from("command line"),
+            field: String::from("--fit"),
+            value: format!("{} parameters", parameters.len()),
+            allowed: String::from("one or more parameters, each once"),
+        });
+    }
+    let points = &measurement.approach;
+    let a0 = measurement.a0_nm;
+    let amplitudes: Vec<f64> = points.iter().map(|p| p.amplitude_nm).collect();
+    let phases: Vec<f64> = points.iter().map(|p| p.phase_deg).collect();
+    let sigma = [
+        noise_sigma(&amplitudes).max(1e-6 * a0),
+        noise_sigma(&phases).max(1e-6),
+    ];
+    // Starting values from the case's model.
+    let initial_problem = Problem {
+        case,
+        measured_a0: a0,
+        points,
+        parameters: &[],
+        fixed: Fixed {
+            z_offset: 0.0,
+            calibration: 1.0,
+            phase_offset: 0.0,
+        },
+        sigma,
+        step: settings.difference_step,
+        z_floor: 0.0,
+        theta: DVector::zeros(0),
+        cache: RefCell::new(HashMap::new()),
+        failure: RefCell::new(None),
+    };
+    let start_values = Values {
+        z_offset: 0.0,
+        calibration: 1.0,
+        phase_offset: 0.0,
+        case: Vec::new(),
+    };
+    let start = initial_problem.branch(&start_values)?;
+    let zs: Vec<f64> = points.iter().map(|p| p.z_nm).collect();
+    let ratios: Vec<f64> = amplitudes.iter().map(|a| a / a0).collect();
+    let model_z: Vec<f64> = start.diagram.points.iter().map(|p| p.z_nm).collect();
+    let model_ratio: Vec<f64> = start
+        .diagram
+        .points
+        .iter()
+        .map(|p| p.amplitude_ratio)
+        .collect();
+    let z_offset = match (
+        crossing(&zs, &ratios, 0.9),
+        crossing(&model_z, &model_ratio, 0.9),
+    ) {
+        (Some(data), Some(model)) => data - model,
+        _ => zs[0] - start.z_top(),
+    };
+    let free = measurement.free_rows.max(1).min(points.len());
+    let free_phase = phases[..free].iter().sum::<f64>() / free as f64;
+    let phase_offset = free_phase - start.value(f64::INFINITY, |p| p.phase_deg).value;
+    let fixed = Fixed {
+        z_offset,
+        calibration: 1.0,
+        phase_offset,
+    };
+    let mut theta = DVector::zeros(parameters.len());
+    let mut initial = Vec::new();
+    for (k, p) in parameters.iter().enumerate() {
+        let value = match p {
+            FitParameter::ZOffset => fixed.z_offset,
+            FitParameter::AmplitudeCalibration => 1.0,
+            FitParameter::PhaseOffset => fixed.phase_offset,
+            FitParameter::Case(axis) => axis.value(case)?,
+        };
+        theta[k] = if p.logarithmic() { value.ln() } else { value };
+        initial.push(value);
+    }
+    let z_floor = zs.iter().copied().fold(f64::INFINITY, f64::min) - z_offset - 0.15 * a0;
+    let problem = Problem {
+        case,
+        measured_a0: a0,
+        points,
+        parameters,
+        fixed,
+        sigma,
+        step: settings.difference_step,
+        z_floor,
+        theta: theta.clone(),
+        cache: RefCell::new(HashMap::new()),
+        failure: RefCell::new(None),
+    };
+    let patience = settings
+        .max_evaluations
+        .div_ceil(parameters.len() + 1)
+        .max(1);
+    let (problem, report) = LevenbergMarquardt::new()
+        .with_patience(patience)
+        .with_ftol(1e-7)
+        .with_xtol(1e-7)
+        .minimize(problem);
+    if let Some(error) = problem.failure.borrow_mut().take() {
+        if !report.termination.was_successful() {
+            return Err(error);
+        }
+    }
+    let theta = problem.theta.clone();
+    let residuals = problem.residuals_at(&theta)?;
+    let jacobian = problem.jacobian_at(&theta)?;
+    let n = points.len();
+    let p = parameters.len();
+    let chi2 = residuals.norm_squared();
+    let dof = (2 * n).saturating_sub(p).max(1);
+    let reduced_chi2 = chi2 / dof as f64;
+    // Covariance: s^2 (J^T J)^{-1} by SVD; directions with singular values below 1e-8 of the
+    // largest are undetermined.
+    let svd = jacobian.clone().svd(false, true);
+    let largest = svd.singular_values.max();
+    let v_t = svd.v_t.expect("v_t asked for");
+    let mut covariance = DMatrix::zeros(p, p);
+    let mut undetermined = vec![false; p];
+    for (j, &s) in svd.singular_values.iter().enumerate() {
+        let row = v_t.row(j);
+        if s <= 1e-8 * largest {
+            for k in 0..p {
+                if row[k].abs() > 1e-3 {
+                    undetermined[k] = true;
+                }
+            }
+            continue;
+        }
+        covariance += row.transpose() * row / (s * s);
+    }
+    covariance *= reduced_chi2;
+    let values = problem.values(&theta);
+    let mut warnings = Vec::new();
+    let mut fitted = Vec::new();
+    for (k, parameter) in parameters.iter().enumerate() {
+        let raw = covariance[(k, k)].max(0.0).sqrt();
+        let value = if parameter.logarithmic() {
+            theta[k].exp()
+        } else {
+            theta[k]
+        };
+        let mut stderr = if parameter.logarithmic() {
+            value * raw
+        } else {
+            raw
+        };
+        if *parameter == FitParameter::AmplitudeCalibration {
+            // The data fix the true A0 = A0_measured / c: the error of the measured A0 is the
+            // calibration's too.
+            stderr = stderr.hypot(value * measurement.a0_stderr_nm / a0);
+        }
+        let relative = stderr / value.abs().max(1e-300);
+        let stderr = if undetermined[k] {
+            warnings.push(format!(
+                "{}: the data cannot determine it (a direction of zero sensitivity); its value is the start's",
+                parameter.key()
+            ));
+            None
+        } else {
+            if parameter.logarithmic() && relative > 0.5 {
+                warnings.push(format!(
+                    "{}: poorly determined (stderr {:.0}% of the value)",
+                    parameter.key(),
+                    100.0 * relative
+                ));
+            }
+            Some(stderr)
+        };
+        fitted.push(FittedValue {
+            name: parameter.key(),
+            value,
+            stderr,
+            initial: initial[k],
+        });
+    }
+    let correlations = (0..p)
+        .map(|i| {
+            (0..p)
+                .map(|j| {
+                    let scale = (covariance[(i, i)] * covariance[(j, j)]).sqrt();
+                    (!undetermined[i] && !undetermined[j] && scale > 0.0)
+                        .then(|| covariance[(i, j)] / scale)
+                })
+                .collect()
+        })
+        .collect();
+    if reduced_chi2 > 4.0 {
+        warnings.push(format!(
+            "reduced chi^2 = {reduced_chi2:.2}: the model does not describe the data within its noise; the standard errors are scaled by sqrt of it"
+        ));
+    }
+    let branch = problem.branch(&values)?;
+    let read = |z: f64, f: Reading| branch.value(z, f).value;
+    let fitted_points = points
+        .iter()
+        .map(|point| {
+            let z = point.z_nm - values.z_offset;
+            FittedPoint {
+                line: point.line,
+                z_nm: point.z_nm,
+                amplitude_nm: point.amplitude_nm,
+                phase_deg: point.phase_deg,
+                separation_nm: z,
+                model_amplitude_nm: a0 * read(z, |d| d.amplitude_ratio),
+                model_phase_deg: read(z, |d| d.phase_deg) + values.phase_offset,
+                impacts_per_period: read(z, |d| d.impacts_per_period),
+                peak_force_nn: read(z, |d: &DiagramPoint| d.peak_force_nn),
+                dissipated_ev: read(z, |d| d.dissipated_ev),
+                virial_ev: read(z, |d| d.virial_ev),
+                max_indentation_nm: read(z, |d| d.max_indentation_nm),
+                mean_indentation_nm: read(z, |d| d.mean_indentation_nm),
+            }
+        })
+        .collect::<Vec<_>>();
+    let rms = |range: std::ops::Range<usize>, sigma: f64| {
+        (residuals.rows(range.start, range.len()).norm_squared() / n as f64).sqrt() * sigma
+    };
+    let grazing = branch
+        .diagram
+        .special_points
+        .iter()
+        .filter(|s| s.label.starts_with('G') || s.label == "fold")
+        .map(|s| FittedGrazing {
+            label: s.label.clone(),
+            z_nm: s.z_nm + values.z_offset,
+            amplitude_ratio: s.amplitude_ratio,
+            phase_deg: s.phase_deg + values.phase_offset,
+        })
+        .collect();
+    Ok(FitResult {
+        parameters: fitted,
+        correlations,
+        residual_rms_amplitude_nm: rms(0..n, sigma[0]),
+        residual_rms_phase_deg: rms(n..2 * n, sigma[1]),
+        reduced_chi2,
+        noise: sigma,
+        grazing,
+        points: fitted_points,
+        evaluations: report.number_of_evaluations,
+        termination: format!("{:?}", report.termination),
+        converged: report.termination.was_successful(),
+        warnings,
+    })
+}

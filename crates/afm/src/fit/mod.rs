@@ -1,0 +1,7 @@
+//! Measured curves in the loop (MODEL.md section 13): reading a measured approach curve,
+//! detecting its regime boundaries, and fitting the model's followed approach branch to it.
+pub mod followed_branch;
+pub mod least_squares;
+pub mod measurement;
+pub mod synthetic;
+pub mod transitions;

@@ -1,0 +1,394 @@
+//! Regime boundaries in a measured curve (MODEL.md section 13.2): points where the amplitude
+//! and the phase versus `Z` change slope (a `kink`, as at a grazing `G_n`) or jump (a fold of
+//! the branch, bistability), located with a 1-sigma uncertainty, at a controlled family-wise
+//! false-alarm rate.
+//!
+//! At every gap between consecutive rows a window of `w` rows on each side is fitted by a
+//! quadratic in `Z` (the smooth null), and by the quadratic plus a kink term
+//! `(c - Z)_+^{3/2}` (the shape of a grazing with Hertz contact) or plus a step `H(c - Z)`,
+//! for `A/A0` and phase together, each weighted by its noise (from second differences). The
+//! drop `T` of `chi^2` from the null is `chi^2` with 4 (kink: hinge and curvature below `c`
+//! per signal) or 2 (jump) degrees of freedom on a smooth curve with white Gaussian noise, and
+//! over `M` tests the Bonferroni bound `M P(T)` bounds the probability that any test on a
+//! smooth curve exceeds its `T`. A transition is reported where that bound is below the significance level.
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use crate::error::AfmError;
+use crate::fit::measurement::{noise_sigma, MeasuredPoint};
+
+/// The rounding widths tried when a kink is located, as fractions of the window's `Z` span: the
+/// kink term is a hinge whose slope change builds up linearly over the width `epsilon` below
+/// the onset `c` (a grazing's new impact grows from zero depth; MODEL.md section 13.2).
+pub const KINK_ROUNDING: [f64; 7] = [0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3];
+
+/// How transitions are searched for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DetectionSettings {
+    /// Family-wise false-alarm probability on a smooth curve (default 0.01). In `(0, 0.5]`.
+    pub significance: f64,
+    /// Rows on each side of a candidate in its window; 0 picks `clamp(n / 25, 12, 80)`.
+    pub half_window: usize,
+}
+
+impl Default for DetectionSettings {
+    fn default() -> Self {
+        Self {
+            significance: 0.01,
+            half_window: 0,
+        }
+    }
+}
+
+impl DetectionSettings {
+    /// Check the fields; `source` names their origin in errors.
+    ///
+    /// # Errors
+    /// [`AfmError::InvalidField`] for a significance outside `(0, 0.5]` or a window below 6.
+    pub fn validate(&self, source: &str) -> Result<(), AfmError> {
+        if !(self.significance > 0.0 && self.significance <= 0.5) {
+            return Err(AfmError::InvalidField {
+                file: source.to_string(),
+                field: String::from("significance"),
+                value: self.significance.to_string(),
+                allowed: String::from("(0, 0.5]: the false-alarm probability per curve"),
+            });
+        }
+        if self.half_window != 0 && self.half_window < 6 {
+            return Err(AfmError::InvalidField {
+                file: source.to_string(),
+                field: String::from("window"),
+                value: self.half_window.to_string(),
+                allowed: String::from("0 (automatic) or at least 6 rows"),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The noise of a curve, estimated from second differences.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CurveNoise {
+    /// Standard deviation of the amplitude, nm.
+    pub amplitude_nm: f64,
+    /// Standard deviation of the phase, degrees.
+    pub phase_deg: f64,
+}
+
+/// The kind of a transition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TransitionKind {
+    /// A change of slope (a grazing).
+    Kink,
+    /// A discontinuity (a jump between coexisting orbits).
+    Jump,
+}
+
+/// A detected transition.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Transition {
+    /// Its `Z` in data coordinates, nm.
+    pub z_nm: f64,
+    /// 1-sigma uncertainty of `z_nm`, nm (kink: the `Delta chi^2 = 1` profile interval's half
+    /// width; jump: the gap between the rows over `sqrt(12)`).
+    pub z_uncertainty_nm: f64,
+    /// Measured `A/A0` there (the curve's smooth fit at `z_nm`, upper side).
+    pub amplitude_ratio: f64,
+    /// Measured phase there, degrees.
+    pub phase_deg: f64,
+    /// Kink or jump.
+    pub kind: TransitionKind,
+    /// The family-wise false-alarm probability `min(1, M P(T))` of its statistic, `P` the tail
+    /// of `chi^2` with 4 (kink) or 2 (jump) degrees of freedom: the chance that a smooth curve
+    /// gives one as large anywhere (smaller is more significant).
+    pub significance: f64,
+    /// The statistic `T` (drop of `chi^2` from the smooth null).
+    pub statistic: f64,
+}
+
+/// The result of a detection.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Detection {
+    /// `A0` used, nm.
+    pub a0_nm: f64,
+    /// The noise estimates.
+    pub noise: CurveNoise,
+    /// Rows on each side of a window.
+    pub half_window: usize,
+    /// Tests made (`M`).
+    pub tests: usize,
+    /// The threshold on a jump's `T`, `2 ln(M / significance)` (a kink's is higher: its tail
+    /// is `exp(-T/2) (1 + T/2)`).
+    pub threshold: f64,
+    /// The transitions by decreasing `Z`.
+    pub transitions: Vec<Transition>,
+}
+
+/// The two signals of a window, scaled by their noise: `A/A0 / sigma_r` and `phase / sigma_phi`.
+struct Signals {
+    z: Vec<f64>,
+    values: [Vec<f64>; 2],
+}
+
+/// The residual sum of squares of the least-squares fit of `y` by the columns of `design`.
+fn rss(design: &DMatrix<f64>, y: &DVector<f64>) -> f64 {
+    let svd = design.clone().svd(true, true);
+    match svd.solve(y, 1e-12) {
+        Ok(coefficients) => (design * coefficients - y).norm_squared(),
+        Err(_) => f64::INFINITY,
+    }
+}
+
+/// The term added to the smooth null at `c`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Extra {
+    /// The rounded hinge of width `epsilon` (a fraction of the window's span): with
+    /// `s = (c - Z) / span`, `0` above `c`, `s^2 / (2 epsilon)` for `0 < s < epsilon`, then
+    /// `s - epsilon / 2` (a sharp hinge for `epsilon = 0`).
+    Hinge(f64),
+    /// The step `H(c - Z)`.
+    Step,
+}
+
+/// The design matrix over the window's `z` centred at `c`: `1, u, u^2` (u scaled to the
+/// window) and, if any, the `extra` term (a hinge also frees the curvature below `c`:
+/// `(c - Z)_+^2`).
+fn design(z: &[f64], c: f64, extra: Option<Extra>) -> DMatrix<f64> {
+    let scale = (z[0] - z[z.len() - 1]).abs().max(1e-300);
+    let columns = match extra {
+        None => 3,
+        Some(Extra::Step) => 4,
+        Some(Extra::Hinge(_)) => 5,
+    };
+    DMatrix::from_fn(z.len(), columns, |i, j| {
+        let u = (z[i] - c) / scale;
+        match j {
+            0 => 1.0,
+            1 => u,
+            2 => u * u,
+            4 => u.min(0.0).powi(2),
+            _ => match extra {
+                Some(Extra::Hinge(epsilon)) => {
+                    let s = -u;
+                    if s <= 0.0 {
+                        0.0
+                    } else if s < epsilon {
+                        s * s / (2.0 * epsilon)
+                    } else {
+                        s - 0.5 * epsilon
+                    }
+                }
+                _ => {
+                    if u < 0.0 {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }
+            },
+        }
+    })
+}
+
+/// The drop of `chi^2` (both signals) from the quadratic null to the null plus `kind` at `c`
+/// over the window's rows, and the alternative's `chi^2`.
+fn statistic(signals: &Signals, range: std::ops::Range<usize>, c: f64, extra: Extra) -> (f64, f64) {
+    let z = &signals.z[range.clone()];
+    let null = design(z, c, None);
+    let alternative = design(z, c, Some(extra));
+    let (mut drop, mut chi2) = (0.0, 0.0);
+    for values in &signals.values {
+        let y = DVector::from_column_slice(&values[range.clone()]);
+        let r0 = rss(&null, &y);
+        let r1 = rss(&alternative, &y);
+        drop += r0 - r1;
+        chi2 += r1;
+    }
+    (drop, chi2)
+}
+
+/// Detect transitions on a curve sorted by decreasing `Z` (an approach) or increasing `Z`.
+///
+/// # Errors
+/// [`AfmError::InvalidField`] for bad settings or fewer than `4 w` rows.
+pub fn detect_transitions(
+    points: &[MeasuredPoint],
+    a0_nm: f64,
+    settings: &DetectionSettings,
+) -> Result<Detection, AfmError> {
+    settings.validate("detection settings")?;
+    let mut sorted = points.to_vec();
+    sorted.sort_by(|a, b| b.z_nm.total_cmp(&a.z_nm));
+    let n = sorted.len();
+    let w = if settings.half_window == 0 {
+        (n / 25).clamp(12, 80)
+    } else {
+        settings.half_window
+    };
+    if n < 4 * w {
+        return Err(AfmError::InvalidField {
+            file: String::from("measurement"),
+            field: String::from("rows"),
+            value: n.to_string(),
+            allowed: format!("at least {} rows (4 windows of {w})", 4 * w),
+        });
+    }
+    let ratios: Vec<f64> = sorted.iter().map(|p| p.amplitude_nm / a0_nm).collect();
+    let phases: Vec<f64> = sorted.iter().map(|p| p.phase_deg).collect();
+    let sigma_ratio = noise_sigma(&ratios).max(1e-12);
+    let sigma_phase = noise_sigma(&phases).max(1e-12);
+    let signals = Signals {
+        z: sorted.iter().map(|p| p.z_nm).collect(),
+        values: [
+            ratios.iter().map(|r| r / sigma_ratio).collect(),
+            phases.iter().map(|p| p / sigma_phase).collect(),
+        ],
+    };
+    // Candidate g lies between rows g and g + 1, window rows g + 1 - w ..= g + w.
+    let candidates: Vec<usize> = (w - 1..n - w).collect();
+    let tests = (KINK_ROUNDING.len() + 1) * candidates.len();
+    let threshold = 2.0 * (tests as f64 / settings.significance).ln();
+    // Per candidate: the larger alternative's statistic, its kind and its single-test tail
+    // probability (kink: chi^2 with 4 degrees of freedom, the hinge and the free curvature for
+    // each signal; jump: chi^2 with 2).
+    let scores: Vec<(f64, TransitionKind, f64)> = candidates
+        .iter()
+        .map(|&g| {
+            let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
+            let range = g + 1 - w..g + w + 1;
+            let kink = KINK_ROUNDING
+                .iter()
+                .map(|&epsilon| statistic(&signals, range.clone(), c, Extra::Hinge(epsilon)).0)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let (jump, _) = statistic(&signals, range, c, Extra::Step);
+            let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
+            let jump_tail = (-0.5 * jump).exp();
+            if jump_tail < kink_tail {
+                (jump, TransitionKind::Jump, jump_tail)
+            } else {
+                (kink, TransitionKind::Kink, kink_tail)
+            }
+        })
+        .collect();
+    // Local maxima above the threshold, strongest first; a candidate whose window holds a
+    // stronger chosen one (within 2 w rows) is that one's shadow.
+    let mut order: Vec<usize> = (0..candidates.len())
+        .filter(|&k| tests as f64 * scores[k].2 < settings.significance)
+        .collect();
+    order.sort_by(|&a, &b| scores[a].2.total_cmp(&scores[b].2));
+    let mut chosen: Vec<usize> = Vec::new();
+    for k in order {
+        if chosen.iter().all(|&c| c.abs_diff(k) > 2 * w) {
+            chosen.push(k);
+        }
+    }
+    let mut transitions: Vec<Transition> = chosen
+        .into_iter()
+        .map(|k| {
+            let g = candidates[k];
+            let (score, kind, tail) = scores[k];
+            let range = g + 1 - w..g + w + 1;
+            let (z_nm, z_uncertainty_nm) = match kind {
+                TransitionKind::Jump => (
+                    0.5 * (signals.z[g] + signals.z[g + 1]),
+                    (signals.z[g] - signals.z[g + 1]) / 12f64.sqrt(),
+                ),
+                TransitionKind::Kink => kink_profile(&signals, range.clone(), g, w),
+            };
+            let (ratio, phase) = smooth_value(&signals, range, z_nm, [sigma_ratio, sigma_phase]);
+            Transition {
+                z_nm,
+                z_uncertainty_nm,
+                amplitude_ratio: ratio,
+                phase_deg: phase,
+                kind,
+                significance: (tests as f64 * tail).min(1.0),
+                statistic: score,
+            }
+        })
+        .collect();
+    transitions.sort_by(|a, b| b.z_nm.total_cmp(&a.z_nm));
+    Ok(Detection {
+        a0_nm,
+        noise: CurveNoise {
+            amplitude_nm: sigma_ratio * a0_nm,
+            phase_deg: sigma_phase,
+        },
+        half_window: w,
+        tests,
+        threshold,
+        transitions,
+    })
+}
+
+/// The kink's onset `Z` and its 1-sigma uncertainty: the alternative's `chi^2`, minimised over
+/// the rounding width ([`KINK_ROUNDING`]), profiled over the onset `c` on a grid across the
+/// middle of the window; the onset is the minimum, the uncertainty the half width of the
+/// interval where `chi^2 <= min + 1` (profile likelihood).
+fn kink_profile(
+    signals: &Signals,
+    range: std::ops::Range<usize>,
+    g: usize,
+    w: usize,
+) -> (f64, f64) {
+    let z = &signals.z;
+    let high = z[(g + 1).saturating_sub(w / 2).max(range.start)];
+    let low = z[(g + w / 2).min(range.end - 1)];
+    let steps = 200;
+    let profile: Vec<(f64, f64)> = (0..=steps)
+        .map(|s| {
+            let c = high + (low - high) * s as f64 / steps as f64;
+            let chi2 = KINK_ROUNDING
+                .iter()
+                .map(|&epsilon| statistic(signals, range.clone(), c, Extra::Hinge(epsilon)).1)
+                .fold(f64::INFINITY, f64::min);
+            (c, chi2)
+        })
+        .collect();
+    let (best, minimum) = profile
+        .iter()
+        .copied()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("non-empty profile");
+    let inside: Vec<f64> = profile
+        .iter()
+        .filter(|(_, chi2)| *chi2 <= minimum + 1.0)
+        .map(|(c, _)| *c)
+        .collect();
+    let top = inside.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let bottom = inside.iter().copied().fold(f64::INFINITY, f64::min);
+    let grid = (high - low).abs() / steps as f64;
+    (best, (0.5 * (top - bottom)).max(grid))
+}
+
+/// `A/A0` and phase of the window's null (quadratic) fit on the upper side at `z`.
+fn smooth_value(
+    signals: &Signals,
+    range: std::ops::Range<usize>,
+    z: f64,
+    sigma: [f64; 2],
+) -> (f64, f64) {
+    let rows: Vec<usize> = range.filter(|&i| signals.z[i] >= z).collect();
+    let zs: Vec<f64> = rows.iter().map(|&i| signals.z[i]).collect();
+    if zs.len() < 3 {
+        let i = rows.last().copied().unwrap_or(0);
+        return (
+            signals.values[0][i] * sigma[0],
+            signals.values[1][i] * sigma[1],
+        );
+    }
+    let d = design(&zs, z, None);
+    let mut out = [0.0; 2];
+    for (k, values) in signals.values.iter().enumerate() {
+        let y = DVector::from_iterator(rows.len(), rows.iter().map(|&i| values[i]));
+        let coefficients = d
+            .clone()
+            .svd(true, true)
+            .solve(&y, 1e-12)
+            .unwrap_or_else(|_| DVector::zeros(3));
+        out[k] = coefficients[0] * sigma[k];
+    }
+    (out[0], out[1])
+}
