@@ -17,7 +17,9 @@ use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{model_of, output_path, ModelArgs};
 use crate::option_ranges::{self, OptionRange};
-use crate::output::{print_stdout, push_csv_row, write_atomically};
+use crate::output::{
+    harmonic_columns, print_stdout, push_csv_row, push_harmonic_cells, write_atomically,
+};
 use crate::plot::FigureFile;
 use crate::progress::Progress;
 
@@ -496,11 +498,7 @@ pub const CSV_COLUMNS: [&str; 20] = [
 fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
     let count = diagram.points.first().map_or(0, |p| p.harmonics.len());
     let mut text = format!("direction,{}", CSV_COLUMNS.join(","));
-    for n in 1..=count {
-        text.push_str(&format!(
-            ",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"
-        ));
-    }
+    text.push_str(&harmonic_columns(count));
     text.push('\n');
     for point in &diagram.points {
         push_csv_row(
@@ -511,14 +509,7 @@ fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
         );
         // The row's newline moves after the harmonics.
         text.pop();
-        for n in 0..count {
-            let harmonic = point.harmonics.get(n);
-            text.push_str(&format!(
-                ",{},{}",
-                harmonic.map_or(f64::NAN, |h| h.amplitude_nm),
-                harmonic.map_or(f64::NAN, |h| h.phase_deg)
-            ));
-        }
+        push_harmonic_cells(&mut text, &point.harmonics, count);
         text.push('\n');
     }
     Ok(text)

@@ -43,7 +43,10 @@ struct Computed {
 /// `multiplicity` (drive periods per orbit), `peak_force_nn` (nN), `mean_force_nn` (nN),
 /// `impulse_nn_us` (nN us per period), `contact_time_periods`, `min_gap_nm`, `gap_minima`,
 /// `impacts`, `stable`, `floquet_multipliers` ([re, im] pairs), `state` (q_i in nm and q_i'
-/// in nm/us at t = 0), `periods`, `converged`, `residual`, ... (docs/output-schema.md).
+/// in nm/us at t = 0), `periods`, `converged`, `residual`, the contrast observables
+/// `dissipated_ev` and `virial_ev` (eV), `max_indentation_nm`, `mean_indentation_nm` (nm),
+/// `energy_balance_residual`, `harmonics` (a list of dicts `n`, `amplitude_nm`, `phase_deg`;
+/// MODEL.md section 10), ... (docs/output-schema.md).
 /// `to_dict()` is the whole JSON object, `inputs` and `coexisting_orbit` included.
 #[pyclass(module = "drumroll", frozen)]
 pub struct Orbit {
@@ -292,16 +295,22 @@ pub fn _restore_orbit(case: &Bound<'_, PyAny>, data: &Bound<'_, PyAny>) -> PyRes
 
 /// The steady orbit of the case `resolved` at `z` (or where the approach reaches `amplitude_ratio`), from
 /// `start`: `"approach"`, `"transient"`, or a state (an `Orbit`, or a sequence of floats)
-/// near the orbit.
+/// near the orbit; with harmonics `1..=harmonics` of `u` (checked as `simulate --harmonics`).
 pub fn compute_orbit(
     py: Python<'_>,
     resolved: &Arc<Resolved>,
     z: Option<f64>,
     amplitude_ratio: Option<f64>,
     start: &Bound<'_, PyAny>,
+    harmonics: i64,
 ) -> PyResult<Orbit> {
     let resolved = resolved.clone();
-    let settings = SteadyOrbitSettings::default();
+    let settings = SteadyOrbitSettings {
+        harmonics: drumroll::option_ranges::HARMONICS
+            .count(harmonics)
+            .map_err(to_py_err)?,
+        ..SteadyOrbitSettings::default()
+    };
     if let Ok(name) = start.extract::<String>() {
         let start = match name.as_str() {
             "approach" => Start::Approach,
