@@ -109,7 +109,12 @@ impl Orbit {
                 return Value::Null;
             };
             let resolved = &self.resolved;
-            let settings = SteadyOrbitSettings::default();
+            // The harmonic count the orbit was computed with (`harmonics=`), so that the
+            // coexisting orbit and the inputs say the same as `simulate --harmonics`.
+            let settings = SteadyOrbitSettings {
+                harmonics: computed.orbit.observables().harmonics.len().max(1),
+                ..SteadyOrbitSettings::default()
+            };
             let (options, coexisting) = match computed.origin {
                 Origin::Cli {
                     start,
@@ -126,6 +131,7 @@ impl Orbit {
                         "z_nm": z,
                         "amplitude_ratio": amplitude_ratio,
                         "start": start.name(),
+                        "harmonics": settings.harmonics,
                     });
                     (
                         options,
@@ -133,7 +139,7 @@ impl Orbit {
                     )
                 }
                 Origin::Near => (
-                    json!({"z_nm": computed.orbit.z_nm, "amplitude_ratio": null, "start": "near"}),
+                    json!({"z_nm": computed.orbit.z_nm, "amplitude_ratio": null, "start": "near", "harmonics": settings.harmonics}),
                     None,
                 ),
             };
