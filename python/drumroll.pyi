@@ -65,11 +65,13 @@ class Case:
         *,
         amplitude_ratio: Optional[float] = None,
         start: Union[str, "Orbit", Sequence[float], None] = None,
+        harmonics: int = 4,
     ) -> "Orbit":
         """The steady orbit at separation `z` (nm), or where the approach reaches
         `amplitude_ratio` (A/A0), as `drumroll simulate`. `start`: "approach" (default),
         "transient", or a state near the orbit (a previous Orbit at a nearby Z: the fast warm
-        start; or [q_1 nm, q_1' nm/us, q_2, q_2', ...]). Releases the GIL."""
+        start; or [q_1 nm, q_1' nm/us, q_2, q_2', ...]). `harmonics`: the harmonics
+        n = 1..N of u in `Orbit.harmonics` (N in [1, 1000]). Releases the GIL."""
     def diagram(
         self,
         *,
@@ -78,12 +80,15 @@ class Case:
         max_step: Optional[float] = None,
         max_points: int = 20000,
         retract: bool = False,
+        harmonics: int = 4,
     ) -> "Diagram":
         """The bifurcation diagram in Z (the paper's Fig. 2), as `drumroll continue`: from
         above first contact down to `floor` (nm, default 0.05 A0) or A/A0 <
         `min_amplitude_ratio`; arclength steps up to `max_step` nm (default A0/250); with
         `retract=True` back up too; at most `max_points` points per branch (`completed` is
-        False on a branch cut short). Releases the GIL; Ctrl-C interrupts it."""
+        False on a branch cut short); `harmonics` N: the columns harmonic_<n>_amplitude_nm and
+        harmonic_<n>_phase_deg, n = 1..N, of every point. Releases the GIL; Ctrl-C
+        interrupts it."""
     def approach(
         self,
         *,
@@ -95,12 +100,15 @@ class Case:
         every: int = 1,
         settle_cycles: int = 20,
         tolerance: float = 1e-8,
+        harmonics: int = 4,
     ) -> Table:
         """A time-domain approach sweep, as `drumroll approach`: Z from `from_nm` (default
         Z_G1 + 0.2 nm) to `to_nm` (nm) at `rate_nm_per_s` (nm/s), read by a lock-in over
         `lockin_cycles` drive cycles, every `every`-th reading kept. One row per reading:
         cycle, z_nm, amplitude_ratio, phase_deg, impacts_per_period, peak_force_nn (nN),
-        direction; a DataFrame's attrs["inputs"] holds the inputs. Releases the GIL; Ctrl-C
+        dissipated_ev (eV per cycle), direction, then harmonic_<n>_amplitude_nm (nm) and
+        harmonic_<n>_phase_deg (deg) for n = 1..`harmonics`; a DataFrame's attrs["inputs"]
+        holds the inputs. Releases the GIL; Ctrl-C
         stops it."""
     def map(
         self,
@@ -114,12 +122,14 @@ class Case:
         floor: Optional[float] = None,
         min_amplitude_ratio: float = 0.3,
         max_step: Optional[float] = None,
+        harmonics: int = 4,
     ) -> "RegimeMap":
         """The impact-regime map, as `drumroll map`: each special point of the approach
         diagram (G_n, fold, period-doubling; or those in `labels`) continued over `vary`
         ("a0" nm, "drive-frequency" kHz, "sample-modulus" GPa, "tip-radius" nm,
         "quality-factor-N", "stiffness-N" N/m) from the case's value over [start, stop],
-        exactly at each value of `at`, at least `points` points per curve. Releases the
+        exactly at each value of `at`, at least `points` points per curve; every point
+        carries the contrast observables and harmonics n = 1..`harmonics` of u. Releases the
         GIL."""
     def to_dict(self) -> Dict[str, Any]:
         """The case in the case files' format, cantilever and sample inline."""
@@ -164,6 +174,19 @@ class Orbit:
     """Time in contact per drive period, in drive periods."""
     min_gap_nm: Optional[float]
     """Lowest gap d over the orbit, nm."""
+    dissipated_ev: float
+    """Energy dissipated in the sample per drive period, -int F_ts w' dt, eV (MODEL.md
+    section 10; 0 for a conservative law)."""
+    virial_ev: float
+    """The virial (1/T) int F_ts w dt, eV."""
+    max_indentation_nm: float
+    """Largest indentation of the law's contact geometry over the orbit, nm."""
+    mean_indentation_nm: float
+    """Mean indentation over the time in contact, nm."""
+    energy_balance_residual: float
+    """The largest mode's energy-balance residual over the total damping loss."""
+    harmonics: List[Dict[str, Any]]
+    """Harmonics n = 1..N of u: dicts n, amplitude_nm (nm), phase_deg (deg)."""
     gap_minima: List[Dict[str, Any]]
     """Every local minimum of the gap: t_periods, gap_nm, kind."""
     impacts: List[Dict[str, Any]]

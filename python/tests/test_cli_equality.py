@@ -11,6 +11,17 @@ import drumroll
 from conftest import cli_json, run_cli
 
 
+def flattened(record):
+    """A JSON record with its `harmonics` list as the tables' (and the CLI CSV's) columns
+    harmonic_<n>_amplitude_nm and harmonic_<n>_phase_deg."""
+    flat = {key: value for key, value in record.items() if key != "harmonics"}
+    for harmonic in record.get("harmonics", []):
+        n = harmonic["n"]
+        flat[f"harmonic_{n}_amplitude_nm"] = harmonic["amplitude_nm"]
+        flat[f"harmonic_{n}_phase_deg"] = harmonic["phase_deg"]
+    return flat
+
+
 @pytest.mark.parametrize("z", [12.0, 8.5, 5.0, 2.7])
 def test_orbit_at_z_equals_simulate_json(z):
     case = drumroll.Case("biolever-mica")
@@ -19,6 +30,16 @@ def test_orbit_at_z_equals_simulate_json(z):
     assert orbit.to_dict() == expected
     for key in ("amplitude_ratio", "phase_deg", "impacts_per_period", "peak_force_nn", "state"):
         assert getattr(orbit, key) == expected[key]
+
+
+def test_orbit_harmonics_equal_simulate_harmonics():
+    orbit = drumroll.Case("biolever-mica").orbit(z=5.0, harmonics=8)
+    expected = cli_json("simulate", "--case", "biolever-mica", "--z", "5", "--harmonics", "8", "--json")
+    assert orbit.to_dict() == expected
+    assert [h["n"] for h in orbit.harmonics] == list(range(1, 9))
+    for key in ("dissipated_ev", "virial_ev", "max_indentation_nm", "mean_indentation_nm",
+                "energy_balance_residual", "harmonics"):
+        assert getattr(orbit, key) == expected[key], key
 
 
 def test_orbit_at_amplitude_ratio_and_transient_start_equal_simulate_json():
@@ -60,10 +81,12 @@ def test_diagram_equals_continue_json():
     assert [p["label"] for p in diagram.special_points] == ["G1", "G2", "G3"]
     points = diagram.points
     assert list(points.columns)[:3] == ["z_nm", "amplitude_ratio", "phase_deg"]
-    assert set(points.columns) == set(expected["points"][0])
+    rows = [flattened(p) for p in expected["points"]]
+    assert set(points.columns) == set(rows[0])
+    assert "harmonic_4_phase_deg" in points.columns and "dissipated_ev" in points.columns
     assert len(points) == len(expected["points"])
     for column in points.columns:
-        values = [p[column] for p in expected["points"]]
+        values = [p[column] for p in rows]
         if column == "min_gap_nm":
             values = [math.nan if v is None else v for v in values]
             np.testing.assert_array_equal(points[column].to_numpy(), np.array(values))
@@ -93,11 +116,11 @@ def test_approach_rows_equal_the_jsonl_records():
     ).stdout.splitlines()
     inputs = json.loads(lines[0])["inputs"]
     records = [json.loads(line) for line in lines[1:]]
-    assert table.to_dict(orient="records") == records
+    assert table.to_dict(orient="records") == [flattened(r) for r in records]
     assert list(table.columns) == [
         "cycle", "z_nm", "amplitude_ratio", "phase_deg", "impacts_per_period",
-        "peak_force_nn", "direction",
-    ]
+        "peak_force_nn", "dissipated_ev", "direction",
+    ] + [f"harmonic_{n}_{q}" for n in range(1, 5) for q in ("amplitude_nm", "phase_deg")]
     assert table.attrs["inputs"] == inputs
     assert set(table["direction"]) == {"approach", "retract"}
 
@@ -115,7 +138,7 @@ def test_cases_lists_the_built_in_fixtures():
     assert case_dict["sample"] == inputs["sample"]
 
 
-def test_regime_map_equals_map_json():
+def test_regime_map_equals_map_json(tmp_path):
     case = drumroll.Case("biolever-mica")
     regime = case.map(vary="a0", start=9.0, stop=11.0, at=[10.5], points=10)
     expected = cli_json(
@@ -124,11 +147,22 @@ def test_regime_map_equals_map_json():
     )
     assert regime.to_dict() == expected
     assert set(regime.curves) == {c["label"] for c in expected["curves"]}
+    csv_path = tmp_path / "map.csv"
+    run_cli(
+        "map", "--case", "biolever-mica", "--vary", "a0", "--from", "9", "--to", "11",
+        "--at", "10.5", "--points", "10", "--csv", str(csv_path),
+    )
+    csv_lines = csv_path.read_text().splitlines()
+    csv_columns = csv_lines[0].split(",")[1:]
     for curve in expected["curves"]:
         table = regime.curves[curve["label"]]
-        assert list(table["parameter"]) == [p["parameter"] for p in curve["points"]]
-        assert list(table["z_nm"]) == [p["z_nm"] for p in curve["points"]]
+        rows = [flattened(p) for p in curve["points"]]
+        # The table's first columns are the CSV's (after its `label`), with the same values.
+        assert list(table.columns)[: len(csv_columns)] == csv_columns
+        for column in csv_columns:
+            assert list(table[column]) == [p[column] for p in rows], column
         assert regime.ends[curve["label"]] == curve["ends"]
+    assert "dissipated_ev" in csv_columns and "harmonic_4_phase_deg" in csv_columns
     assert regime.codim2_points == expected["codim2_points"]
     assert regime.parameter_info["case_value"] == 10.0
 

@@ -13,6 +13,7 @@ from conftest import cli_error
         ({"z": float("nan")}, ["--z", "NaN"]),
         ({"z": 1e9}, ["--z", "1e9"]),
         ({"amplitude_ratio": 1.5}, ["--amplitude-ratio", "1.5"]),
+        ({"z": 5.0, "harmonics": 0}, ["--z", "5", "--harmonics", "0"]),
     ],
 )
 def test_orbit_out_of_range_raises_the_cli_message(kwargs, cli_args):
@@ -28,6 +29,7 @@ def test_orbit_out_of_range_raises_the_cli_message(kwargs, cli_args):
         ({"floor": 50.0}, ["--floor", "50"]),
         ({"min_amplitude_ratio": 1.0}, ["--min-amplitude-ratio", "1"]),
         ({"max_step": -1.0}, ["--max-step=-1"]),
+        ({"harmonics": 1001}, ["--harmonics", "1001"]),
     ],
 )
 def test_diagram_out_of_range_raises_the_cli_message(kwargs, cli_args):

@@ -56,6 +56,57 @@ fn map_points_match_independent_diagrams() {
             );
             let n: usize = curve.label[1..].parse().expect("G<n>");
             assert_eq!((point.impacts_before, point.impacts_after), (n - 1, n));
+            // The contrast observables (MODEL.md section 10) of the same orbit: the map's
+            // point and the diagram's are within 2e-9 nm in Z, each solved to a residual of
+            // 1e-10 nm, and each harmonic's complex amplitude `A_n exp(i phase_n)` moves by at
+            // most about 1 nm per nm of Z there, so 1e-7 nm bounds their difference (the
+            // complex amplitude, not the phase alone: at G1 the orbit is free and the phases
+            // of its vanishing higher harmonics are noise); mica is conservative (Hertz), so
+            // both dissipate 0 to 1e-12 eV; the energy balance closes to 1e-9 on every orbit
+            // drumroll reports.
+            assert_eq!(point.harmonics.len(), special.harmonics.len());
+            assert_eq!(point.harmonics.len(), 4, "the default harmonic count");
+            for (ours, theirs) in point.harmonics.iter().zip(&special.harmonics) {
+                assert_eq!(ours.n, theirs.n);
+                let complex = |h: &afm::Harmonic| {
+                    let phase = h.phase_deg.to_radians();
+                    (h.amplitude_nm * phase.cos(), h.amplitude_nm * phase.sin())
+                };
+                let ((x0, y0), (x1, y1)) = (complex(ours), complex(theirs));
+                assert!(
+                    (x0 - x1).hypot(y0 - y1) <= 1e-7,
+                    "{} at A0 = {a0}, harmonic {}: {:?} vs {:?}",
+                    curve.label,
+                    ours.n,
+                    ours,
+                    theirs
+                );
+            }
+            assert!(
+                (point.harmonics[0].amplitude_nm / a0 - point.amplitude_ratio).abs() <= 1e-9,
+                "the first harmonic over A0 = {a0} is A/A0"
+            );
+            // Hertz is conservative: the dissipation is zero up to the solver's tolerance,
+            // 1e-11 of the work scale `F_peak s_max` (tests/contrast.rs), which at these
+            // grazings (s_max below 0.5 nm, F_peak below 10 nN: below 32 eV) is 3.2e-10 eV.
+            assert!(
+                point.max_indentation_nm < 0.5,
+                "{}",
+                point.max_indentation_nm
+            );
+            assert!(
+                point.dissipated_ev.abs() <= 3.2e-10 && special.dissipated_ev.abs() <= 3.2e-10,
+                "{} at A0 = {a0}: {:e} and {:e} eV",
+                curve.label,
+                point.dissipated_ev,
+                special.dissipated_ev
+            );
+            assert!(
+                point.energy_balance_residual <= 1e-9,
+                "{} at A0 = {a0}: residual {:e}",
+                curve.label,
+                point.energy_balance_residual
+            );
         }
     }
 }

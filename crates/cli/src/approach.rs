@@ -16,7 +16,7 @@ use crate::exit_status::Incomplete;
 use crate::inputs::inputs_json;
 use crate::model_args::ModelArgs;
 use crate::option_ranges::{self, OptionRange};
-use crate::output::{check_writable, StreamedFile};
+use crate::output::{check_writable, harmonic_columns, StreamedFile};
 use crate::plot::{render_svg, FigureFile, Panel, Series, Stroke, PHASE_PERIOD_DEG};
 use crate::progress::{note, Progress};
 
@@ -27,14 +27,6 @@ pub const CSV_HEADER: &str =
 
 /// The harmonics each reading gives by default (`--harmonics`).
 pub const DEFAULT_HARMONICS: i64 = afm::orbit::lockin::DEFAULT_HARMONICS as i64;
-
-/// The CSV columns of harmonics `1..=count` after [`CSV_HEADER`]:
-/// `,harmonic_<n>_amplitude_nm,harmonic_<n>_phase_deg` for each `n`.
-pub fn harmonic_columns(count: usize) -> String {
-    (1..=count)
-        .map(|n| format!(",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"))
-        .collect()
-}
 
 /// Progress bar updates: at most one per this many cycles (indicatif also limits redraws).
 const PROGRESS_STRIDE: u64 = 256;

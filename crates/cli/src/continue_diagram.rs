@@ -17,7 +17,9 @@ use crate::exit_status::Incomplete;
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{model_of, output_path, ModelArgs};
 use crate::option_ranges::{self, OptionRange};
-use crate::output::{print_stdout, push_csv_row, write_atomically};
+use crate::output::{
+    harmonic_columns, print_stdout, push_csv_row, push_harmonic_cells, write_atomically,
+};
 use crate::plot::FigureFile;
 use crate::progress::Progress;
 
@@ -493,13 +495,11 @@ pub const CSV_COLUMNS: [&str; 20] = [
 /// `direction`, then [`CSV_COLUMNS`], then `harmonic_<n>_amplitude_nm,harmonic_<n>_phase_deg`
 /// for each `n`.
 pub fn csv_header(harmonics: usize) -> String {
-    let mut header = format!("direction,{}", CSV_COLUMNS.join(","));
-    for n in 1..=harmonics {
-        header.push_str(&format!(
-            ",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"
-        ));
-    }
-    header
+    format!(
+        "direction,{}{}",
+        CSV_COLUMNS.join(","),
+        harmonic_columns(harmonics)
+    )
 }
 
 /// The CSV of a diagram's points (header line first): `direction` (`approach` or `retract`),
@@ -519,14 +519,7 @@ fn csv_text(diagram: &BifurcationDiagram, direction: &str) -> Result<String> {
         );
         // The row's newline moves after the harmonics.
         text.pop();
-        for n in 0..count {
-            let harmonic = point.harmonics.get(n);
-            text.push_str(&format!(
-                ",{},{}",
-                harmonic.map_or(f64::NAN, |h| h.amplitude_nm),
-                harmonic.map_or(f64::NAN, |h| h.phase_deg)
-            ));
-        }
+        push_harmonic_cells(&mut text, &point.harmonics, count);
         text.push('\n');
     }
     Ok(text)

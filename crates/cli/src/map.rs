@@ -14,8 +14,9 @@ use crate::grid_overlay::{read_grid, Grid};
 use crate::inputs::orbit_inputs_json;
 use crate::map_plot::map_panels;
 use crate::model_args::{output_path, ModelArgs};
+use crate::option_ranges;
 use crate::output::write_atomically;
-use crate::output::{print_stdout, push_csv_row};
+use crate::output::{harmonic_columns, print_stdout, push_csv_row, push_harmonic_cells};
 use crate::plot::{render_svg, FigureFile};
 
 /// Options of `drumroll map`.
@@ -55,6 +56,9 @@ pub struct MapArgs {
     /// Largest arclength step of the seed approach, nm (default A0/250).
     #[arg(long)]
     pub max_step: Option<f64>,
+    /// The harmonics n = 1..N of u reported at every curve point, N in [1, 1000].
+    #[arg(long, default_value_t = crate::approach::DEFAULT_HARMONICS, allow_negative_numbers = true)]
+    pub harmonics: i64,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -127,7 +131,9 @@ pub fn map_settings(args: &MapArgs, model: &TappingModel) -> Result<RegimeMapSet
     if args.points < 2 || args.points > 100_000 {
         bail!("--points {}: allowed 2 ..= 100000", args.points);
     }
-    let diagram = approach_settings(model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    let mut diagram =
+        approach_settings(model, args.floor, args.min_amplitude_ratio, args.max_step)?;
+    diagram.orbit.harmonics = option_ranges::HARMONICS.count(args.harmonics)?;
     Ok(RegimeMapSettings {
         diagram,
         from: args.from,
@@ -186,6 +192,7 @@ pub fn map_json(
         "floor_nm": settings.diagram.z_limit_nm,
         "min_amplitude_ratio": settings.diagram.min_amplitude_ratio,
         "max_step_nm": settings.diagram.max_step,
+        "harmonics": settings.diagram.orbit.harmonics,
     });
     json!({
         "case": case.name,
@@ -295,8 +302,8 @@ fn table(case: &str, axis: ParameterAxis, at: &[f64], map: &RegimeMap) -> String
 }
 
 /// The CSV columns after `label`: the scalar keys of a JSON curve point, in this order
-/// (docs/output-schema.md).
-pub const CSV_COLUMNS: [&str; 10] = [
+/// (docs/output-schema.md); the harmonics' columns follow them.
+pub const CSV_COLUMNS: [&str; 15] = [
     "parameter",
     "z_nm",
     "amplitude_ratio",
@@ -307,6 +314,11 @@ pub const CSV_COLUMNS: [&str; 10] = [
     "spectral_radius",
     "residual",
     "at_fixed_parameter",
+    "dissipated_ev",
+    "virial_ev",
+    "max_indentation_nm",
+    "mean_indentation_nm",
+    "energy_balance_residual",
 ];
 
 /// The figure `map --plot` draws (SVG): the map in the `(PARAM, Z)` and `(PARAM, A/A0)`
@@ -315,9 +327,17 @@ pub fn map_figure(axis: ParameterAxis, map: &RegimeMap, grid: Option<&Grid>) -> 
     render_svg(&map_panels(axis, map, grid), 1, 2, (620, 480))
 }
 
-/// The CSV of every curve's points: `label`, then [`CSV_COLUMNS`] (what `map --csv` writes).
+/// The CSV of every curve's points: `label`, then [`CSV_COLUMNS`], then
+/// `harmonic_<n>_amplitude_nm` and `harmonic_<n>_phase_deg` for `n = 1..N` (the JSON point's
+/// `harmonics[n - 1]`), as `continue --csv` writes them (what `map --csv` writes).
 pub fn csv_text(curves: &[MapCurve]) -> Result<String> {
-    let mut text = format!("label,{}\n", CSV_COLUMNS.join(","));
+    let count = curves
+        .iter()
+        .find_map(|curve| curve.points.first())
+        .map_or(0, |point| point.harmonics.len());
+    let mut text = format!("label,{}", CSV_COLUMNS.join(","));
+    text.push_str(&harmonic_columns(count));
+    text.push('\n');
     for curve in curves {
         for point in &curve.points {
             push_csv_row(
@@ -326,6 +346,10 @@ pub fn csv_text(curves: &[MapCurve]) -> Result<String> {
                 &serde_json::to_value(point)?,
                 &CSV_COLUMNS,
             );
+            // The row's newline moves after the harmonics.
+            text.pop();
+            push_harmonic_cells(&mut text, &point.harmonics, count);
+            text.push('\n');
         }
     }
     Ok(text)

@@ -214,3 +214,24 @@ impl StreamedFile {
             .with_context(|| format!("cannot write {}", self.path.display()))
     }
 }
+
+/// The CSV header cells of harmonics `n = 1..=count`, appended after a command's columns:
+/// `,harmonic_<n>_amplitude_nm,harmonic_<n>_phase_deg` for each `n` (docs/output-schema.md).
+pub fn harmonic_columns(count: usize) -> String {
+    (1..=count)
+        .map(|n| format!(",harmonic_{n}_amplitude_nm,harmonic_{n}_phase_deg"))
+        .collect()
+}
+
+/// Append the cells of the first `count` harmonics of a CSV row: `,amplitude_nm,phase_deg` of
+/// `harmonics[n - 1]` for `n = 1..=count` (`NaN` where the row has fewer).
+pub fn push_harmonic_cells(text: &mut String, harmonics: &[afm::Harmonic], count: usize) {
+    for n in 0..count {
+        let harmonic = harmonics.get(n);
+        text.push_str(&format!(
+            ",{},{}",
+            harmonic.map_or(f64::NAN, |h| h.amplitude_nm),
+            harmonic.map_or(f64::NAN, |h| h.phase_deg)
+        ));
+    }
+}

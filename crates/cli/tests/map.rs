@@ -29,11 +29,18 @@ fn continue_point(a0: f64, label: &str) -> Value {
 /// `continue --a0` locates the same grazing within 1e-9 nm in `Z` (plus the precision the
 /// diagram reports for its own location: its bracket). At the case's own value the map's points
 /// are `continue`'s special points: `Z` as above, `A/A0` and the phase within 1e-6 (the
-/// observables of two orbits 1e-9 nm apart; `dA/dZ ~ 1`).
+/// observables of two orbits 1e-9 nm apart; `dA/dZ ~ 1`), and so are the contrast
+/// observables: the harmonics' amplitudes and the indentations within 1e-6 nm, the virial and
+/// the dissipation within 1e-6 eV (each moves by less than 1 per nm of `Z` there). The CSV
+/// written alongside holds the JSON's numbers, the harmonics in their columns.
 #[test]
 fn map_points_are_the_special_points_of_independent_continue_runs() {
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let csv = directory.path().join("map.csv");
     let map = json_of(&[
         "map",
+        "--csv",
+        csv.to_str().expect("utf-8 path"),
         "--case",
         "biolever-mica",
         "--vary",
@@ -82,6 +89,57 @@ fn map_points_are_the_special_points_of_independent_continue_runs() {
                 }
                 assert_eq!(points[0]["impacts_before"], special["impacts_before"]);
                 assert_eq!(points[0]["impacts_after"], special["impacts_after"]);
+                for key in [
+                    "dissipated_ev",
+                    "virial_ev",
+                    "max_indentation_nm",
+                    "mean_indentation_nm",
+                ] {
+                    let d = (number(points[0], key) - number(&special, key)).abs();
+                    assert!(d <= 1e-6, "{label} {key}: {d:e}");
+                }
+                assert!(number(points[0], "energy_balance_residual") <= 1e-9);
+                let harmonics = points[0]["harmonics"].as_array().expect("harmonics");
+                assert_eq!(harmonics.len(), 4, "the default --harmonics");
+                for (ours, theirs) in harmonics
+                    .iter()
+                    .zip(special["harmonics"].as_array().expect("harmonics"))
+                {
+                    let d = (number(ours, "amplitude_nm") - number(theirs, "amplitude_nm")).abs();
+                    assert!(d <= 1e-6, "{label} harmonic {}: {d:e}", ours["n"]);
+                }
+            }
+        }
+    }
+    // The CSV: one row per JSON point, curve after curve, the harmonics' cells the JSON's.
+    let text = std::fs::read_to_string(&csv).expect("CSV written");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let points: Vec<&Value> = curves
+        .iter()
+        .flat_map(|c| c["points"].as_array().expect("points"))
+        .collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), points.len());
+    for (row, point) in rows.iter().zip(&points) {
+        for (column, cell) in header.iter().zip(row) {
+            let value = match column.strip_prefix("harmonic_") {
+                Some(rest) => {
+                    let (n, key) = rest.split_once('_').expect("harmonic_<n>_<key>");
+                    let n: usize = n.parse().expect("n");
+                    point["harmonics"][n - 1][key].clone()
+                }
+                None if *column == "label" => continue,
+                None => point[*column].clone(),
+            };
+            // Within 2 ulp: the test's JSON parser (serde_json without `float_roundtrip`)
+            // may round the printed shortest digits to a neighbouring float.
+            if let Some(expected) = value.as_f64() {
+                let written = cell.parse::<f64>().expect("a number");
+                assert!(
+                    (written - expected).abs() <= 4.0 * f64::EPSILON * expected.abs(),
+                    "{column}: {written} vs {expected}"
+                );
             }
         }
     }
@@ -141,7 +199,7 @@ fn the_plot_names_regions_shades_the_bistable_area_and_marks_cusps() {
 
 #[test]
 fn bad_input_is_refused_with_a_message_naming_the_option() {
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 9] = [
         (
             &["--vary", "mass", "--from", "5", "--to", "20"],
             "a0, drive-frequency, sample-modulus, tip-radius, quality-factor-N, stiffness-N",
@@ -166,6 +224,19 @@ fn bad_input_is_refused_with_a_message_naming_the_option() {
                 "--vary", "a0", "--from", "5", "--to", "20", "--labels", "G9",
             ],
             "--labels G9",
+        ),
+        (
+            &[
+                "--vary",
+                "a0",
+                "--from",
+                "5",
+                "--to",
+                "20",
+                "--harmonics",
+                "0",
+            ],
+            "--harmonics",
         ),
     ];
     for (args, message) in cases {

@@ -465,7 +465,23 @@ fn csv_columns_are_the_documented_json_keys_in_order() {
         map_csv.to_str().expect("utf-8 path"),
     ]);
     let written = std::fs::read_to_string(&map_csv).expect("CSV");
-    let header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    let full_header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    // As continue's: the harmonic columns come last, n = 1..4 by default.
+    let (header, harmonic_columns): (Vec<&str>, Vec<&str>) = full_header
+        .iter()
+        .partition(|column| !column.starts_with("harmonic_"));
+    assert_eq!(harmonic_columns.len(), 8);
+    for (index, pair) in harmonic_columns.chunks(2).enumerate() {
+        let n = index + 1;
+        assert_eq!(
+            pair,
+            [
+                format!("harmonic_{n}_amplitude_nm"),
+                format!("harmonic_{n}_phase_deg")
+            ]
+        );
+    }
+    assert_eq!(&full_header[..header.len()], &header[..]);
     assert_eq!(header[0], "label");
     let curve_points = &schema["`drumroll map --json`"];
     for column in &header[1..] {

@@ -29,6 +29,8 @@ pub struct ApproachOptions {
     pub settle_cycles: i64,
     /// Contact integration tolerance.
     pub tolerance: f64,
+    /// The harmonics `1..=N` of `u` of every reading.
+    pub harmonics: i64,
 }
 
 /// The sweep of the case `resolved` with `options`: a table (DataFrame, or dict of numpy arrays) with one
@@ -49,7 +51,7 @@ pub fn compute_approach<'py>(
         every: options.every,
         settle_cycles: options.settle_cycles,
         tolerance: options.tolerance,
-        harmonics: drumroll::approach::DEFAULT_HARMONICS,
+        harmonics: options.harmonics,
         jsonl: true,
         out: None,
         plot: None,

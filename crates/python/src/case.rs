@@ -214,18 +214,20 @@ impl Case {
     /// approach, the one the paper and `continue` report), `"transient"` (the attractor of
     /// transients from the free orbit), or a state near the orbit: a previous `Orbit` (at a
     /// nearby Z, as along a branch: the fast warm start) or the state `[q_1, q_1', ...]` (nm,
-    /// nm/us). Runs without the GIL.
-    #[pyo3(signature = (z=None, *, amplitude_ratio=None, start=None))]
+    /// nm/us). `harmonics`: the harmonics n = 1..N of u among the attributes (`harmonics`,
+    /// N in [1, 1000], as `simulate --harmonics`). Runs without the GIL.
+    #[pyo3(signature = (z=None, *, amplitude_ratio=None, start=None, harmonics=drumroll::approach::DEFAULT_HARMONICS))]
     fn orbit(
         &self,
         py: Python<'_>,
         z: Option<f64>,
         amplitude_ratio: Option<f64>,
         start: Option<&Bound<'_, PyAny>>,
+        harmonics: i64,
     ) -> PyResult<crate::orbit::Orbit> {
         let default = pyo3::types::PyString::new(py, "approach");
         let start = start.unwrap_or(default.as_any());
-        crate::orbit::compute_orbit(py, &self.resolved, z, amplitude_ratio, start)
+        crate::orbit::compute_orbit(py, &self.resolved, z, amplitude_ratio, start, harmonics)
     }
 
     /// The bifurcation diagram in Z (the paper's Fig. 2), as `drumroll continue`: the
@@ -234,9 +236,11 @@ impl Case {
     /// disables), arclength steps of at most `max_step` (nm; default A0/250), special points
     /// located to |dZ| < 1e-9 nm, at most `max_points` points per branch (a branch that
     /// reaches it stops there: `completed` is then False); with `retract=True` also back up
-    /// from the lowest point.
+    /// from the lowest point; `harmonics`: the harmonics n = 1..N of u at every point (the
+    /// table's `harmonic_<n>_amplitude_nm`, `harmonic_<n>_phase_deg` columns; N in [1, 1000]).
     /// Runs without the GIL; Ctrl-C interrupts it between branch points.
-    #[pyo3(signature = (*, floor=None, min_amplitude_ratio=0.3, max_step=None, max_points=20000, retract=false))]
+    #[pyo3(signature = (*, floor=None, min_amplitude_ratio=0.3, max_step=None, max_points=20000, retract=false, harmonics=drumroll::approach::DEFAULT_HARMONICS))]
+    #[allow(clippy::too_many_arguments)]
     fn diagram(
         &self,
         py: Python<'_>,
@@ -245,6 +249,7 @@ impl Case {
         max_step: Option<f64>,
         max_points: i64,
         retract: bool,
+        harmonics: i64,
     ) -> PyResult<crate::diagram::Diagram> {
         let options = crate::diagram::DiagramOptions {
             floor,
@@ -252,6 +257,7 @@ impl Case {
             max_step,
             max_points,
             retract,
+            harmonics,
         };
         crate::diagram::compute_diagram(py, &self.resolved, &options)
     }
@@ -278,9 +284,11 @@ impl Case {
     /// cycles at the start; `retract=True` sweeps back up; `tolerance` is the contact
     /// integration's. Returns a pandas DataFrame (dict of numpy arrays without pandas), one
     /// row per reading: `cycle`, `z_nm`, `amplitude_ratio`, `phase_deg` (deg),
-    /// `impacts_per_period`, `peak_force_nn` (nN), `direction`; `attrs["inputs"]` holds the
+    /// `impacts_per_period`, `peak_force_nn` (nN), `dissipated_ev` (eV per cycle),
+    /// `direction`, then `harmonic_<n>_amplitude_nm` and `harmonic_<n>_phase_deg` for
+    /// `n = 1..harmonics` (N in [1, 1000]); `attrs["inputs"]` holds the
     /// inputs. Runs without the GIL; Ctrl-C stops it and raises KeyboardInterrupt.
-    #[pyo3(signature = (*, from_nm=None, to_nm=0.0, rate_nm_per_s=1.0, retract=false, lockin_cycles=1, every=1, settle_cycles=20, tolerance=afm::sweep::DEFAULT_TOLERANCE))]
+    #[pyo3(signature = (*, from_nm=None, to_nm=0.0, rate_nm_per_s=1.0, retract=false, lockin_cycles=1, every=1, settle_cycles=20, tolerance=afm::sweep::DEFAULT_TOLERANCE, harmonics=drumroll::approach::DEFAULT_HARMONICS))]
     #[allow(clippy::too_many_arguments)]
     fn approach<'py>(
         &self,
@@ -293,6 +301,7 @@ impl Case {
         every: i64,
         settle_cycles: i64,
         tolerance: f64,
+        harmonics: i64,
     ) -> PyResult<Bound<'py, PyAny>> {
         let options = crate::approach::ApproachOptions {
             from_nm,
@@ -303,6 +312,7 @@ impl Case {
             every,
             settle_cycles,
             tolerance,
+            harmonics,
         };
         crate::approach::compute_approach(py, &self.resolved, &options)
     }
@@ -355,9 +365,10 @@ impl Case {
     /// `"tip-radius"` nm, `"quality-factor-N"`, `"stiffness-N"` N/m for mode N) from the
     /// case's own value over [`start`, `stop`], with a point exactly at each value of `at`
     /// and at least `points` points per curve over the range. `floor`,
-    /// `min_amplitude_ratio` and `max_step` set the seed approach as in `diagram`. Runs
+    /// `min_amplitude_ratio` and `max_step` set the seed approach as in `diagram`;
+    /// `harmonics`: the harmonics n = 1..N of u at every curve point (N in [1, 1000]). Runs
     /// without the GIL.
-    #[pyo3(signature = (vary, start, stop, *, at=None, labels=None, points=100, floor=None, min_amplitude_ratio=0.3, max_step=None))]
+    #[pyo3(signature = (vary, start, stop, *, at=None, labels=None, points=100, floor=None, min_amplitude_ratio=0.3, max_step=None, harmonics=drumroll::approach::DEFAULT_HARMONICS))]
     #[allow(clippy::too_many_arguments)]
     fn map(
         &self,
@@ -371,6 +382,7 @@ impl Case {
         floor: Option<f64>,
         min_amplitude_ratio: f64,
         max_step: Option<f64>,
+        harmonics: i64,
     ) -> PyResult<crate::regime_map::RegimeMap> {
         let options = crate::regime_map::MapOptions {
             vary,
@@ -382,6 +394,7 @@ impl Case {
             floor,
             min_amplitude_ratio,
             max_step,
+            harmonics,
         };
         crate::regime_map::compute_regime_map(py, &self.resolved, options)
     }

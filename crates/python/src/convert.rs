@@ -121,7 +121,9 @@ fn column<'py>(
 
 /// The records (JSON objects with the same keys) as columns: a pandas DataFrame if pandas can
 /// be imported, else a dict of numpy arrays; one column per key, the keys of `order` first in
-/// that order, then the others alphabetically.
+/// that order, then a record's `harmonics` list as the columns `harmonic_<n>_amplitude_nm` and
+/// `harmonic_<n>_phase_deg` for `n = 1..N` (as the CLI's CSV writes them; NaN where a record
+/// has fewer), then the other keys alphabetically.
 pub fn records_to_table<'py>(
     py: Python<'py>,
     records: &[Value],
@@ -129,17 +131,37 @@ pub fn records_to_table<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let numpy = py.import("numpy")?;
     let mut keys: Vec<String> = order.iter().map(|k| k.to_string()).collect();
+    let harmonic_count = records
+        .first()
+        .and_then(|r| r["harmonics"].as_array())
+        .map_or(0, Vec::len);
     if let Some(Value::Object(first)) = records.first() {
         let mut rest: Vec<String> = first
             .keys()
-            .filter(|k| !order.contains(&k.as_str()))
+            .filter(|k| !order.contains(&k.as_str()) && k.as_str() != "harmonics")
             .cloned()
             .collect();
         rest.sort();
         keys.extend(rest);
     }
     let columns = PyDict::new(py);
-    for key in &keys {
+    for key in &keys[..order.len()] {
+        let values: Vec<&Value> = records.iter().map(|r| &r[key.as_str()]).collect();
+        columns.set_item(key, column(py, &numpy, &values)?)?;
+    }
+    for n in 1..=harmonic_count {
+        for (name, field) in [
+            (format!("harmonic_{n}_amplitude_nm"), "amplitude_nm"),
+            (format!("harmonic_{n}_phase_deg"), "phase_deg"),
+        ] {
+            let values: Vec<f64> = records
+                .iter()
+                .map(|r| r["harmonics"][n - 1][field].as_f64().unwrap_or(f64::NAN))
+                .collect();
+            columns.set_item(name, float_array(py, values)?)?;
+        }
+    }
+    for key in &keys[order.len()..] {
         let values: Vec<&Value> = records.iter().map(|r| &r[key.as_str()]).collect();
         columns.set_item(key, column(py, &numpy, &values)?)?;
     }

@@ -17,10 +17,12 @@ use std::sync::Arc;
 /// above first contact down to a floor, every special point (grazing G_n, fold, ...) located
 /// to |dZ| < 1e-9 nm, and optionally the retract branch back up.
 ///
-/// `points`: one row per branch point, the columns the keys of a `continue --json` point
-/// (`z_nm` in nm, `amplitude_ratio`, `phase_deg` in degrees, `impacts_per_period`,
-/// `peak_force_nn` in nN, `stable`, ..., docs/output-schema.md); a pandas DataFrame, or a dict
-/// of numpy arrays without pandas (a `null` `min_gap_nm` is NaN there).
+/// `points`: one row per branch point, the columns those of `continue --csv` (the keys of a
+/// `continue --json` point: `z_nm` in nm, `amplitude_ratio`, `phase_deg` in degrees,
+/// `impacts_per_period`, `peak_force_nn` in nN, `dissipated_ev` and `virial_ev` in eV,
+/// `max_indentation_nm`, `energy_balance_residual`, `stable`, ..., then
+/// `harmonic_<n>_amplitude_nm` and `harmonic_<n>_phase_deg`; docs/output-schema.md); a pandas
+/// DataFrame, or a dict of numpy arrays without pandas (a `null` `min_gap_nm` is NaN there).
 /// `special_points`: a list of dicts (`label`, `z_nm`, `amplitude_ratio`, `phase_deg`,
 /// `impacts_before`, `impacts_after`, `bracket_nm`, `precision_nm`, `converged`, `state`).
 /// `to_dict()`: the whole `continue --json` object.
@@ -148,6 +150,8 @@ pub struct DiagramOptions {
     pub max_points: i64,
     /// Continue back up after the approach.
     pub retract: bool,
+    /// The harmonics `1..=N` of `u` at every point.
+    pub harmonics: i64,
 }
 
 /// The diagram of the case `resolved` (options as `drumroll continue`'s), computed without the GIL and
@@ -169,7 +173,7 @@ pub fn compute_diagram(
         plot: None,
         overlay: false,
         panels: None,
-        harmonics: drumroll::approach::DEFAULT_HARMONICS,
+        harmonics: options.harmonics,
     };
     let (json, warning) = without_gil(
         py,

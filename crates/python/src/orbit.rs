@@ -43,7 +43,10 @@ struct Computed {
 /// `multiplicity` (drive periods per orbit), `peak_force_nn` (nN), `mean_force_nn` (nN),
 /// `impulse_nn_us` (nN us per period), `contact_time_periods`, `min_gap_nm`, `gap_minima`,
 /// `impacts`, `stable`, `floquet_multipliers` ([re, im] pairs), `state` (q_i in nm and q_i'
-/// in nm/us at t = 0), `periods`, `converged`, `residual`, ... (docs/output-schema.md).
+/// in nm/us at t = 0), `periods`, `converged`, `residual`, the contrast observables
+/// `dissipated_ev` and `virial_ev` (eV), `max_indentation_nm`, `mean_indentation_nm` (nm),
+/// `energy_balance_residual`, `harmonics` (a list of dicts `n`, `amplitude_nm`, `phase_deg`;
+/// MODEL.md section 10), ... (docs/output-schema.md).
 /// `to_dict()` is the whole JSON object, `inputs` and `coexisting_orbit` included.
 #[pyclass(module = "drumroll", frozen)]
 pub struct Orbit {
@@ -106,7 +109,12 @@ impl Orbit {
                 return Value::Null;
             };
             let resolved = &self.resolved;
-            let settings = SteadyOrbitSettings::default();
+            // The harmonic count the orbit was computed with (`harmonics=`), so that the
+            // coexisting orbit and the inputs say the same as `simulate --harmonics`.
+            let settings = SteadyOrbitSettings {
+                harmonics: computed.orbit.observables().harmonics.len().max(1),
+                ..SteadyOrbitSettings::default()
+            };
             let (options, coexisting) = match computed.origin {
                 Origin::Cli {
                     start,
@@ -123,6 +131,7 @@ impl Orbit {
                         "z_nm": z,
                         "amplitude_ratio": amplitude_ratio,
                         "start": start.name(),
+                        "harmonics": settings.harmonics,
                     });
                     (
                         options,
@@ -130,7 +139,7 @@ impl Orbit {
                     )
                 }
                 Origin::Near => (
-                    json!({"z_nm": computed.orbit.z_nm, "amplitude_ratio": null, "start": "near"}),
+                    json!({"z_nm": computed.orbit.z_nm, "amplitude_ratio": null, "start": "near", "harmonics": settings.harmonics}),
                     None,
                 ),
             };
@@ -292,16 +301,22 @@ pub fn _restore_orbit(case: &Bound<'_, PyAny>, data: &Bound<'_, PyAny>) -> PyRes
 
 /// The steady orbit of the case `resolved` at `z` (or where the approach reaches `amplitude_ratio`), from
 /// `start`: `"approach"`, `"transient"`, or a state (an `Orbit`, or a sequence of floats)
-/// near the orbit.
+/// near the orbit; with harmonics `1..=harmonics` of `u` (checked as `simulate --harmonics`).
 pub fn compute_orbit(
     py: Python<'_>,
     resolved: &Arc<Resolved>,
     z: Option<f64>,
     amplitude_ratio: Option<f64>,
     start: &Bound<'_, PyAny>,
+    harmonics: i64,
 ) -> PyResult<Orbit> {
     let resolved = resolved.clone();
-    let settings = SteadyOrbitSettings::default();
+    let settings = SteadyOrbitSettings {
+        harmonics: drumroll::option_ranges::HARMONICS
+            .count(harmonics)
+            .map_err(to_py_err)?,
+        ..SteadyOrbitSettings::default()
+    };
     if let Ok(name) = start.extract::<String>() {
         let start = match name.as_str() {
             "approach" => Start::Approach,

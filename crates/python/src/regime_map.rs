@@ -35,6 +35,8 @@ pub struct MapOptions {
     pub min_amplitude_ratio: f64,
     /// Largest arclength step of the seed approach, nm.
     pub max_step: Option<f64>,
+    /// The harmonics `1..=N` of `u` at every curve point.
+    pub harmonics: i64,
 }
 
 /// An impact-regime map: for each special point of the case's approach diagram (`G2`, `G3`,
@@ -45,7 +47,9 @@ pub struct MapOptions {
 /// row per curve point: `parameter` (the parameter's unit, `parameter_info["unit"]`), `z_nm`
 /// (nm), `amplitude_ratio`, `phase_deg` (deg), `impacts_before`, `impacts_after`, `stable`,
 /// `spectral_radius`, `residual`, `at_fixed_parameter` (a point at one of `at`),
-/// `floquet_multipliers`, `state`. `ends`: why and where each curve ended.
+/// `dissipated_ev` and `virial_ev` (eV), `max_indentation_nm`, `mean_indentation_nm`,
+/// `energy_balance_residual`, `harmonic_<n>_amplitude_nm` and `harmonic_<n>_phase_deg` for
+/// `n = 1..N`, `floquet_multipliers`, `state` (the columns of `map --csv`, then the rest). `ends`: why and where each curve ended.
 /// `codim2_points`: the codimension-two points met on the curves. `to_dict()`: the whole
 /// JSON object.
 #[pyclass(module = "drumroll", frozen)]
@@ -149,6 +153,7 @@ pub fn compute_regime_map(
         floor: options.floor,
         min_amplitude_ratio: options.min_amplitude_ratio,
         max_step: options.max_step,
+        harmonics: options.harmonics,
         json: true,
         csv: None,
         plot: None,

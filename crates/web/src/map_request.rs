@@ -78,6 +78,7 @@ impl MapRequest {
             floor: self.floor_nm,
             min_amplitude_ratio: self.min_amplitude_ratio,
             max_step: self.max_step_nm,
+            harmonics: drumroll::approach::DEFAULT_HARMONICS,
             json: true,
             csv: None,
             plot: None,

@@ -41,7 +41,7 @@ use crate::error::AfmError;
 use crate::map::parameter_axis::{CaseFamily, ParameterAxis};
 use crate::model::case::Case;
 use crate::model::TappingModel;
-use crate::orbit::observables::orbit_observables;
+use crate::orbit::observables::{orbit_observables, Harmonic, OrbitObservables};
 use crate::orbit::steady_orbit::MAX_SEPARATION_NM;
 
 /// How a regime map is computed; [`RegimeMapSettings::new`] gives the defaults.
@@ -106,6 +106,22 @@ pub struct MapPoint {
     /// Whether the point was computed at a fixed parameter value (a range end, an `at` value
     /// or the case's own value) rather than along the arclength.
     pub at_fixed_parameter: bool,
+    /// Energy dissipated in the sample per drive period, `-int F_ts w' dt`, eV (MODEL.md
+    /// section 10; 0 for a conservative law).
+    pub dissipated_ev: f64,
+    /// The virial `(1/T) int F_ts w dt`, eV (MODEL.md section 10).
+    pub virial_ev: f64,
+    /// The largest indentation of the law's contact geometry over the period, nm (0 without
+    /// contact).
+    pub max_indentation_nm: f64,
+    /// The mean indentation over the time in contact, nm (0 without contact).
+    pub mean_indentation_nm: f64,
+    /// The largest mode's energy-balance residual over the total damping loss (MODEL.md
+    /// section 10).
+    pub energy_balance_residual: f64,
+    /// Harmonics `n = 1..N` of `u` (`N = settings.diagram.orbit.harmonics`; MODEL.md
+    /// section 10).
+    pub harmonics: Vec<Harmonic>,
     /// The orbit's state at `t = 0` (nm, nm/us).
     pub state: Vec<f64>,
 }
@@ -317,22 +333,30 @@ pub fn regime_map(
     let mut map_curves = Vec::new();
     let mut codim2_points = Vec::new();
     for (kind, curve, label) in &curves {
-        map_curves.push(map_curve(&family, *kind, curve, label, &integration)?);
+        map_curves.push(map_curve(
+            &family,
+            *kind,
+            curve,
+            label,
+            &integration,
+            settings.diagram.orbit.harmonics,
+        )?);
         for point in &curve.codim2_points {
-            let (_, ratio, _) = observe(
+            let (_, observables) = observe(
                 &family,
                 point.second_parameter,
                 point.parameter,
                 point.state.as_slice(),
                 point.section_time,
                 &integration,
+                1,
             )?;
             codim2_points.push(MapCodim2Point {
                 label: point.kind.label().to_string(),
                 curve: label.clone(),
                 parameter: point.second_parameter,
                 z_nm: point.parameter,
-                amplitude_ratio: ratio,
+                amplitude_ratio: observables.amplitude_ratio,
                 impacts: [point.impacts.0, point.impacts.1],
                 precision: point.precision,
                 converged: point.converged,
@@ -347,7 +371,8 @@ pub fn regime_map(
     })
 }
 
-/// The state at `t = 0` and `(A/A0, phase)` of the orbit through `state` at `section_time`.
+/// The state at `t = 0` and the observables (harmonics `1..=harmonics` of `u`) of the orbit
+/// through `state` at `section_time`.
 fn observe(
     family: &CaseFamily,
     q: f64,
@@ -355,7 +380,8 @@ fn observe(
     state: &[f64],
     section_time: f64,
     integration: &hybrid::Settings,
-) -> Result<(Vec<f64>, f64, f64), AfmError> {
+    harmonics: usize,
+) -> Result<(Vec<f64>, OrbitObservables), AfmError> {
     let mut model = family.model_at(q)?;
     continuation::Parametrised::set_parameter(&mut model, z);
     let period = model.period_us();
@@ -373,8 +399,8 @@ fn observe(
         )?
         .state
     };
-    let observables = orbit_observables(&model, &at_zero, integration, 1)?;
-    Ok((at_zero, observables.amplitude_ratio, observables.phase_deg))
+    let observables = orbit_observables(&model, &at_zero, integration, harmonics)?;
+    Ok((at_zero, observables))
 }
 
 /// Words for why a curve end stopped.
@@ -389,23 +415,26 @@ fn end_words(end: &CurveEnd) -> &'static str {
     }
 }
 
-/// The map curve of a continued curve, with the observables of every point.
+/// The map curve of a continued curve, with the observables of every point (harmonics
+/// `1..=harmonics` of `u`).
 fn map_curve(
     family: &CaseFamily,
     kind: CodimOneKind,
     curve: &Curve,
     label: &str,
     integration: &hybrid::Settings,
+    harmonics: usize,
 ) -> Result<MapCurve, AfmError> {
     let mut points = Vec::with_capacity(curve.points.len());
     for point in &curve.points {
-        let (state, ratio, phase) = observe(
+        let (state, observables) = observe(
             family,
             point.second_parameter,
             point.parameter,
             point.state.as_slice(),
             point.section_time,
             integration,
+            harmonics,
         )?;
         let impacts = point.structure.impacts;
         let after = if kind == CodimOneKind::Grazing {
@@ -416,8 +445,8 @@ fn map_curve(
         points.push(MapPoint {
             parameter: point.second_parameter,
             z_nm: point.parameter,
-            amplitude_ratio: ratio,
-            phase_deg: phase,
+            amplitude_ratio: observables.amplitude_ratio,
+            phase_deg: observables.phase_deg,
             impacts_before: impacts,
             impacts_after: after,
             stable: point.stable,
@@ -425,6 +454,12 @@ fn map_curve(
             floquet_multipliers: point.multipliers.iter().map(|m| [m.re, m.im]).collect(),
             residual: point.residual,
             at_fixed_parameter: point.at_fixed_second,
+            dissipated_ev: observables.dissipated_ev,
+            virial_ev: observables.virial_ev,
+            max_indentation_nm: observables.max_indentation_nm,
+            mean_indentation_nm: observables.mean_indentation_nm,
+            energy_balance_residual: observables.energy_balance_residual,
+            harmonics: observables.harmonics,
             state,
         });
     }
