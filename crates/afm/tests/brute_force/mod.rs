@@ -122,7 +122,7 @@ pub fn brute_force(model: &TappingModel, x0: &[f64], periods: usize) -> LastPeri
 }
 
 /// The separation (nm) at which the brute-force orbit's gap minimum nearest the surface
-/// crosses zero, by bisection in Z within `z_nm +- 2e-3` to 2e-8 nm, each orbit 12 periods
+/// crosses zero, by bisection in Z within `z_nm +- 2e-4` to 2e-8 nm, each orbit 12 periods
 /// from `state` (the Biolever's transients decay by over 1e-13 in that time).
 pub fn grazing_by_bisection(model: &TappingModel, state: &[f64], z_nm: f64) -> f64 {
     let nearest = |z: f64| {
@@ -134,7 +134,7 @@ pub fn grazing_by_bisection(model: &TappingModel, state: &[f64], z_nm: f64) -> f
             .min_by(|a, b| a.abs().total_cmp(&b.abs()))
             .unwrap()
     };
-    let (mut below, mut above) = (z_nm - 2e-3, z_nm + 2e-3);
+    let (mut below, mut above) = (z_nm - 2e-4, z_nm + 2e-4);
     assert!(nearest(below) < 0.0 && nearest(above) > 0.0);
     while above - below > 2e-8 {
         let mid = 0.5 * (below + above);
