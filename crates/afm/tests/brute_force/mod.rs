@@ -1,3 +1,6 @@
+// Each test file uses a subset of this shared reference.
+#![allow(dead_code)]
+
 //! A brute-force reference for the laws with a state or a force outside contact (MODEL.md
 //! section 9): fixed-step RK4 on the model's vector field (its sample state included), each
 //! crossing of a switching surface located by bisection of the step and the step split there,
