@@ -9,7 +9,7 @@ use hybrid::{
 use nalgebra::DMatrix;
 
 use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
-use crate::contact::ContactLaw;
+use crate::contact::{ContactLaw, HertzShape, HertzTip};
 use crate::model::contact_series::{self, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
@@ -147,7 +147,8 @@ impl ExactFlow for TappingModel {
 impl TappingModel {
     /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
     /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
-    /// outside it (van der Waals, when `H > 0`); `None` for every other law, mode, or with a
+    /// outside it (van der Waals, when `H > 0`), the Hertz sphere with a hydration force (in
+    /// contact plus `F_h(0)`, outside `F_h(d)`); `None` for every other law, mode, or with a
     /// double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
     pub(crate) fn series_force(&self, mode: Mode) -> Option<SeriesForce> {
         if self.plain_hertz {
@@ -157,7 +158,36 @@ impl TappingModel {
                 constant: 0.0,
             });
         }
-        let (ContactLaw::Dmt(dmt), None) = (self.force.law, self.force.double_layer) else {
+        if let (
+            ContactLaw::Hertz(HertzShape {
+                tip: HertzTip::Sphere { .. },
+                ..
+            }),
+            None,
+            Some(hydration),
+        ) = (self.force.law, self.force.double_layer, self.force.hydration)
+        {
+            // The Hertz sphere with the hydration force: in contact Hertz plus the constant
+            // `F_h(0)`, outside the hydration force's own series.
+            return Some(if Self::in_contact(mode) {
+                SeriesForce::Hertz {
+                    coefficient: self.hertz.coefficient,
+                    contact_gap: 0.0,
+                    constant: -hydration.force(0.0),
+                }
+            } else {
+                SeriesForce::Hydration {
+                    amplitude: hydration.amplitude_nn,
+                    wavenumber: 2.0 * std::f64::consts::PI / hydration.layer_spacing_nm,
+                    decay_length: hydration.decay_length_nm,
+                }
+            });
+        }
+        let (ContactLaw::Dmt(dmt), None, None) = (
+            self.force.law,
+            self.force.double_layer,
+            self.force.hydration,
+        ) else {
             return None;
         };
         if Self::in_contact(mode) {
