@@ -52,8 +52,13 @@ fn orbit_matches_the_brute_force() {
     let mut model = TappingModel::from_case(&case).unwrap();
     let z = 8.5;
     model.set_separation(Separation::Constant(z)).unwrap();
-    let orbit =
-        steady_orbit(&model, z, OrbitStart::Approach, &SteadyOrbitSettings::default()).unwrap();
+    let orbit = steady_orbit(
+        &model,
+        z,
+        OrbitStart::Approach,
+        &SteadyOrbitSettings::default(),
+    )
+    .unwrap();
     assert!(orbit.converged && orbit.multiplicity == 1);
     let o = orbit.observables();
     let last = brute_force(&model, &orbit.state, 3);
@@ -70,7 +75,11 @@ fn orbit_matches_the_brute_force() {
         o.phase_deg
     );
     assert!(o.dissipated_ev.abs() < 1e-9, "{}", o.dissipated_ev);
-    assert!(o.energy_balance_residual < 1e-9, "{:e}", o.energy_balance_residual);
+    assert!(
+        o.energy_balance_residual < 1e-9,
+        "{:e}",
+        o.energy_balance_residual
+    );
 }
 
 /// With `P_0 = 0` the force is Hertz's: the diagram's grazing points agree with the plain
@@ -87,7 +96,8 @@ fn zero_pressure_reproduces_hertz_and_the_case_continues() {
             .map(|p| (p.label.clone(), p.z_nm, p.converged))
             .collect::<Vec<_>>()
     };
-    let hertz = grazings(&TappingModel::from_case(&builtin_case("biolever-mica").unwrap()).unwrap());
+    let hertz =
+        grazings(&TappingModel::from_case(&builtin_case("biolever-mica").unwrap()).unwrap());
     let mut case = builtin_case("biolever-mica-hydration").unwrap();
     let hydrated = grazings(&TappingModel::from_case(&case).unwrap());
     case.sample.hydration.as_mut().unwrap().pressure_mpa = 0.0;
@@ -97,9 +107,15 @@ fn zero_pressure_reproduces_hertz_and_the_case_continues() {
     for ((label, z, _), (limit_label, limit_z, converged)) in hertz.iter().zip(&limit) {
         assert_eq!(label, limit_label);
         assert!(converged);
-        assert!((z - limit_z).abs() < 1e-9, "{label}: Hertz {z} vs P0 = 0 {limit_z}");
+        assert!(
+            (z - limit_z).abs() < 1e-9,
+            "{label}: Hertz {z} vs P0 = 0 {limit_z}"
+        );
     }
-    assert!(hydrated.iter().all(|(_, _, converged)| *converged), "{hydrated:?}");
+    assert!(
+        hydrated.iter().all(|(_, _, converged)| *converged),
+        "{hydrated:?}"
+    );
     let g1 = |points: &[(String, f64, bool)]| points.iter().find(|p| p.0 == "G1").unwrap().1;
     assert!((g1(&hydrated) - g1(&hertz)).abs() > 1e-6, "{hydrated:?}");
 }
@@ -108,6 +124,11 @@ fn zero_pressure_reproduces_hertz_and_the_case_continues() {
 #[test]
 fn sample_file_checks_the_hydration_object() {
     let text = r#"{"name": "t", "youngs_modulus_gpa": 60, "hydration": {"pressure_mpa": 10, "layer_spacing_nm": 0, "decay_length_nm": 0.3}}"#;
-    let error = afm::fixtures::parse_sample("t.json", text).unwrap_err().to_string();
-    assert!(error.contains("t.json") && error.contains("hydration.layer_spacing_nm"), "{error}");
+    let error = afm::fixtures::parse_sample("t.json", text)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("t.json") && error.contains("hydration.layer_spacing_nm"),
+        "{error}"
+    );
 }

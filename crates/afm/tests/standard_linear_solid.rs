@@ -6,9 +6,9 @@
 mod brute_force;
 
 use afm::{
-    approach_diagram, builtin_cantilever, builtin_case, regime_map, steady_orbit,
-    DiagramSettings, OrbitStart, ParameterAxis, RegimeMapSettings, Sample, Separation,
-    SteadyOrbitSettings, TappingModel,
+    approach_diagram, builtin_cantilever, builtin_case, regime_map, steady_orbit, DiagramSettings,
+    OrbitStart, ParameterAxis, RegimeMapSettings, Sample, Separation, SteadyOrbitSettings,
+    TappingModel,
 };
 use brute_force::{brute_force, grazing_by_bisection};
 
@@ -51,8 +51,13 @@ fn dashpot_rate(model: &TappingModel, gap: f64, rho: f64) -> f64 {
 fn orbit_and_dissipation_match_the_brute_force() {
     let z = 8.5;
     let model = model_with(SLS, z);
-    let orbit = steady_orbit(&model, z, OrbitStart::Approach, &SteadyOrbitSettings::default())
-        .unwrap();
+    let orbit = steady_orbit(
+        &model,
+        z,
+        OrbitStart::Approach,
+        &SteadyOrbitSettings::default(),
+    )
+    .unwrap();
     assert!(orbit.converged && orbit.multiplicity == 1);
     let o = orbit.observables();
     assert_eq!(o.impacts_per_period, 2.0);
@@ -116,7 +121,11 @@ fn second_impact_grazing_matches_the_brute_force_bisection() {
         .expect("G2 on the approach");
     assert!(g2.converged);
     let z = grazing_by_bisection(&model, &g2.state, g2.z_nm);
-    assert!((z - g2.z_nm).abs() < 1e-7, "G2 {} vs brute force {z}", g2.z_nm);
+    assert!(
+        (z - g2.z_nm).abs() < 1e-7,
+        "G2 {} vs brute force {z}",
+        g2.z_nm
+    );
 }
 
 /// `E_0 = E_inf` keeps `rho = 0`: the diagram's grazing points are Hertz's (1 GPa) to 1e-9 nm.
@@ -140,7 +149,10 @@ fn equal_moduli_reproduce_the_hertz_grazing_points() {
     assert_eq!(hertz.len(), sls.len(), "{hertz:?} vs {sls:?}");
     for ((label, z), (sls_label, sls_z)) in hertz.iter().zip(&sls) {
         assert_eq!(label, sls_label);
-        assert!((z - sls_z).abs() < 1e-9, "{label}: Hertz {z} vs SLS {sls_z}");
+        assert!(
+            (z - sls_z).abs() < 1e-9,
+            "{label}: Hertz {z} vs SLS {sls_z}"
+        );
     }
 }
 
@@ -164,28 +176,28 @@ fn regime_map_follows_the_grazing_points() {
     };
     let map = regime_map(&case, ParameterAxis::FreeAmplitude, &settings).unwrap();
     for a0 in [9.5, 10.0] {
-        let rebuilt = ParameterAxis::FreeAmplitude.apply(&case, a0, "test").unwrap();
+        let rebuilt = ParameterAxis::FreeAmplitude
+            .apply(&case, a0, "test")
+            .unwrap();
         let at = TappingModel::from_case(&rebuilt).unwrap();
         let diagram = approach_diagram(&at, &DiagramSettings::approach(&at)).unwrap();
-        for label in ["G2"] {
-            let curve = map.curves.iter().find(|c| c.label == label).expect(label);
-            let point = curve
-                .points
-                .iter()
-                .find(|p| p.parameter == a0)
-                .unwrap_or_else(|| panic!("{label} at A0 = {a0}"));
-            let special = diagram
-                .special_points
-                .iter()
-                .find(|s| s.label == label)
-                .unwrap();
-            assert!(
-                (point.z_nm - special.z_nm).abs() <= 1e-9 + special.precision_nm,
-                "{label} at A0 = {a0}: map {} vs diagram {}",
-                point.z_nm,
-                special.z_nm
-            );
-        }
+        let curve = map.curves.iter().find(|c| c.label == "G2").expect("G2");
+        let point = curve
+            .points
+            .iter()
+            .find(|p| p.parameter == a0)
+            .unwrap_or_else(|| panic!("G2 at A0 = {a0}"));
+        let special = diagram
+            .special_points
+            .iter()
+            .find(|s| s.label == "G2")
+            .unwrap();
+        assert!(
+            (point.z_nm - special.z_nm).abs() <= 1e-9 + special.precision_nm,
+            "G2 at A0 = {a0}: map {} vs diagram {}",
+            point.z_nm,
+            special.z_nm
+        );
     }
 }
 
@@ -193,9 +205,8 @@ fn regime_map_follows_the_grazing_points() {
 #[test]
 fn sample_file_checks_the_moduli_and_the_time() {
     let error = |contact: &str| {
-        let text = format!(
-            r#"{{"name": "test", "youngs_modulus_gpa": 1.0, "contact": {contact}}}"#
-        );
+        let text =
+            format!(r#"{{"name": "test", "youngs_modulus_gpa": 1.0, "contact": {contact}}}"#);
         afm::fixtures::parse_sample("test.json", &text)
             .unwrap_err()
             .to_string()

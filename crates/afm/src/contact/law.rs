@@ -195,8 +195,7 @@ impl TipSampleForce {
             (false, _) => self.law.outside(gap_nm),
         };
         let contact_gap = self.contact_gap_nm();
-        let held =
-            inside || (self.law.standard_linear_solid().is_some() && gap_nm < contact_gap);
+        let held = inside || (self.law.standard_linear_solid().is_some() && gap_nm < contact_gap);
         let additive = |slopes: ForceSlopes| {
             if held {
                 ForceSlopes {

@@ -134,7 +134,7 @@ impl ExactFlow for TappingModel {
             let last = 2 * self.modes.len();
             let decay = (-sls.recovery_rate_per_us() * dt).exp();
             x[last] = x0[last] * decay;
-            if let Some(matrix) = transition.as_deref_mut() {
+            if let Some(matrix) = transition {
                 matrix[(last, last)] = decay;
             }
         }
@@ -165,8 +165,11 @@ impl TappingModel {
             }),
             None,
             Some(hydration),
-        ) = (self.force.law, self.force.double_layer, self.force.hydration)
-        {
+        ) = (
+            self.force.law,
+            self.force.double_layer,
+            self.force.hydration,
+        ) {
             // The Hertz sphere with the hydration force: in contact Hertz plus the constant
             // `F_h(0)`, outside the hydration force's own series.
             return Some(if Self::in_contact(mode) {

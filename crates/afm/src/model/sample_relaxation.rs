@@ -21,7 +21,13 @@ struct RelaxingSlopes {
 }
 
 impl TappingModel {
-    fn relaxing_slopes(&self, sls: &StandardLinearSolid, mode: Mode, t: f64, x: &[f64]) -> RelaxingSlopes {
+    fn relaxing_slopes(
+        &self,
+        sls: &StandardLinearSolid,
+        mode: Mode,
+        t: f64,
+        x: &[f64],
+    ) -> RelaxingSlopes {
         let inside = mode & CONTACT != 0;
         let state = self.sample_state(x);
         let gap = self.gap(t, x);
