@@ -1,7 +1,8 @@
 //! Benchmark of the contact laws (MODEL.md section 9): the approach diagram
 //! (`DiagramSettings::approach`) of the Biolever and the MAClever on the soft sample with a DMT
-//! law (H = 5e-22 J, a0 = 0.165 nm) and a clipped Kelvin-Voigt law (eta = 100 Pa s), against the
-//! Hertz diagram of the same case. Target: each within 3 times the Hertz time.
+//! law (H = 5e-22 J, a0 = 0.165 nm), a clipped Kelvin-Voigt law (eta = 100 Pa s), a standard
+//! linear solid (E0 = 1 GPa, Einf = 0.4 GPa, tau = 5 us) and Hertz with the hydration force
+//! (10 MPa, 0.25 nm, 0.3 nm), against the Hertz diagram of the same case. Target: each within 3 times the Hertz time.
 //!
 //! Run with `cargo bench -p afm --bench contact_laws`; `-- --repetitions N` (default 5) sets
 //! the repetitions of each diagram, whose median thread CPU time is reported.
@@ -70,6 +71,19 @@ fn main() {
         (
             "kelvin-voigt",
             Some(r#"{"law": "kelvin-voigt", "viscosity_pa_s": 100}"#),
+        ),
+        (
+            "sls",
+            Some(
+                r#"{"law": "standard-linear-solid", "instant_modulus_gpa": 1.0, "relaxed_modulus_gpa": 0.4, "relaxation_time_us": 5.0}"#,
+            ),
+        ),
+        // The hydration object follows the contact object in the sample's text.
+        (
+            "hydration",
+            Some(
+                r#"{"law": "hertz"}, "hydration": {"pressure_mpa": 10, "layer_spacing_nm": 0.25, "decay_length_nm": 0.3}"#,
+            ),
         ),
     ];
     for (cantilever, a0) in [("biolever", 10.0), ("maclever", 20.0)] {

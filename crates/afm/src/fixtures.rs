@@ -42,6 +42,8 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "soft"),
     embedded!("samples", "purple-membrane"),
     embedded!("samples", "purple-membrane-film"),
+    embedded!("samples", "soft-viscoelastic"),
+    embedded!("samples", "mica-hydration"),
 ];
 
 const CASES: &[Embedded] = &[
@@ -52,6 +54,8 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "maclever-mica-experiment"),
     embedded!("cases", "maclever-membrane-experiment"),
     embedded!("cases", "maclever-membrane-film"),
+    embedded!("cases", "biolever-soft-viscoelastic"),
+    embedded!("cases", "biolever-mica-hydration"),
 ];
 
 const LINES: &[Embedded] = &[embedded!("lines", "membrane-patch")];
@@ -66,14 +70,14 @@ pub fn cantilever_names() -> Vec<&'static str> {
 }
 
 /// The names of the built-in samples (`mica`, `soft`, `purple-membrane`,
-/// `purple-membrane-film`).
+/// `purple-membrane-film`, `soft-viscoelastic`, `mica-hydration`).
 pub fn sample_names() -> Vec<&'static str> {
     names(SAMPLES)
 }
 
 /// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
 /// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
-/// `maclever-membrane-film`).
+/// `maclever-membrane-film`, `biolever-soft-viscoelastic`, `biolever-mica-hydration`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }

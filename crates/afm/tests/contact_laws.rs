@@ -26,6 +26,7 @@ fn alone(law: ContactLaw) -> TipSampleForce {
     TipSampleForce {
         law,
         double_layer: None,
+        hydration: None,
     }
 }
 
@@ -240,6 +241,7 @@ fn double_layer_matches_its_closed_form_and_is_held_inside_contact() {
     let force = TipSampleForce {
         law: ContactLaw::Hertz(sphere()),
         double_layer: Some(layer),
+        hydration: None,
     };
     for d in [0.0, 0.5, 3.0] {
         let exact = amplitude * (-d / lambda).exp();

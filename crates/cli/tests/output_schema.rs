@@ -180,8 +180,8 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
     ];
     printed.extend(check(&schema, "`drumroll simulate --json`", &simulate));
 
-    // simulate with each contact law's sample file (the inputs' `contact` and
-    // `electrostatic` objects, MODEL.md section 9).
+    // simulate with each contact law's sample file (the inputs' `contact`, `electrostatic`
+    // and `hydration` objects, MODEL.md section 9).
     let directory = tempfile::tempdir().expect("temporary directory");
     let laws = [
         r#""contact": {"law": "dmt", "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}"#,
@@ -189,6 +189,7 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
         r#""contact": {"law": "film", "thickness_nm": 6, "correction": "garcia-2018"}"#,
         r#""contact": {"law": "hertz", "tip_shape": "cone", "cone_half_angle_deg": 20}, "electrostatic": {"debye_length_nm": 1, "tip_charge_c_per_m2": 0.02, "sample_charge_c_per_m2": 0.02, "relative_permittivity": 80}"#,
         r#""contact": {"law": "hertz", "tip_shape": "flat-punch", "punch_radius_nm": 2}"#,
+        r#""contact": {"law": "standard-linear-solid", "instant_modulus_gpa": 1, "relaxed_modulus_gpa": 0.4, "relaxation_time_us": 5}, "hydration": {"pressure_mpa": 10, "layer_spacing_nm": 0.25, "decay_length_nm": 0.3}"#,
     ];
     let mut with_laws = Vec::new();
     for (i, law) in laws.iter().enumerate() {

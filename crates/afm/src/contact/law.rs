@@ -4,7 +4,10 @@
 
 use std::ops::AddAssign;
 
-use super::{DmtContact, DoubleLayer, FilmContact, HertzShape, KelvinVoigtContact};
+use super::{
+    DmtContact, DoubleLayer, FilmContact, HertzShape, HydrationForce, KelvinVoigtContact,
+    StandardLinearSolid,
+};
 
 /// A force `F` (nN, repulsive positive) with its slopes `dF/dd` (nN/nm) and `dF/dd'`
 /// (nN us/nm) at one gap `d` and gap rate `d'`.
@@ -47,6 +50,8 @@ pub enum ContactLaw {
     KelvinVoigt(KelvinVoigtContact),
     /// A film of thickness `h` on a rigid substrate: Hertz times a bottom-effect correction.
     Film(FilmContact),
+    /// A standard linear solid: Hertz on a relaxing sample with an internal state.
+    StandardLinearSolid(StandardLinearSolid),
 }
 
 impl ContactLaw {
@@ -58,9 +63,17 @@ impl ContactLaw {
         }
     }
 
-    /// The force and slopes inside contact (`d < d_c`), unclipped.
+    /// The force and slopes inside contact (`d < d_c`), unclipped; a standard linear solid's
+    /// for a recovered sample (`rho = 0`; [`ContactLaw::inside_at`] takes the state).
     pub fn inside(&self, gap_nm: f64, gap_rate: f64) -> ForceSlopes {
+        self.inside_at(gap_nm, gap_rate, 0.0)
+    }
+
+    /// [`ContactLaw::inside`] with the sample's internal state `rho` (nm^{3/2}; used by the
+    /// standard linear solid only).
+    pub fn inside_at(&self, gap_nm: f64, gap_rate: f64, sample_state: f64) -> ForceSlopes {
         match self {
+            Self::StandardLinearSolid(sls) => sls.force_slopes(gap_nm, sample_state),
             Self::Hertz(shape) => shape.force_slopes(gap_nm),
             Self::Dmt(dmt) => dmt.inside(gap_nm),
             Self::KelvinVoigt(kv) => kv.force_slopes(gap_nm, gap_rate),
@@ -74,6 +87,23 @@ impl ContactLaw {
         match self {
             Self::Dmt(dmt) => dmt.outside(gap_nm),
             _ => ForceSlopes::ZERO,
+        }
+    }
+
+    /// The standard linear solid, if the law is one (it adds a state to the model).
+    pub fn standard_linear_solid(&self) -> Option<&StandardLinearSolid> {
+        match self {
+            Self::StandardLinearSolid(sls) => Some(sls),
+            _ => None,
+        }
+    }
+
+    /// How far below `d = d_c` the contact surface lies for internal state `rho`: the
+    /// standard linear solid's unrecovered depth `sigma = rho^{2/3}` (nm), 0 for other laws.
+    pub fn surface_depth_nm(&self, sample_state: f64) -> f64 {
+        match self {
+            Self::StandardLinearSolid(_) => StandardLinearSolid::unrecovered_depth_nm(sample_state),
+            _ => 0.0,
         }
     }
 
@@ -102,13 +132,15 @@ impl ContactLaw {
     pub fn half_power_inside(&self) -> bool {
         match self {
             Self::Hertz(shape) => shape.has_half_powers(),
-            Self::Dmt(_) | Self::KelvinVoigt(_) | Self::Film(_) => true,
+            Self::Dmt(_) | Self::KelvinVoigt(_) | Self::Film(_) | Self::StandardLinearSolid(_) => {
+                true
+            }
         }
     }
 }
 
 /// The tip-sample force of a sample: its contact law plus an optional electrostatic double
-/// layer (MODEL.md section 9). A clipped Kelvin-Voigt law's force inside contact is zero in
+/// layer and hydration force (MODEL.md section 9). A clipped Kelvin-Voigt law's force inside contact is zero in
 /// the clipped mode (the side `h_1 < 0` of its release surface).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TipSampleForce {
@@ -116,6 +148,8 @@ pub struct TipSampleForce {
     pub law: ContactLaw,
     /// The double-layer term, if any.
     pub double_layer: Option<DoubleLayer>,
+    /// The hydration (solvation) term, if any.
+    pub hydration: Option<HydrationForce>,
 }
 
 impl TipSampleForce {
@@ -124,14 +158,14 @@ impl TipSampleForce {
         self.law.contact_gap_nm()
     }
 
-    /// Whether any force acts outside contact (DMT's van der Waals, a double layer).
+    /// Whether any force acts outside contact (DMT's van der Waals, a double layer, a
+    /// hydration force).
     pub fn acts_outside_contact(&self) -> bool {
-        self.law.acts_outside_contact() || self.double_layer.is_some()
+        self.law.acts_outside_contact() || self.double_layer.is_some() || self.hydration.is_some()
     }
 
     /// The force and slopes on one side: inside contact (`inside`), with the contact law
-    /// zeroed when `clipped`, or outside. The double layer adds `F_dl(d)` outside and its
-    /// value on the contact surface, `F_dl(d_c)`, inside (held constant).
+    /// zeroed when `clipped`, or outside, for a recovered sample (`rho = 0`).
     pub fn in_region(
         &self,
         inside: bool,
@@ -139,20 +173,45 @@ impl TipSampleForce {
         gap_nm: f64,
         gap_rate: f64,
     ) -> ForceSlopes {
+        self.in_region_at(inside, clipped, gap_nm, gap_rate, 0.0)
+    }
+
+    /// [`TipSampleForce::in_region`] with the sample's internal state `rho` (nm^{3/2}; the
+    /// standard linear solid's). The double layer and the hydration force add `F(d)` outside
+    /// (for a standard linear solid at `max(d, d_c)`: constant between its rest surface and
+    /// its unrecovered surface) and their value on the contact surface, `F(d_c)`, inside (held
+    /// constant).
+    pub fn in_region_at(
+        &self,
+        inside: bool,
+        clipped: bool,
+        gap_nm: f64,
+        gap_rate: f64,
+        sample_state: f64,
+    ) -> ForceSlopes {
         let mut total = match (inside, clipped) {
             (true, true) => ForceSlopes::ZERO,
-            (true, false) => self.law.inside(gap_nm, gap_rate),
+            (true, false) => self.law.inside_at(gap_nm, gap_rate, sample_state),
             (false, _) => self.law.outside(gap_nm),
         };
-        if let Some(layer) = &self.double_layer {
-            total += if inside {
+        let contact_gap = self.contact_gap_nm();
+        let held = inside || (self.law.standard_linear_solid().is_some() && gap_nm < contact_gap);
+        let additive = |slopes: ForceSlopes| {
+            if held {
                 ForceSlopes {
-                    force: layer.force(self.contact_gap_nm()),
+                    force: slopes.force,
                     ..ForceSlopes::ZERO
                 }
             } else {
-                layer.force_slopes(gap_nm)
-            };
+                slopes
+            }
+        };
+        let at = if held { contact_gap } else { gap_nm };
+        if let Some(layer) = &self.double_layer {
+            total += additive(layer.force_slopes(at));
+        }
+        if let Some(hydration) = &self.hydration {
+            total += additive(hydration.force_slopes(at));
         }
         total
     }
@@ -160,12 +219,19 @@ impl TipSampleForce {
     /// The force (nN) at gap `d` and rate `d'` with the region taken from the gap itself
     /// (inside when `d < d_c`) and a clipped law clipped at zero: what a sampled state feels.
     pub fn force(&self, gap_nm: f64, gap_rate: f64) -> f64 {
-        let inside = gap_nm < self.contact_gap_nm();
+        self.force_at(gap_nm, gap_rate, 0.0)
+    }
+
+    /// [`TipSampleForce::force`] with the sample's internal state `rho` (nm^{3/2}): inside
+    /// when `d + sigma < d_c` (`sigma` the standard linear solid's unrecovered depth).
+    pub fn force_at(&self, gap_nm: f64, gap_rate: f64, sample_state: f64) -> f64 {
+        let inside = gap_nm + self.law.surface_depth_nm(sample_state) < self.contact_gap_nm();
         let clipped = inside
             && self
                 .law
                 .release_time_us()
                 .is_some_and(|tau| -gap_nm - tau * gap_rate < 0.0);
-        self.in_region(inside, clipped, gap_nm, gap_rate).force
+        self.in_region_at(inside, clipped, gap_nm, gap_rate, sample_state)
+            .force
     }
 }

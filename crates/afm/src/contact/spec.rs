@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     ContactLaw, DmtContact, DoubleLayer, FilmContact, FilmCorrection, HertzShape, HertzTip,
-    KelvinVoigtContact, TipSampleForce,
+    HydrationForce, KelvinVoigtContact, StandardLinearSolid, TipSampleForce,
 };
 use crate::error::AfmError;
 use crate::validation::{check, invalid, Interval};
@@ -86,6 +86,66 @@ pub enum ContactSpec {
         #[serde(default)]
         correction: FilmCorrectionSpec,
     },
+    /// A standard linear solid (MODEL.md section 9): instantaneous modulus `E_0` and relaxed
+    /// modulus `E_inf` in GPa, range [1e-7, 1e4] with `E_inf <= E_0`; relaxation time `tau` in
+    /// us, range [1e-3, 1e6]. They replace the sample's `youngs_modulus_gpa` in the contact.
+    StandardLinearSolid {
+        /// `E_0`, GPa.
+        instant_modulus_gpa: f64,
+        /// `E_inf`, GPa.
+        relaxed_modulus_gpa: f64,
+        /// `tau`, us.
+        relaxation_time_us: f64,
+    },
+}
+
+/// The `hydration` object of a sample file: the solvation force of ordered water layers added
+/// to the contact law (MODEL.md section 9, [`HydrationForce`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HydrationSpec {
+    /// The pressure amplitude `P_0` between flat surfaces at contact, MPa; range [-1e4, 1e4]
+    /// (positive: repulsive at contact).
+    pub pressure_mpa: f64,
+    /// The layer spacing `sigma` (about a water molecule's diameter, 0.25-0.3 nm), nm; range
+    /// [0.05, 5].
+    pub layer_spacing_nm: f64,
+    /// The decay length `lambda`, nm; range [0.05, 10].
+    pub decay_length_nm: f64,
+}
+
+impl HydrationSpec {
+    /// Check every parameter's range; errors name `file` and `hydration.<field>`.
+    pub fn validate(&self, file: &str) -> Result<(), AfmError> {
+        check(
+            file,
+            "hydration.pressure_mpa",
+            self.pressure_mpa,
+            Interval::closed(-1e4, 1e4, "MPa"),
+        )?;
+        check(
+            file,
+            "hydration.layer_spacing_nm",
+            self.layer_spacing_nm,
+            Interval::closed(0.05, 5.0, "nm"),
+        )?;
+        check(
+            file,
+            "hydration.decay_length_nm",
+            self.decay_length_nm,
+            Interval::closed(0.05, 10.0, "nm"),
+        )
+    }
+
+    /// The hydration force on a tip of radius `R` (nm).
+    pub fn force(&self, tip_radius_nm: f64) -> HydrationForce {
+        HydrationForce::new(
+            tip_radius_nm,
+            self.pressure_mpa,
+            self.layer_spacing_nm,
+            self.decay_length_nm,
+        )
+    }
 }
 
 /// The `electrostatic` object of a sample file: a double layer added to the contact law.
@@ -140,14 +200,64 @@ impl ContactSpec {
                 *thickness_nm,
                 Interval::positive(1e5, "nm"),
             ),
+            Self::StandardLinearSolid {
+                instant_modulus_gpa,
+                relaxed_modulus_gpa,
+                relaxation_time_us,
+            } => {
+                check(
+                    file,
+                    "contact.instant_modulus_gpa",
+                    *instant_modulus_gpa,
+                    Interval::closed(1e-7, 1e4, "GPa"),
+                )?;
+                check(
+                    file,
+                    "contact.relaxed_modulus_gpa",
+                    *relaxed_modulus_gpa,
+                    Interval::closed(1e-7, *instant_modulus_gpa, "GPa"),
+                )?;
+                check(
+                    file,
+                    "contact.relaxation_time_us",
+                    *relaxation_time_us,
+                    Interval::closed(1e-3, 1e6, "us"),
+                )
+            }
+        }
+    }
+
+    /// The sample moduli a law uses in place of the sample's `youngs_modulus_gpa`: a standard
+    /// linear solid's `(E_0, E_inf)`, GPa; `None` for every other law.
+    pub fn sample_moduli_gpa(&self) -> Option<(f64, f64)> {
+        match *self {
+            Self::StandardLinearSolid {
+                instant_modulus_gpa,
+                relaxed_modulus_gpa,
+                ..
+            } => Some((instant_modulus_gpa, relaxed_modulus_gpa)),
+            _ => None,
         }
     }
 
     /// The law for reduced modulus `E*` (GPa), tip radius `R` (nm) and sample Poisson ratio
-    /// `nu_s` (for `eta* = eta / (1 - nu_s^2)`). Call after [`ContactSpec::validate`].
+    /// `nu_s` (for `eta* = eta / (1 - nu_s^2)`). Call after [`ContactSpec::validate`]. A
+    /// standard linear solid takes `E*` as its instantaneous reduced modulus and scales its
+    /// relaxed one by `E_inf/E_0` (exact for a rigid tip); the tapping model replaces both by
+    /// the reduced moduli of `E_0` and `E_inf` with the tip's.
     pub fn law(&self, effective_modulus_gpa: f64, tip_radius_nm: f64, poisson: f64) -> ContactLaw {
         let e = effective_modulus_gpa;
         match *self {
+            Self::StandardLinearSolid {
+                instant_modulus_gpa,
+                relaxed_modulus_gpa,
+                relaxation_time_us,
+            } => ContactLaw::StandardLinearSolid(StandardLinearSolid {
+                instant_modulus_gpa: e,
+                relaxed_modulus_gpa: e * relaxed_modulus_gpa / instant_modulus_gpa,
+                relaxation_time_us,
+                tip_radius_nm,
+            }),
             Self::Hertz {
                 tip_shape,
                 cone_half_angle_deg,
@@ -327,5 +437,6 @@ pub fn tip_sample_force(
     TipSampleForce {
         law,
         double_layer: electrostatic.map(|spec| spec.double_layer(tip_radius_nm)),
+        hydration: None,
     }
 }

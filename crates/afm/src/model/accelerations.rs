@@ -9,7 +9,7 @@ use hybrid::{
 use nalgebra::DMatrix;
 
 use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
-use crate::contact::ContactLaw;
+use crate::contact::{ContactLaw, HertzShape, HertzTip};
 use crate::model::contact_series::{self, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
@@ -78,6 +78,16 @@ impl ExactFlow for TappingModel {
                 states[j * n + 2 * i + 1] = steady[1] + y[1];
             }
         }
+        if let Some(sls) = self.force.law.standard_linear_solid() {
+            // The unloaded surface's recovery `rho(t) = rho_0 exp(-(1 - beta) (t - t_0) / tau)`.
+            let last = 2 * self.modes.len();
+            let decay = (-sls.recovery_rate_per_us() * spacing).exp();
+            let mut state = x0[last];
+            for j in 0..count {
+                state *= decay;
+                states[j * n + last] = state;
+            }
+        }
     }
 
     /// The free flight's closed-form flow (block diagonal, one [`DrivenOscillator`] per mode);
@@ -120,6 +130,14 @@ impl ExactFlow for TappingModel {
                 }
             }
         }
+        if let Some(sls) = self.force.law.standard_linear_solid() {
+            let last = 2 * self.modes.len();
+            let decay = (-sls.recovery_rate_per_us() * dt).exp();
+            x[last] = x0[last] * decay;
+            if let Some(matrix) = transition {
+                matrix[(last, last)] = decay;
+            }
+        }
         if let Some(dxdp) = dxdp {
             dxdp.fill(0.0);
         }
@@ -129,7 +147,8 @@ impl ExactFlow for TappingModel {
 impl TappingModel {
     /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
     /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
-    /// outside it (van der Waals, when `H > 0`); `None` for every other law, mode, or with a
+    /// outside it (van der Waals, when `H > 0`), the Hertz sphere with a hydration force (in
+    /// contact plus `F_h(0)`, outside `F_h(d)`); `None` for every other law, mode, or with a
     /// double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
     pub(crate) fn series_force(&self, mode: Mode) -> Option<SeriesForce> {
         if self.plain_hertz {
@@ -139,7 +158,39 @@ impl TappingModel {
                 constant: 0.0,
             });
         }
-        let (ContactLaw::Dmt(dmt), None) = (self.force.law, self.force.double_layer) else {
+        if let (
+            ContactLaw::Hertz(HertzShape {
+                tip: HertzTip::Sphere { .. },
+                ..
+            }),
+            None,
+            Some(hydration),
+        ) = (
+            self.force.law,
+            self.force.double_layer,
+            self.force.hydration,
+        ) {
+            // The Hertz sphere with the hydration force: in contact Hertz plus the constant
+            // `F_h(0)`, outside the hydration force's own series.
+            return Some(if Self::in_contact(mode) {
+                SeriesForce::Hertz {
+                    coefficient: self.hertz.coefficient,
+                    contact_gap: 0.0,
+                    constant: -hydration.force(0.0),
+                }
+            } else {
+                SeriesForce::Hydration {
+                    amplitude: hydration.amplitude_nn,
+                    wavenumber: 2.0 * std::f64::consts::PI / hydration.layer_spacing_nm,
+                    decay_length: hydration.decay_length_nm,
+                }
+            });
+        }
+        let (ContactLaw::Dmt(dmt), None, None) = (
+            self.force.law,
+            self.force.double_layer,
+            self.force.hydration,
+        ) else {
             return None;
         };
         if Self::in_contact(mode) {
@@ -275,15 +326,20 @@ impl SwitchingStructure for TappingModel {
     }
 
     /// The gap `Z(t) + sum_i q_i` is affine (`Z(t)` is a constant or a linear ramp), and so
-    /// are `h_0 = d - d_c` and `h_1 = -d - tau d'`.
+    /// are `h_0 = d - d_c` and `h_1 = -d - tau d'`; a standard linear solid's
+    /// `h_0 = d + rho^{2/3}` is not, unless `E_0 = E_inf` keeps `rho = 0`.
     fn switching_is_affine(&self, _k: usize) -> bool {
-        true
+        self.force
+            .law
+            .standard_linear_solid()
+            .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
     }
 
     /// In free flight, a bound on the gap's curvature `|d''| = |Z'' + sum_i q_i''|` over
     /// `[t0, t0 + dt]` (any `dt`), nm/us^2; `Z'' = 0` for both separation laws. Each mode is its
     /// steady drive response `p_i = alpha_i cos(w t) + beta_i sin(w t)` plus a homogeneous part
-    /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
+    /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` (plus a
+    /// standard linear solid's `|sigma''|`, below) with
     /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
     /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
     /// (extrema inside the sample, the gap's minima, are always wanted), and `None` for the
@@ -316,6 +372,13 @@ impl SwitchingStructure for TappingModel {
                 steady + homogeneous
             })
             .sum::<f64>();
+        // A standard linear solid's unrecovered depth `sigma = rho^{2/3}` decays as
+        // `exp(-(2/3) r t)` (`r` the recovery rate): `|sigma''| <= (4/9) r^2 sigma(t0)`.
+        let surface = self.force.law.standard_linear_solid().map_or(0.0, |sls| {
+            let rate = sls.recovery_rate_per_us();
+            4.0 / 9.0 * rate * rate * self.force.law.surface_depth_nm(self.sample_state(x0))
+        });
+        let bound = bound + surface;
         // Slack for the rounding of the sums (relative 1e-12) and of `y` (absolute).
         bound.is_finite().then_some(bound * (1.0 + 1e-12) + 1e-12)
     }

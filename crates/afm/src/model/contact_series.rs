@@ -50,6 +50,48 @@ pub(crate) enum SeriesForce {
         /// `A`, nN nm.
         scale: f64,
     },
+    /// The hydration force outside contact, `B exp(-d/lambda) [cos(k d) - k lambda sin(k d)]`
+    /// (nN; MODEL.md section 9): the real and imaginary parts of `w = exp(c delta)`,
+    /// `c = 1/lambda - i k`, `delta = -d`, whose coefficients follow from `w' = c delta' w`.
+    Hydration {
+        /// `B`, nN.
+        amplitude: f64,
+        /// `k = 2 pi / sigma`, 1/nm.
+        wavenumber: f64,
+        /// `lambda`, nm.
+        decay_length: f64,
+    },
+}
+
+/// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`; real parts in
+/// `re`, imaginary in `im`) from `delta`'s coefficients to `k` and `w`'s below `k`:
+/// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`.
+#[inline]
+fn update_layer_exponential(
+    re: &mut [f64],
+    im: &mut [f64],
+    delta: &[f64],
+    k: usize,
+    wavenumber: f64,
+    decay_length: f64,
+) {
+    let (c_re, c_im) = (1.0 / decay_length, -wavenumber);
+    if k == 0 {
+        let magnitude = (c_re * delta[0]).exp();
+        let (sin, cos) = (c_im * delta[0]).sin_cos();
+        re[0] = magnitude * cos;
+        im[0] = magnitude * sin;
+        return;
+    }
+    let (mut sum_re, mut sum_im) = (0.0, 0.0);
+    for j in 1..=k {
+        let weight = j as f64 * delta[j];
+        sum_re += weight * re[k - j];
+        sum_im += weight * im[k - j];
+    }
+    let scale = 1.0 / k as f64;
+    re[k] = scale * (c_re * sum_re - c_im * sum_im);
+    im[k] = scale * (c_re * sum_im + c_im * sum_re);
 }
 
 /// The separation `Z(t(s))`'s coefficients `0..=2` (`Z` constant or a linear ramp in `t`, `t`
@@ -222,6 +264,20 @@ fn force_coefficient(
             update_reciprocal_gap(root, delta, k);
             Some(-scale * convolution(&root[..=k], &root[..=k]))
         }
+        SeriesForce::Hydration {
+            amplitude,
+            wavenumber,
+            decay_length,
+        } => {
+            // Analytic in d everywhere, on the time clock; `root` holds `w`'s real parts then
+            // its imaginary parts.
+            if onset {
+                return None;
+            }
+            let (re, im) = root.split_at_mut(MAX_ORDER + 1);
+            update_layer_exponential(re, im, delta, k, wavenumber, decay_length);
+            Some(amplitude * (re[k] - wavenumber * decay_length * im[k]))
+        }
     }
 }
 
@@ -243,7 +299,8 @@ fn state_recurrence(
     let mut cos = [0.0; MAX_ORDER + 1];
     let mut sin = [0.0; MAX_ORDER + 1];
     let mut delta = [0.0; MAX_ORDER + 1];
-    let mut root = [0.0; MAX_ORDER + 1];
+    // The auxiliary series; twice as long for the hydration force's complex exponential.
+    let mut root = [0.0; 2 * (MAX_ORDER + 1)];
     let mut force = [0.0; MAX_ORDER + 1];
     (sin[0], cos[0]) = phase::sin_cos(drive_frequency * clock.start);
     let x = series.coefficients_mut();
@@ -342,6 +399,18 @@ pub(crate) fn contact_tangent_series(
                 root[m] = convolution(&square[..=m], &reciprocal[..=m]);
             }
             2.0 * scale
+        }
+        SeriesForce::Hydration {
+            amplitude,
+            wavenumber,
+            decay_length,
+        } => {
+            // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w.
+            let mut im = [0.0; MAX_ORDER + 1];
+            for m in 0..p {
+                update_layer_exponential(&mut root, &mut im, &delta, m, wavenumber, decay_length);
+            }
+            -amplitude * (1.0 / decay_length + wavenumber * wavenumber * decay_length)
         }
     };
     // Highest power first, so that the convolutions below run forward through both series.

@@ -3,6 +3,7 @@
 
 use hybrid::{Accelerations, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials};
 
+use crate::contact::standard_linear_solid::StandardLinearSolid;
 use crate::contact::ForceSlopes;
 use nalgebra::DMatrix;
 
@@ -10,8 +11,9 @@ use super::{TappingModel, CLIPPED, GAP_SURFACE, RELEASE_SURFACE};
 use crate::model::phase;
 
 impl HybridSystem for TappingModel {
+    /// `2N`, plus 1 for a standard linear solid's state `rho` (MODEL.md section 9).
     fn dim(&self) -> usize {
-        2 * self.modes.len()
+        2 * self.modes.len() + self.sample_state_count()
     }
 
     /// The contact surface, and a clipped Kelvin-Voigt law's release surface.
@@ -38,12 +40,17 @@ impl HybridSystem for TappingModel {
             0.0
         };
         self.modal_field(drive, force, x, dxdt);
+        self.sample_state_field(mode, t, x, dxdt);
     }
 
     /// `df/dx`: the modal blocks `[[0, 1], [-w_i^2, -w_i/Q_i]]`, plus
     /// `d q_i'' / d q_j = (w_i^2 / k_i) dF_ts/dd` and `d q_i'' / d q_j' = (w_i^2 / k_i)
     /// dF_ts/dd'` for every `i, j`.
     fn jacobian(&self, mode: Mode, t: f64, x: &[f64], jacobian: &mut DMatrix<f64>) {
+        if self.sample_state_count() > 0 {
+            self.relaxing_jacobian(mode, t, x, jacobian.as_mut_slice());
+            return;
+        }
         let slopes = self.force_slopes(mode, t, x);
         self.modal_jacobian(slopes.gap_slope, slopes.rate_slope, jacobian.as_mut_slice());
     }
@@ -52,6 +59,7 @@ impl HybridSystem for TappingModel {
     fn parameter_derivative(&self, mode: Mode, t: f64, x: &[f64], dfdp: &mut [f64]) {
         let slope = self.force_slopes(mode, t, x).gap_slope;
         self.separation_derivative(slope, dfdp);
+        self.sample_state_parameter_derivative(mode, t, x, dfdp);
     }
 
     /// The field, Jacobian and `df/dZ` above from one evaluation of the gap, the drive and
@@ -66,6 +74,14 @@ impl HybridSystem for TappingModel {
         jacobian: &mut DMatrix<f64>,
         dfdp: Option<&mut [f64]>,
     ) {
+        if self.sample_state_count() > 0 {
+            self.vector_field(mode, t, x, dxdt);
+            self.jacobian(mode, t, x, jacobian);
+            if let Some(dfdp) = dfdp {
+                self.parameter_derivative(mode, t, x, dfdp);
+            }
+            return;
+        }
         let drive = phase::cos(self.drive.angular_frequency * t);
         let slopes = self.force_slopes(mode, t, x);
         self.modal_field(drive, slopes.force, x, dxdt);
@@ -92,6 +108,11 @@ impl HybridSystem for TappingModel {
         parameter_column: bool,
         _buffers: &mut LinearisationBuffers,
     ) {
+        if self.sample_state_count() > 0 {
+            self.vector_field(mode, t, x, dxdt);
+            self.relaxing_tangent_rates(mode, t, x, tangents, tangent_rates, parameter_column);
+            return;
+        }
         let drive = phase::cos(self.drive.angular_frequency * t);
         let slopes = self.force_slopes(mode, t, x);
         self.modal_field(drive, slopes.force, x, dxdt);
@@ -102,34 +123,38 @@ impl HybridSystem for TappingModel {
         }
     }
 
-    /// `h_0 = d - d_c = Z(t) + sum_i q_i - d_c`, nm; a clipped Kelvin-Voigt law's
-    /// `h_1 = -d - tau d'`, nm (MODEL.md section 9).
+    /// `h_0 = d - d_c = Z(t) + sum_i q_i - d_c`, nm (a standard linear solid's
+    /// `h_0 = d + sigma`, `sigma = rho^{2/3}` its unrecovered depth); a clipped Kelvin-Voigt
+    /// law's `h_1 = -d - tau d'`, nm (MODEL.md section 9).
     fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
             self.gap(t, x) - self.contact_gap_nm()
+                + self.force.law.surface_depth_nm(self.sample_state(x))
         } else {
             -self.gap(t, x) - self.release_time() * self.gap_rate(x)
         }
     }
 
-    /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in every mode), nm/us;
+    /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in every mode; plus `sigma'` of the mode's
+    /// `rho'` for a standard linear solid), nm/us;
     /// `dh_1/dt = -d' - tau d''` with `d'' = sum_i q_i''` of mode `mode` (`Z'' = 0`).
     fn switching_rate(&self, k: usize, mode: Mode, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
-            self.gap_rate(x)
+            self.gap_rate(x) + self.surface_depth_rate(mode, t, x)
         } else {
             -self.gap_rate(x) - self.release_time() * self.gap_acceleration(mode, t, x)
         }
     }
 
-    /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'`; `dh_0/dt|_x = Z'(t)`; `dh_0/dZ = 1`.
+    /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'` (and `d sigma/d rho = (2/3)
+    /// rho^{-1/3}` on a standard linear solid's `rho`); `dh_0/dt|_x = Z'(t)`; `dh_0/dZ = 1`.
     /// `grad h_1` = -1 on every `q_i`, `-tau` on every `q_i'`; `dh_1/dt|_x = -Z'(t)`;
     /// `dh_1/dZ = -1`.
     fn switching_gradient(
         &self,
         k: usize,
         _t: f64,
-        _x: &[f64],
+        x: &[f64],
         gradient: &mut [f64],
     ) -> SwitchingPartials {
         let (on_gap, on_rate, sign) = if k == RELEASE_SURFACE {
@@ -137,8 +162,16 @@ impl HybridSystem for TappingModel {
         } else {
             (1.0, 0.0, 1.0)
         };
-        for (i, g) in gradient.iter_mut().enumerate() {
+        let modal = 2 * self.modes.len();
+        for (i, g) in gradient[..modal].iter_mut().enumerate() {
             *g = if i % 2 == 0 { on_gap } else { on_rate };
+        }
+        if self.sample_state_count() > 0 {
+            gradient[modal] = if k == GAP_SURFACE {
+                StandardLinearSolid::depth_slope(self.sample_state(x))
+            } else {
+                0.0
+            };
         }
         SwitchingPartials {
             t: sign * self.separation.rate(),

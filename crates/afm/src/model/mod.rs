@@ -24,6 +24,7 @@ mod hybrid_system;
 pub(crate) mod modal_constants;
 pub mod phase;
 pub mod sample;
+mod sample_relaxation;
 pub mod separation;
 #[cfg(test)]
 mod tests;
@@ -135,7 +136,7 @@ impl TappingModel {
         let grid_rotations = std::array::from_fn(|i| {
             phase::sin_cos(drive.angular_frequency * grid_spacing(exact_step_limit, i + 1))
         });
-        let force = tip_sample_force(
+        let mut force = tip_sample_force(
             sample.contact.as_ref(),
             sample.electrostatic.as_ref(),
             effective_modulus_gpa(
@@ -147,6 +148,25 @@ impl TappingModel {
             cantilever.tip_radius_nm,
             sample.poisson_ratio,
         );
+        let reduced = |modulus_gpa: f64| {
+            effective_modulus_gpa(
+                modulus_gpa,
+                sample.poisson_ratio,
+                cantilever.tip_youngs_modulus_gpa,
+                cantilever.tip_poisson_ratio,
+            )
+        };
+        if let (ContactLaw::StandardLinearSolid(sls), Some((instant, relaxed))) = (
+            &mut force.law,
+            sample.contact.as_ref().and_then(|c| c.sample_moduli_gpa()),
+        ) {
+            sls.instant_modulus_gpa = reduced(instant);
+            sls.relaxed_modulus_gpa = reduced(relaxed);
+        }
+        force.hydration = sample
+            .hydration
+            .as_ref()
+            .map(|spec| spec.force(cantilever.tip_radius_nm));
         // The free orbit's lowest gap reaches the contact surface `d = d_c`.
         let grazing_separation_nm = free_response.grazing_separation_nm() + force.contact_gap_nm();
         let plain_hertz = matches!(
@@ -155,7 +175,8 @@ impl TappingModel {
                 tip: HertzTip::Sphere { .. },
                 ..
             })
-        ) && force.double_layer.is_none();
+        ) && force.double_layer.is_none()
+            && force.hydration.is_none();
         Ok(Self {
             hertz: HertzContact::new(&cantilever, &sample),
             force,
@@ -343,11 +364,12 @@ impl TappingModel {
     #[inline]
     fn force_slopes(&self, mode: Mode, t: f64, x: &[f64]) -> ForceSlopes {
         if !self.plain_hertz {
-            return self.force.in_region(
+            return self.force.in_region_at(
                 Self::in_contact(mode),
                 mode & CLIPPED != 0,
                 self.gap(t, x),
                 self.gap_rate(x),
+                self.sample_state(x),
             );
         }
         let (force, gap_slope) = self.hertz_force_and_slope(mode, t, x);
@@ -470,11 +492,31 @@ impl TappingModel {
         if self.plain_hertz {
             self.hertz.force(self.gap(t, x))
         } else {
-            self.force.force(self.gap(t, x), self.gap_rate(x))
+            self.force
+                .force_at(self.gap(t, x), self.gap_rate(x), self.sample_state(x))
         }
     }
 
-    /// The tip-sample force (nN) at a gap minimum (gap rate 0) of gap `d` (nm).
+    /// The sample's internal state `rho` (nm^{3/2}): the last component of the state for a
+    /// standard linear solid (MODEL.md section 9), 0 for every other law.
+    #[inline]
+    pub fn sample_state(&self, x: &[f64]) -> f64 {
+        if self.force.law.standard_linear_solid().is_some() {
+            x[2 * self.modes.len()]
+        } else {
+            0.0
+        }
+    }
+
+    /// The number of the sample's internal states in the model's state after the `2N` modal
+    /// ones: 1 for a standard linear solid, 0 otherwise.
+    pub fn sample_state_count(&self) -> usize {
+        usize::from(self.force.law.standard_linear_solid().is_some())
+    }
+
+    /// The tip-sample force (nN) at a gap minimum (gap rate 0) of gap `d` (nm), for a
+    /// recovered sample (a standard linear solid's force needs its state: use
+    /// [`TappingModel::tip_sample_force`]).
     #[inline]
     pub fn force_at_gap_minimum(&self, gap_nm: f64) -> f64 {
         if self.plain_hertz {

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::contact::{ContactSpec, ElectrostaticSpec};
+use crate::contact::{ContactSpec, ElectrostaticSpec, HydrationSpec};
 use crate::error::AfmError;
 use crate::model::cantilever::DEFAULT_POISSON_RATIO;
 use crate::validation::{check_all, check_name, ranges, warnings_of, NumericField};
@@ -32,6 +32,10 @@ pub struct Sample {
     /// none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub electrostatic: Option<ElectrostaticSpec>,
+    /// A hydration (solvation) force added to the contact law (MODEL.md section 9); absent:
+    /// none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hydration: Option<HydrationSpec>,
 }
 
 impl Sample {
@@ -64,6 +68,9 @@ impl Sample {
         }
         if let Some(electrostatic) = &self.electrostatic {
             electrostatic.validate(file)?;
+        }
+        if let Some(hydration) = &self.hydration {
+            hydration.validate(file)?;
         }
         Ok(())
     }

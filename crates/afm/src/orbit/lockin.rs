@@ -84,6 +84,8 @@ pub struct CycleLockIn {
     /// Start time and state of the free-flight interval in progress, if any.
     free_start: Option<f64>,
     free_state: Vec<f64>,
+    /// Scratch for the state at a gap minimum (a standard linear solid's force needs it).
+    minimum_state: Vec<f64>,
 }
 
 impl CycleLockIn {
@@ -111,6 +113,7 @@ impl CycleLockIn {
             previous_end: 0.0,
             free_start: None,
             free_state: vec![0.0; model.dim()],
+            minimum_state: vec![0.0; model.dim()],
         }
     }
 
@@ -159,9 +162,13 @@ impl CycleLockIn {
                 && extremum.kind == ExtremumKind::Minimum
                 && extremum.value < 0.0
             {
-                self.peak_force = self
-                    .peak_force
-                    .max(model.force_at_gap_minimum(extremum.value + model.contact_gap_nm()));
+                let force = if model.sample_state_count() > 0 {
+                    solver.interpolate(extremum.t, &mut self.minimum_state);
+                    model.tip_sample_force(extremum.t, &self.minimum_state)
+                } else {
+                    model.force_at_gap_minimum(extremum.value + model.contact_gap_nm())
+                };
+                self.peak_force = self.peak_force.max(force);
             }
         }
         if let StepOutcome::Event(event) = outcome {

@@ -16,6 +16,7 @@ use hybrid::{
 
 use serde::Serialize;
 
+use crate::contact::standard_linear_solid::StandardLinearSolid;
 use crate::error::AfmError;
 use crate::model::free_flight_energy::{FreeFlightEnergy, ModeIntegrals};
 use crate::model::free_flight_fourier::FreeFlightFourier;
@@ -258,6 +259,15 @@ pub struct PeriodObserver {
     /// The states at the window's start and end.
     start_state: Vec<f64>,
     end_state: Vec<f64>,
+    /// A standard linear solid's law (its state is the model state's last component).
+    relaxing: Option<StandardLinearSolid>,
+    /// The standard linear solid's dashpot loss `int D dt` over the window, nN nm.
+    dashpot_loss: f64,
+    /// `(t, F_ts)` at every gap minimum, for a standard linear solid (whose force at a
+    /// minimum of `h_0 = d + sigma` depends on its state).
+    minimum_forces: Vec<(f64, f64)>,
+    /// Scratch for a state at a gap minimum.
+    scratch: Vec<f64>,
 }
 
 /// One mode's constants in the energy balance (MODEL.md section 10).
@@ -341,6 +351,10 @@ impl PeriodObserver {
             indentation: 0.0,
             start_state: x0.to_vec(),
             end_state: vec![f64::NAN; model.dim()],
+            relaxing: model.contact_force().law.standard_linear_solid().copied(),
+            dashpot_loss: 0.0,
+            minimum_forces: Vec::new(),
+            scratch: vec![0.0; model.dim()],
         }
     }
 
@@ -382,6 +396,11 @@ impl PeriodObserver {
                 && extremum.t < self.end
             {
                 self.minima.push((extremum.t, extremum.value));
+                if self.relaxing.is_some() {
+                    solver.interpolate(extremum.t, &mut self.scratch);
+                    let force = model.tip_sample_force(extremum.t, &self.scratch);
+                    self.minimum_forces.push((extremum.t, force));
+                }
             }
         }
         if let StepOutcome::Event(event) = outcome {
@@ -412,6 +431,14 @@ impl PeriodObserver {
             if let Some(energy) = &self.free_flight_energy {
                 energy.accumulate(start, &self.free_state, end, &mut self.mode_integrals);
             }
+            if let Some(sls) = &self.relaxing {
+                // Unloaded, `D = -dU/dt`: the loss is the stored energy's fall as `rho` decays
+                // by `exp(-(1 - beta) t / tau)`.
+                let state = self.free_state[2 * self.modes.len()];
+                let later = state * (-sls.recovery_rate_per_us() * (end - start)).exp();
+                self.dashpot_loss += sls.stored_energy(f64::INFINITY, state)
+                    - sls.stored_energy(f64::INFINITY, later);
+            }
         }
     }
 
@@ -441,6 +468,10 @@ impl PeriodObserver {
             *work += weight * force * velocity;
         }
         self.virial += weight * force * deflection;
+        if let Some(sls) = &self.relaxing {
+            self.dashpot_loss +=
+                weight * sls.dissipation_rate(model.gap(t, state), model.sample_state(state));
+        }
         self.indentation += weight * (self.contact_gap - model.gap(t, state)).max(0.0);
         let (mut sin_k, mut cos_k) = (sin, cos);
         for coefficient in self.fourier.iter_mut() {
@@ -496,6 +527,7 @@ impl PeriodObserver {
             .iter()
             .map(|mode| mode.residual_ev().abs())
             .fold(0.0, f64::max);
+        let largest_residual = largest_residual.max(self.sample_residual_ev(model, &mode_energy));
         let energy_balance_residual = if total_damping > 0.0 {
             largest_residual / total_damping
         } else {
@@ -544,6 +576,25 @@ impl PeriodObserver {
         }
     }
 
+    /// A standard linear solid's balance `E_ts = D_s + dU_s` per drive period (MODEL.md
+    /// section 10): the work on the sample `-sum_i int F_ts q_i' dt - Z' int F_ts dt` against
+    /// the dashpot's loss and the change of the sample's stored energy, eV (0 for other laws).
+    fn sample_residual_ev(&self, model: &TappingModel, mode_energy: &[ModeEnergy]) -> f64 {
+        let Some(sls) = &self.relaxing else {
+            return 0.0;
+        };
+        let k = self.window_periods as f64;
+        let per_period = NN_NM_IN_EV / k;
+        let work: f64 = mode_energy
+            .iter()
+            .map(|mode| mode.dissipated_share_ev)
+            .sum::<f64>()
+            - per_period * model.separation().rate() * self.impulse;
+        let stored = |t: f64, x: &[f64]| sls.stored_energy(model.gap(t, x), model.sample_state(x));
+        let change = stored(self.end, &self.end_state) - stored(self.start, &self.start_state);
+        (work - per_period * (self.dashpot_loss + change)).abs()
+    }
+
     fn periods(&self, t: f64) -> f64 {
         (t - self.start) / self.period
     }
@@ -581,14 +632,38 @@ impl PeriodObserver {
         let tail = open;
         let head_fragment = self.starts_in_contact && !intervals.is_empty();
         let peak_in = |from: f64, to: f64| {
+            if self.relaxing.is_some() {
+                return self
+                    .minimum_forces
+                    .iter()
+                    .filter(|(t, _)| (from..=to).contains(&self.periods(*t)))
+                    .map(|&(_, force)| force)
+                    .fold(0.0, f64::max);
+            }
             minima
                 .iter()
                 .filter(|minimum| minimum.t_periods >= from && minimum.t_periods <= to)
                 .map(|minimum| model.force_at_gap_minimum(minimum.gap_nm))
                 .fold(0.0, f64::max)
         };
-        let boundary_start = model.force_at_gap_minimum(self.gap_at_start);
-        let boundary_end = model.force_at_gap_minimum(self.gap_at_end);
+        let (boundary_start, boundary_end) = if self.relaxing.is_some() {
+            let at = |t: f64, x: &[f64]| {
+                if x.iter().all(|v| v.is_finite()) {
+                    model.tip_sample_force(t, x)
+                } else {
+                    0.0
+                }
+            };
+            (
+                at(self.start, &self.start_state),
+                at(self.end, &self.end_state),
+            )
+        } else {
+            (
+                model.force_at_gap_minimum(self.gap_at_start),
+                model.force_at_gap_minimum(self.gap_at_end),
+            )
+        };
         let mut impacts = Vec::with_capacity(intervals.len() + 1);
         let mut head: Option<(f64, f64)> = None; // (end, peak) of the head fragment
         for (index, &(start, end, velocity)) in intervals.iter().enumerate() {

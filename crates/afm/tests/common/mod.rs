@@ -80,6 +80,7 @@ pub fn mica() -> Sample {
         poisson_ratio: 0.3,
         contact: None,
         electrostatic: None,
+        hydration: None,
     }
 }
 
