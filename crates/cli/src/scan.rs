@@ -245,7 +245,7 @@ pub fn pixel_json(pixel: &ScanPixel) -> Value {
 pub fn scan_csv(pixels: &[ScanPixel], harmonics: usize) -> String {
     let mut text = String::from("direction,");
     text.push_str(&CSV_COLUMNS.join(","));
-    text.push_str(&crate::approach::harmonic_columns(harmonics));
+    text.push_str(&crate::output::harmonic_columns(harmonics));
     text.push('\n');
     for pixel in pixels {
         let mut row = String::new();
@@ -442,7 +442,7 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
         columns.extend(CSV_COLUMNS);
         let mut text = String::from("direction,");
         text.push_str(&columns.join(","));
-        text.push_str(&crate::approach::harmonic_columns(settings.orbit.harmonics));
+        text.push_str(&crate::output::harmonic_columns(settings.orbit.harmonics));
         text.push('\n');
         for (j, row) in rows.iter().enumerate() {
             for pixel in row {
