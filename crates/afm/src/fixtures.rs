@@ -52,6 +52,8 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "maclever-mica-experiment"),
     embedded!("cases", "maclever-membrane-experiment"),
     embedded!("cases", "maclever-membrane-film"),
+    embedded!("cases", "biolever-mica-acoustic"),
+    embedded!("cases", "biolever-mica-bimodal"),
 ];
 
 fn names(table: &[Embedded]) -> Vec<&'static str> {
@@ -71,7 +73,7 @@ pub fn sample_names() -> Vec<&'static str> {
 
 /// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
 /// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
-/// `maclever-membrane-film`).
+/// `maclever-membrane-film`, `biolever-mica-acoustic`, `biolever-mica-bimodal`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }
@@ -268,5 +270,6 @@ fn resolve_case(file: CaseFile, base: Option<&Path>, source: &str) -> Result<Cas
         sample,
         free_amplitude_nm: file.free_amplitude_nm,
         drive_frequency_khz: file.drive_frequency_khz,
+        drive: file.drive,
     })
 }

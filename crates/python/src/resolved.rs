@@ -2,6 +2,7 @@
 //! computed on it, and its JSON form (the case files' format, cantilever and sample inline).
 
 use afm::{Case as AfmCase, TappingModel};
+use serde::Deserialize;
 use anyhow::Context;
 use serde_json::{json, Value};
 
@@ -58,6 +59,11 @@ impl Resolved {
             )?,
             free_amplitude_nm,
             drive_frequency_khz: number("drive_frequency_khz"),
+            drive: match value.get("drive") {
+                None | Some(Value::Null) => afm::model::drive_spec::DriveSpec::Direct,
+                Some(drive) => afm::model::drive_spec::DriveSpec::deserialize(drive)
+                    .map_err(|error| anyhow::anyhow!("{source}: drive: {error}"))?,
+            },
         };
         Self::new(case)
     }

@@ -99,6 +99,7 @@ impl CaseRequest {
             sample,
             free_amplitude_nm: a0,
             drive_frequency_khz: self.drive_frequency_khz,
+            drive: afm::model::drive_spec::DriveSpec::Direct,
         };
         case.validate(SOURCE).context("invalid model parameters")?;
         Ok(case)
