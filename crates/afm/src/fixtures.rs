@@ -263,6 +263,12 @@ fn resolve_case(file: CaseFile, base: Option<&Path>, source: &str) -> Result<Cas
         load_sample,
         source,
     )?;
+    // The drive against its cantilever (an incommensurate bimodal ratio, participation
+    // factors per mode), blamed on the case file.
+    let frequency = file
+        .drive_frequency_khz
+        .unwrap_or_else(|| cantilever.fundamental_frequency_khz());
+    file.drive.validate(source, &cantilever, frequency)?;
     Ok(Case {
         name: file.name,
         description: file.description,

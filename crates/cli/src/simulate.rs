@@ -276,6 +276,16 @@ pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serd
         "mean_indentation_nm": observables.mean_indentation_nm,
         "energy_balance_residual": observables.energy_balance_residual,
         "harmonics": observables.harmonics,
+        "second_drive": observables.second_drive.map(|response| json!({
+            "frequency_khz": model.second_drive().map(|second| second.frequency_khz),
+            "free_amplitude_nm": model.second_drive().map(|second| second.free_amplitude_nm),
+            "amplitude_nm": response.amplitude_nm,
+            "phase_deg": response.phase_deg,
+            "free_phase_deg": model
+                .free_response()
+                .second_photodiode_harmonic()
+                .map(|[a, b]| b.atan2(a).to_degrees()),
+        })),
         "state": orbit.state,
         "periods": orbit.period_breakdown(model.free_amplitude_nm()),
     })
