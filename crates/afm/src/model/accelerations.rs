@@ -10,7 +10,7 @@ use nalgebra::DMatrix;
 
 use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
 use crate::contact::ContactLaw;
-use crate::model::contact_series::{self, SeriesForce};
+use crate::model::contact_series::{self, SeriesDrive, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
 
@@ -145,16 +145,24 @@ impl TappingModel {
             .map_or([0.0, 0.0], |second| second.oscillators[i].steady_state(t))
     }
 
+    /// The drives of the Taylor series: `w`, an acoustic drive's base amplitude, a bimodal
+    /// drive's second frequency and relative force (MODEL.md section 14).
+    fn series_drive(&self) -> SeriesDrive {
+        SeriesDrive {
+            frequency: self.drive.angular_frequency,
+            base_amplitude: self.base.as_ref().map_or(0.0, |base| base.amplitude_nm),
+            second: self
+                .second
+                .as_ref()
+                .map(|second| (second.angular_frequency, second.relative_force)),
+        }
+    }
+
     /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
     /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
     /// outside it (van der Waals, when `H > 0`); `None` for every other law, mode, or with a
     /// double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
     pub(crate) fn series_force(&self, mode: Mode) -> Option<SeriesForce> {
-        // The series know one drive frequency and a gap without base motion (MODEL.md
-        // section 14): an acoustic or bimodal drive integrates its contact by Runge-Kutta.
-        if self.base.is_some() || self.second.is_some() {
-            return None;
-        }
         if self.plain_hertz {
             return Self::in_contact(mode).then_some(SeriesForce::Hertz {
                 coefficient: self.hertz.coefficient,
@@ -207,7 +215,7 @@ impl TaylorExpansion for TappingModel {
             contact_series::contact_state_series(
                 &self.modes,
                 force,
-                self.drive.angular_frequency,
+                &self.series_drive(),
                 &self.separation,
                 clock,
                 series,
@@ -230,6 +238,7 @@ impl TaylorExpansion for TappingModel {
             contact_series::contact_tangent_series(
                 &self.modes,
                 force,
+                &self.series_drive(),
                 &self.separation,
                 clock,
                 state,
