@@ -192,7 +192,10 @@ fn acoustic_free_orbit_is_the_analytic_base_driven_steady_state() {
         .map(|j| period * j as f64 / samples as f64)
         .min_by(|a, b| gap(*a).total_cmp(&gap(*b)))
         .expect("samples");
-    let (mut lo, mut hi) = (best - period / samples as f64, best + period / samples as f64);
+    let (mut lo, mut hi) = (
+        best - period / samples as f64,
+        best + period / samples as f64,
+    );
     for _ in 0..200 {
         let (m1, m2) = (lo + (hi - lo) * 0.382, lo + (hi - lo) * 0.618);
         if gap(m1) < gap(m2) {
@@ -212,7 +215,10 @@ fn acoustic_free_orbit_is_the_analytic_base_driven_steady_state() {
     let orbit = converged_orbit(&at(&model, far), far);
     let (ratio, orbit_phase) = orbit.lockin(10.0);
     assert!((ratio - 1.0).abs() < 1e-9, "A/A0 {ratio}");
-    assert!((orbit_phase - phase).abs() < 1e-6, "{orbit_phase} vs {phase}");
+    assert!(
+        (orbit_phase - phase).abs() < 1e-6,
+        "{orbit_phase} vs {phase}"
+    );
 }
 
 /// The acoustic Biolever tapping mica at 0.7 `Z_G1` (base motion in the gap): the steady
@@ -354,8 +360,7 @@ fn bimodal_tapping_orbit_matches_brute_force() {
 #[test]
 fn diagrams_through_acoustic_and_bimodal_drives() {
     for name in ["biolever-mica-acoustic", "biolever-mica-bimodal"] {
-        let model =
-            TappingModel::from_case(&builtin_case(name).expect("case")).expect("model");
+        let model = TappingModel::from_case(&builtin_case(name).expect("case")).expect("model");
         let mut settings = DiagramSettings::approach(&model);
         settings.min_amplitude_ratio = 0.7;
         let diagram = approach_diagram(&model, &settings).expect("diagram");
@@ -418,5 +423,8 @@ fn bad_drives_are_refused_with_the_field_and_the_choices() {
     let error = load(r#"{"kind": "magnetic"}"#).expect_err("unknown kind");
     assert!(error.contains("drive"), "{error}");
     assert!(load(r#"{"kind": "acoustic", "base_participation": [1.5, -0.9]}"#).is_ok());
-    assert!(load(r#"{"kind": "bimodal", "second_frequency_khz": 74.4, "second_free_amplitude_nm": 1}"#).is_ok());
+    assert!(load(
+        r#"{"kind": "bimodal", "second_frequency_khz": 74.4, "second_free_amplitude_nm": 1}"#
+    )
+    .is_ok());
 }

@@ -2,8 +2,8 @@
 //! computed on it, and its JSON form (the case files' format, cantilever and sample inline).
 
 use afm::{Case as AfmCase, TappingModel};
-use serde::Deserialize;
 use anyhow::Context;
+use serde::Deserialize;
 use serde_json::{json, Value};
 
 /// A case resolved into its model, shared by the results computed on it.

@@ -340,26 +340,27 @@ impl SwitchingStructure for TappingModel {
             .base
             .as_ref()
             .map_or(0.0, |base| w * w * base.amplitude_nm.abs());
-        let bound = base + self
-            .modes
-            .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
-                let [pb, dpb] = self.second_steady_state(i, t0);
-                let (y, dy) = (x0[2 * i] - p - pb, x0[2 * i + 1] - dp - dpb);
-                let [alpha, beta] = m.oscillator.steady_coefficients();
-                // A bimodal drive's second steady response adds `w_b^2 P_bi`.
-                let second = self.second.as_ref().map_or(0.0, |second| {
-                    let [a, b] = second.oscillators[i].steady_coefficients();
-                    second.angular_frequency * second.angular_frequency * a.hypot(b)
-                });
-                let steady = w * w * alpha.hypot(beta) + second;
-                let homogeneous = (m.omega_squared.sqrt() + m.damping)
-                    * (dy * dy + m.omega_squared * y * y).sqrt();
-                steady + homogeneous
-            })
-            .sum::<f64>();
+        let bound = base
+            + self
+                .modes
+                .iter()
+                .enumerate()
+                .map(|(i, m)| {
+                    let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
+                    let [pb, dpb] = self.second_steady_state(i, t0);
+                    let (y, dy) = (x0[2 * i] - p - pb, x0[2 * i + 1] - dp - dpb);
+                    let [alpha, beta] = m.oscillator.steady_coefficients();
+                    // A bimodal drive's second steady response adds `w_b^2 P_bi`.
+                    let second = self.second.as_ref().map_or(0.0, |second| {
+                        let [a, b] = second.oscillators[i].steady_coefficients();
+                        second.angular_frequency * second.angular_frequency * a.hypot(b)
+                    });
+                    let steady = w * w * alpha.hypot(beta) + second;
+                    let homogeneous = (m.omega_squared.sqrt() + m.damping)
+                        * (dy * dy + m.omega_squared * y * y).sqrt();
+                    steady + homogeneous
+                })
+                .sum::<f64>();
         // Slack for the rounding of the sums (relative 1e-12) and of `y` (absolute).
         bound.is_finite().then_some(bound * (1.0 + 1e-12) + 1e-12)
     }

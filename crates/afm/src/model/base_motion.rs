@@ -84,8 +84,6 @@ pub fn beam_participation(cantilever: &Cantilever, file: &str) -> Result<Vec<f64
         })?;
     Ok(shapes
         .iter()
-        .map(|shape| {
-            (shape.distributed_force_integral() + mu) / (shape.beam_mass_integral() + mu)
-        })
+        .map(|shape| (shape.distributed_force_integral() + mu) / (shape.beam_mass_integral() + mu))
         .collect())
 }

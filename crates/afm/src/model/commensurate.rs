@@ -127,7 +127,8 @@ mod tests {
             .map(|v| (v - ratio).abs())
             .fold(f64::INFINITY, f64::min);
         assert_eq!((nearest[0].value() - ratio).abs(), best);
-        assert!(nearest.windows(2).all(|w| (w[0].value() - ratio).abs()
-            <= (w[1].value() - ratio).abs()));
+        assert!(nearest
+            .windows(2)
+            .all(|w| (w[0].value() - ratio).abs() <= (w[1].value() - ratio).abs()));
     }
 }

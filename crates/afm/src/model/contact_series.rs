@@ -206,8 +206,7 @@ pub(crate) fn contact_state_series(
     }
     let separation = shifted_separation(separation, clock, force);
     // The common mode counts as constants, so that the loops over modes unroll.
-    let mut run =
-        |modes| state_recurrence(modes, force, drive, &separation, clock, series);
+    let mut run = |modes| state_recurrence(modes, force, drive, &separation, clock, series);
     match modes.len() {
         1 => run(&modes[..1]),
         2 => run(&modes[..2]),
@@ -290,13 +289,7 @@ fn state_recurrence(
     let mut second_cos = [0.0; MAX_ORDER + 1];
     let mut second_sin = [0.0; MAX_ORDER + 1];
     if drive.second.is_some() {
-        phase_series(
-            second_frequency,
-            clock,
-            p,
-            &mut second_cos,
-            &mut second_sin,
-        );
+        phase_series(second_frequency, clock, p, &mut second_cos, &mut second_sin);
     }
     let x = series.coefficients_mut();
     // The sum of every coefficient and force, finite only if each of them is (or rejecting

@@ -352,7 +352,9 @@ impl TappingModel {
         let first = phase::cos(self.drive.angular_frequency * t);
         match &self.second {
             None => first,
-            Some(second) => first + second.relative_force * phase::cos(second.angular_frequency * t),
+            Some(second) => {
+                first + second.relative_force * phase::cos(second.angular_frequency * t)
+            }
         }
     }
 

@@ -178,6 +178,10 @@ pub struct OrbitObservables {
     /// deflection, `y_base` an acoustic drive's base motion, else 0), eV (MODEL.md sections 10
     /// and 14): zero for a conservative law, positive for a dissipative one.
     pub dissipated_ev: f64,
+    /// The contact force's work on the moving base per drive period,
+    /// `(1/k) int F_ts y_base' dt` over the window, eV (MODEL.md section 14; 0 but under an
+    /// acoustic drive): the modes' dissipated shares add up to `dissipated_ev + base_work_ev`.
+    pub base_work_ev: f64,
     /// The virial `V_ts = (1/(k T)) int F_ts w dt` over the window, eV.
     pub virial_ev: f64,
     /// The largest indentation `s = d_c - d` of the law's contact geometry in the window, nm
@@ -571,6 +575,7 @@ impl PeriodObserver {
                 .map(|mode| mode.dissipated_share_ev)
                 .sum::<f64>()
                 - per_period * self.base_work,
+            base_work_ev: per_period * self.base_work,
             second_drive: self.second_fourier.map(|(_, [a, b])| SecondDriveResponse {
                 amplitude_nm: scale * a.hypot(b),
                 phase_deg: b.atan2(a).to_degrees(),
