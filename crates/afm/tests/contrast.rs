@@ -295,8 +295,10 @@ fn dft(samples: &[f64], count: usize) -> Vec<[f64; 2]> {
 fn harmonics_match_a_dft_of_the_sampled_orbit() {
     let count = 20;
     let samples_per_period = 1 << 16;
-    let mut settings = SteadyOrbitSettings::default();
-    settings.harmonics = count;
+    let settings = SteadyOrbitSettings {
+        harmonics: count,
+        ..SteadyOrbitSettings::default()
+    };
     let models = [
         {
             let mut model = TappingModel::from_case(&builtin_case("biolever-mica").expect("case"))
