@@ -35,6 +35,7 @@ impl Resolved {
             "sample": self.case.sample,
             "free_amplitude_nm": self.case.free_amplitude_nm,
             "drive_frequency_khz": self.case.drive_frequency_khz,
+            "drive": self.case.drive,
         })
     }
 
