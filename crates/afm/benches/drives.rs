@@ -7,6 +7,11 @@
 //! in their number of points (the second drive adds folds and period doublings), so the time
 //! per branch point is compared as well as the total.
 //!
+//! Measured on the shared 2-core machine (three runs, loaded): the bimodal diagram has 575
+//! points and 17 special points against the single drive's 351 and 3, and takes 1.6 to 2.6
+//! times as long per point (2.6 to 4.2 times in total); the acoustic one 8 to 9 times per point
+//! (its Hertz contact by Runge-Kutta, MODEL.md section 14).
+//!
 //! Run with `cargo bench -p afm --bench drives`; `-- --repetitions N` (default 3) sets the
 //! repetitions of each diagram, whose median is reported.
 
