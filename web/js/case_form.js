@@ -247,6 +247,8 @@ export class CaseForm {
       sample,
       free_amplitude_nm: readNumber(document.getElementById("a0")),
       drive_frequency_khz: readNumber(document.getElementById("drive"), { optional: true }),
+      // The excitation (direct, acoustic or bimodal) is not edited here: kept from the case.
+      drive: base.drive,
     };
   }
 }

@@ -56,6 +56,8 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "maclever-membrane-film"),
     embedded!("cases", "biolever-soft-viscoelastic"),
     embedded!("cases", "biolever-mica-hydration"),
+    embedded!("cases", "biolever-mica-acoustic"),
+    embedded!("cases", "biolever-mica-bimodal"),
 ];
 
 const LINES: &[Embedded] = &[embedded!("lines", "membrane-patch")];
@@ -78,6 +80,7 @@ pub fn sample_names() -> Vec<&'static str> {
 /// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
 /// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
 /// `maclever-membrane-film`, `biolever-soft-viscoelastic`, `biolever-mica-hydration`).
+/// `maclever-membrane-film`, `biolever-mica-acoustic`, `biolever-mica-bimodal`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }
@@ -302,6 +305,12 @@ fn resolve_case(file: CaseFile, base: Option<&Path>, source: &str) -> Result<Cas
         load_sample,
         source,
     )?;
+    // The drive against its cantilever (an incommensurate bimodal ratio, participation
+    // factors per mode), blamed on the case file.
+    let frequency = file
+        .drive_frequency_khz
+        .unwrap_or_else(|| cantilever.fundamental_frequency_khz());
+    file.drive.validate(source, &cantilever, frequency)?;
     Ok(Case {
         name: file.name,
         description: file.description,
@@ -309,5 +318,6 @@ fn resolve_case(file: CaseFile, base: Option<&Path>, source: &str) -> Result<Cas
         sample,
         free_amplitude_nm: file.free_amplitude_nm,
         drive_frequency_khz: file.drive_frequency_khz,
+        drive: file.drive,
     })
 }

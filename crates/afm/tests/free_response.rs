@@ -188,7 +188,9 @@ fn first_contact_separation_matches_brute_force_sampling() {
             |t| {
                 let mut y = vec![0.0; dim];
                 free.state_at(t, &mut y);
-                (0..model.mode_count()).map(|i| y[2 * i]).sum::<f64>()
+                // The gap minus Z: `sum_i q_i`, plus an acoustic drive's base motion
+                // (MODEL.md section 14).
+                (0..model.mode_count()).map(|i| y[2 * i]).sum::<f64>() + model.base_displacement(t)
             },
             model.period_us(),
             20_000,

@@ -68,9 +68,20 @@ pub fn listing() -> Result<String> {
     writeln!(s, "cases (--case NAME):")?;
     for name in fixtures::case_names() {
         let case = fixtures::builtin_case(name)?;
+        // The drive's kind when not the default direct one (MODEL.md section 14).
+        let drive = match &case.drive {
+            afm::model::drive_spec::DriveSpec::Direct => String::new(),
+            afm::model::drive_spec::DriveSpec::Acoustic { .. } => String::from(" (acoustic)"),
+            afm::model::drive_spec::DriveSpec::Bimodal {
+                second_frequency_khz,
+                second_free_amplitude_nm,
+            } => format!(
+                " + {second_frequency_khz:.3} kHz (bimodal, A0_b = {second_free_amplitude_nm} nm)"
+            ),
+        };
         writeln!(
             s,
-            "  {name:<30} A0 = {} nm, drive {:.3} kHz, {} on {}",
+            "  {name:<30} A0 = {} nm, drive {:.3} kHz{drive}, {} on {}",
             case.free_amplitude_nm,
             case.drive_frequency_or_fundamental_khz(),
             case.cantilever.name,

@@ -25,6 +25,7 @@ pub fn inputs_json(
         "sample": case.sample,
         "free_amplitude_nm": model.free_amplitude_nm(),
         "drive_frequency_khz": model.drive_frequency_khz(),
+        "drive": drive_json(model),
         "solver": {
             "relative_tolerance": integration.relative_tolerance,
             "absolute_tolerance": integration.absolute_tolerance,
@@ -56,4 +57,23 @@ pub fn orbit_inputs_json(
         "max_multiplicity": settings.max_multiplicity,
     });
     inputs
+}
+
+/// The `drive` object of [`inputs_json`] (docs/output-schema.md; MODEL.md section 14): the
+/// case's drive object as written (`kind` and its fields) with what the model solved from it:
+/// the acoustic base amplitude `Y` and participation factors, or the bimodal second drive's
+/// force, ratio and the common period.
+pub fn drive_json(model: &TappingModel) -> Value {
+    let mut drive = json!(model.drive_spec());
+    drive["force_nn"] = json!(model.drive_force_nn());
+    if let Some(base) = model.base_motion() {
+        drive["base_amplitude_nm"] = json!(base.amplitude_nm);
+        drive["base_participation"] = json!(base.participation);
+    }
+    if let Some(second) = model.second_drive() {
+        drive["second_force_nn"] = json!(second.force_nn);
+        drive["frequency_ratio"] = json!([second.ratio.numerator, second.ratio.denominator]);
+        drive["common_period_us"] = json!(model.period_us());
+    }
+    drive
 }

@@ -114,6 +114,7 @@ impl ModelArgs {
                     sample: sample_model,
                     free_amplitude_nm: a0,
                     drive_frequency_khz: None,
+                    drive: afm::model::drive_spec::DriveSpec::Direct,
                 }
             }
             (None, None, None) => fixtures::builtin_case(DEFAULT_CASE)?,

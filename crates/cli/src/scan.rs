@@ -171,6 +171,7 @@ impl ScanArgs {
                     sample: line.materials[0].clone(),
                     free_amplitude_nm: self.a0.unwrap_or(1.0),
                     drive_frequency_khz: None,
+                    drive: afm::model::drive_spec::DriveSpec::Direct,
                 }
             }
             None => fixtures::find_case(self.case.as_deref().unwrap_or(DEFAULT_CASE))?,

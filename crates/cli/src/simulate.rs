@@ -276,6 +276,16 @@ pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serd
         "mean_indentation_nm": observables.mean_indentation_nm,
         "energy_balance_residual": observables.energy_balance_residual,
         "harmonics": observables.harmonics,
+        "second_drive": observables.second_drive.map(|response| json!({
+            "frequency_khz": model.second_drive().map(|second| second.frequency_khz),
+            "free_amplitude_nm": model.second_drive().map(|second| second.free_amplitude_nm),
+            "amplitude_nm": response.amplitude_nm,
+            "phase_deg": response.phase_deg,
+            "free_phase_deg": model
+                .free_response()
+                .second_photodiode_harmonic()
+                .map(|[a, b]| b.atan2(a).to_degrees()),
+        })),
         "state": orbit.state,
         "periods": orbit.period_breakdown(model.free_amplitude_nm()),
     })
@@ -327,6 +337,24 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
         model.drive_frequency_khz(),
         model.grazing_separation_nm()
     );
+    if let Some(base) = model.base_motion() {
+        let _ = writeln!(
+            s,
+            "acoustic drive: the base moves by Y cos(w t), Y = {:.6} nm (MODEL.md section 14)",
+            base.amplitude_nm
+        );
+    }
+    if let Some(second) = model.second_drive() {
+        let _ = writeln!(
+            s,
+            "bimodal drive: + {:.4} kHz with A0_b = {} nm (ratio {}/{}; the orbit's period is              the common period {:.6} us)",
+            second.frequency_khz,
+            second.free_amplitude_nm,
+            second.ratio.numerator,
+            second.ratio.denominator,
+            model.period_us()
+        );
+    }
     let status = if orbit.converged {
         format!(
             "converged in {} Newton iterations, residual {:.1e}",
@@ -360,6 +388,17 @@ pub fn summary(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> String 
         "A/A0 = {ratio:.6}   phase = {phase:.4} deg (free: {:.4} deg)",
         model.free_phase_deg()
     );
+    if let Some(response) = observables.second_drive {
+        let free_phase = model
+            .free_response()
+            .second_photodiode_harmonic()
+            .map_or(f64::NAN, |[a, b]| b.atan2(a).to_degrees());
+        let _ = writeln!(
+            s,
+            "at the second frequency: A_b = {:.6} nm   phase = {:.4} deg (free: {:.4} deg)",
+            response.amplitude_nm, response.phase_deg, free_phase
+        );
+    }
     let k = orbit.multiplicity;
     let per_period = digits::impacts_per_period(orbit.impacts_per_orbit(), k);
     if k > 1 {

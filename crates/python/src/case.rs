@@ -146,6 +146,7 @@ impl Case {
                 sample,
                 free_amplitude_nm: a0,
                 drive_frequency_khz,
+                drive: afm::model::drive_spec::DriveSpec::Direct,
             }
         } else {
             let name = |r: Option<Reference<'_>>| match r {

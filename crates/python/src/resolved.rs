@@ -3,6 +3,7 @@
 
 use afm::{Case as AfmCase, TappingModel};
 use anyhow::Context;
+use serde::Deserialize;
 use serde_json::{json, Value};
 
 /// A case resolved into its model, shared by the results computed on it.
@@ -34,6 +35,7 @@ impl Resolved {
             "sample": self.case.sample,
             "free_amplitude_nm": self.case.free_amplitude_nm,
             "drive_frequency_khz": self.case.drive_frequency_khz,
+            "drive": self.case.drive,
         })
     }
 
@@ -58,6 +60,11 @@ impl Resolved {
             )?,
             free_amplitude_nm,
             drive_frequency_khz: number("drive_frequency_khz"),
+            drive: match value.get("drive") {
+                None | Some(Value::Null) => afm::model::drive_spec::DriveSpec::Direct,
+                Some(drive) => afm::model::drive_spec::DriveSpec::deserialize(drive)
+                    .map_err(|error| anyhow::anyhow!("{source}: drive: {error}"))?,
+            },
         };
         Self::new(case)
     }

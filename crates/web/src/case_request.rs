@@ -2,6 +2,7 @@
 //! line's `--a0` and `--drive-frequency`), or a case with its cantilever and sample inline in
 //! the fixture files' format (MODEL.md sections 1-3 and 9), checked as the CLI checks them.
 
+use afm::model::drive_spec::DriveSpec;
 use afm::{fixtures, Case, TappingModel};
 use anyhow::{bail, Context, Result};
 use drumroll::model_args::{model_of, ModelArgs, DEFAULT_CASE};
@@ -15,8 +16,8 @@ pub const SOURCE: &str = "the page's case";
 /// The page's case as it sends it: either `name` alone (a built-in case; `free_amplitude_nm`
 /// and `drive_frequency_khz` override its values, as `--case NAME --a0 --drive-frequency` do),
 /// or `cantilever` and `sample` (each a built-in name or the file's object inline) with
-/// `free_amplitude_nm` (nm, in [0.001, 100000]) and optionally `drive_frequency_khz` (kHz; absent
-/// or `null`: the fundamental `f_1`).
+/// `free_amplitude_nm` (nm, in [0.001, 100000]), optionally `drive_frequency_khz` (kHz; absent
+/// or `null`: the fundamental `f_1`) and `drive` (absent: direct).
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CaseRequest {
@@ -38,6 +39,10 @@ pub struct CaseRequest {
     /// The drive frequency, kHz.
     #[serde(default)]
     pub drive_frequency_khz: Option<f64>,
+    /// The excitation as a case file gives it (`{"kind": "direct" | "acoustic" | "bimodal",
+    /// ...}`, MODEL.md section 14); absent: direct.
+    #[serde(default)]
+    pub drive: Option<DriveSpec>,
 }
 
 impl CaseRequest {
@@ -99,6 +104,7 @@ impl CaseRequest {
             sample,
             free_amplitude_nm: a0,
             drive_frequency_khz: self.drive_frequency_khz,
+            drive: self.drive.clone().unwrap_or_default(),
         };
         case.validate(SOURCE).context("invalid model parameters")?;
         Ok(case)

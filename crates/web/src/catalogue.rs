@@ -9,7 +9,8 @@ use serde_json::{json, Value};
 
 /// The catalogue object: `cases` (one `{name, description, case, fundamental_frequency_khz}`
 /// per built-in case, `case` in the form [`crate::case_request::CaseRequest`] reads: cantilever
-/// and sample inline, A0 in nm, drive in kHz or `null` for `f_1`), `cantilevers` and `samples`
+/// and sample inline, A0 in nm, drive frequency in kHz or `null` for `f_1`, the
+/// drive's kind), `cantilevers` and `samples`
 /// (the built-in files' objects by name), `parameters` (the names `drumroll map --vary`
 /// takes, `N` a mode number) and `default_case`.
 pub fn catalogue() -> Result<Value> {
@@ -28,6 +29,7 @@ pub fn catalogue() -> Result<Value> {
                     "sample": case.sample,
                     "free_amplitude_nm": case.free_amplitude_nm,
                     "drive_frequency_khz": case.drive_frequency_khz,
+                    "drive": case.drive,
                 },
             }))
         })

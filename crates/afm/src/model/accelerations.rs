@@ -10,7 +10,7 @@ use nalgebra::DMatrix;
 
 use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
 use crate::contact::{ContactLaw, HertzShape, HertzTip};
-use crate::model::contact_series::{self, SeriesForce};
+use crate::model::contact_series::{self, SeriesDrive, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
 
@@ -62,7 +62,11 @@ impl ExactFlow for TappingModel {
                 None => m.oscillator.homogeneous_transition(spacing),
             };
             let start = m.oscillator.steady_state_at_phase(sin0, cos0);
-            let mut y = [x0[2 * i] - start[0], x0[2 * i + 1] - start[1]];
+            let second = self.second_steady_state(i, t0);
+            let mut y = [
+                x0[2 * i] - start[0] - second[0],
+                x0[2 * i + 1] - start[1] - second[1],
+            ];
             let (mut sin, mut cos) = (sin0, cos0);
             for j in 0..count {
                 y = [
@@ -74,8 +78,9 @@ impl ExactFlow for TappingModel {
                     cos * cos_step - sin * sin_step,
                 );
                 let steady = m.oscillator.steady_state_at_phase(sin, cos);
-                states[j * n + 2 * i] = steady[0] + y[0];
-                states[j * n + 2 * i + 1] = steady[1] + y[1];
+                let second = self.second_steady_state(i, t0 + (j + 1) as f64 * spacing);
+                states[j * n + 2 * i] = steady[0] + second[0] + y[0];
+                states[j * n + 2 * i + 1] = steady[1] + second[1] + y[1];
             }
         }
         if let Some(sls) = self.force.law.standard_linear_solid() {
@@ -114,14 +119,18 @@ impl ExactFlow for TappingModel {
             } else {
                 m.oscillator.homogeneous_transition(dt)
             };
+            // A bimodal drive's second response is a further particular solution: the flow of
+            // `x0 - s_b(t0)` under the first drive, plus `s_b(t0 + dt)`.
+            let start = self.second_steady_state(i, t0);
+            let end = self.second_steady_state(i, t0 + dt);
             let state = m.oscillator.flow_with_transition(
                 start_phase,
                 end_phase,
-                [x0[2 * i], x0[2 * i + 1]],
+                [x0[2 * i] - start[0], x0[2 * i + 1] - start[1]],
                 &phi,
             );
-            x[2 * i] = state[0];
-            x[2 * i + 1] = state[1];
+            x[2 * i] = state[0] + end[0];
+            x[2 * i + 1] = state[1] + end[1];
             if let Some(matrix) = transition.as_deref_mut() {
                 for r in 0..2 {
                     for c in 0..2 {
@@ -145,6 +154,28 @@ impl ExactFlow for TappingModel {
 }
 
 impl TappingModel {
+    /// Mode `i`'s steady response to a bimodal drive's second drive at `t`, `[q, q']` (nm,
+    /// nm/us); zero for another drive.
+    #[inline]
+    fn second_steady_state(&self, i: usize, t: f64) -> [f64; 2] {
+        self.second
+            .as_ref()
+            .map_or([0.0, 0.0], |second| second.oscillators[i].steady_state(t))
+    }
+
+    /// The drives of the Taylor series: `w`, an acoustic drive's base amplitude, a bimodal
+    /// drive's second frequency and relative force (MODEL.md section 14).
+    fn series_drive(&self) -> SeriesDrive {
+        SeriesDrive {
+            frequency: self.drive.angular_frequency,
+            base_amplitude: self.base.as_ref().map_or(0.0, |base| base.amplitude_nm),
+            second: self
+                .second
+                .as_ref()
+                .map(|second| (second.angular_frequency, second.relative_force)),
+        }
+    }
+
     /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
     /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
     /// outside it (van der Waals, when `H > 0`), the Hertz sphere with a hydration force (in
@@ -235,7 +266,7 @@ impl TaylorExpansion for TappingModel {
             contact_series::contact_state_series(
                 &self.modes,
                 force,
-                self.drive.angular_frequency,
+                &self.series_drive(),
                 &self.separation,
                 clock,
                 series,
@@ -258,6 +289,7 @@ impl TaylorExpansion for TappingModel {
             contact_series::contact_tangent_series(
                 &self.modes,
                 force,
+                &self.series_drive(),
                 &self.separation,
                 clock,
                 state,
@@ -290,7 +322,7 @@ impl SwitchingStructure for TappingModel {
     fn crossing_tangent_limit(
         &self,
         mode: Mode,
-        _t: f64,
+        t: f64,
         x: &[f64],
         tangents: &[f64],
         tangent_rates: &mut [f64],
@@ -303,7 +335,7 @@ impl SwitchingStructure for TappingModel {
             return false;
         }
         let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
-        let indentation_rate = -self.gap_rate(x);
+        let indentation_rate = -self.gap_rate_at(t, x);
         let limit =
             -c * kv.release_time_us() * indentation_rate.signum() * indentation_rate.abs().sqrt();
         let n = self.dim();
@@ -326,13 +358,16 @@ impl SwitchingStructure for TappingModel {
     }
 
     /// The gap `Z(t) + sum_i q_i` is affine (`Z(t)` is a constant or a linear ramp), and so
-    /// are `h_0 = d - d_c` and `h_1 = -d - tau d'`; a standard linear solid's
-    /// `h_0 = d + rho^{2/3}` is not, unless `E_0 = E_inf` keeps `rho = 0`.
+    /// are `h_0 = d - d_c` and `h_1 = -d - tau d'`; not with an acoustic drive's base motion
+    /// `Y cos(w t)` in the gap (MODEL.md section 14), nor with a standard linear solid's
+    /// `h_0 = d + rho^{2/3}` unless `E_0 = E_inf` keeps `rho = 0`.
     fn switching_is_affine(&self, _k: usize) -> bool {
-        self.force
-            .law
-            .standard_linear_solid()
-            .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
+        self.base.is_none()
+            && self
+                .force
+                .law
+                .standard_linear_solid()
+                .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
     }
 
     /// In free flight, a bound on the gap's curvature `|d''| = |Z'' + sum_i q_i''|` over
@@ -358,20 +393,32 @@ impl SwitchingStructure for TappingModel {
         }
         let w = self.drive.angular_frequency;
         let (sin, cos) = phase::sin_cos(w * t0);
-        let bound = self
-            .modes
-            .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
-                let (y, dy) = (x0[2 * i] - p, x0[2 * i + 1] - dp);
-                let [alpha, beta] = m.oscillator.steady_coefficients();
-                let steady = w * w * alpha.hypot(beta);
-                let homogeneous = (m.omega_squared.sqrt() + m.damping)
-                    * (dy * dy + m.omega_squared * y * y).sqrt();
-                steady + homogeneous
-            })
-            .sum::<f64>();
+        // The base's `|y_base''| <= w^2 |Y|` (acoustic drive, MODEL.md section 14).
+        let base = self
+            .base
+            .as_ref()
+            .map_or(0.0, |base| w * w * base.amplitude_nm.abs());
+        let bound = base
+            + self
+                .modes
+                .iter()
+                .enumerate()
+                .map(|(i, m)| {
+                    let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
+                    let [pb, dpb] = self.second_steady_state(i, t0);
+                    let (y, dy) = (x0[2 * i] - p - pb, x0[2 * i + 1] - dp - dpb);
+                    let [alpha, beta] = m.oscillator.steady_coefficients();
+                    // A bimodal drive's second steady response adds `w_b^2 P_bi`.
+                    let second = self.second.as_ref().map_or(0.0, |second| {
+                        let [a, b] = second.oscillators[i].steady_coefficients();
+                        second.angular_frequency * second.angular_frequency * a.hypot(b)
+                    });
+                    let steady = w * w * alpha.hypot(beta) + second;
+                    let homogeneous = (m.omega_squared.sqrt() + m.damping)
+                        * (dy * dy + m.omega_squared * y * y).sqrt();
+                    steady + homogeneous
+                })
+                .sum::<f64>();
         // A standard linear solid's unrecovered depth `sigma = rho^{2/3}` decays as
         // `exp(-(2/3) r t)` (`r` the recovery rate): `|sigma''| <= (4/9) r^2 sigma(t0)`.
         let surface = self.force.law.standard_linear_solid().map_or(0.0, |sls| {

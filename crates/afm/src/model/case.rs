@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::AfmError;
 use crate::model::cantilever::Cantilever;
+use crate::model::drive_spec::DriveSpec;
 use crate::model::sample::Sample;
 use crate::validation::{check_all, check_name, ranges, warnings_of, NumericField};
 
@@ -30,6 +31,15 @@ pub struct CaseFile {
     /// absent: `f_1` (the paper's `w = w_1`, MODEL.md section 3).
     #[serde(default)]
     pub drive_frequency_khz: Option<f64>,
+    /// The excitation (`{"kind": "direct" | "acoustic" | "bimodal", ...}`, MODEL.md section
+    /// 14); absent: `direct`.
+    #[serde(default, skip_serializing_if = "is_direct")]
+    pub drive: DriveSpec,
+}
+
+/// Whether `drive` is the default direct drive (left out of a written case file).
+fn is_direct(drive: &DriveSpec) -> bool {
+    *drive == DriveSpec::Direct
 }
 
 impl CaseFile {
@@ -83,6 +93,8 @@ pub struct Case {
     pub free_amplitude_nm: f64,
     /// The drive frequency, kHz; `None` means the fundamental `f_1`.
     pub drive_frequency_khz: Option<f64>,
+    /// The excitation: direct (default), acoustic or bimodal (MODEL.md section 14).
+    pub drive: DriveSpec,
 }
 
 impl Case {
@@ -113,7 +125,11 @@ impl Case {
                 ));
             }
         }
-        Ok(())
+        self.drive.validate(
+            file,
+            &self.cantilever,
+            self.drive_frequency_or_fundamental_khz(),
+        )
     }
 
     /// The plausibility warnings of every field (the cantilever's and the sample's included):

@@ -94,6 +94,44 @@ fn update_layer_exponential(
     im[k] = scale * (c_re * sum_im + c_im * sum_re);
 }
 
+/// The drives a series expands Eq. 1 with (MODEL.md sections 1 and 14): the drive at
+/// `frequency` (rad/us), an acoustic drive's base motion `base_amplitude cos(w t)` in the gap
+/// (nm; 0 without), and a bimodal drive's second drive `(w_b, F_1b / F_1)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SeriesDrive {
+    /// The drive angular frequency `w`, rad/us.
+    pub(crate) frequency: f64,
+    /// The base amplitude `Y` of an acoustic drive, nm (0 for another drive).
+    pub(crate) base_amplitude: f64,
+    /// A bimodal drive's `(w_b, F_1b / F_1)`.
+    pub(crate) second: Option<(f64, f64)>,
+}
+
+/// Coefficients `0..=p` of `cos(w t(s))` and `sin(w t(s))` into `cos` and `sin`, by the
+/// recurrence `(cos)' = -w tau sin`, `(sin)' = w tau cos` (as in [`contact_state_series`]).
+fn phase_series(
+    frequency: f64,
+    clock: &ClockPolynomial,
+    p: usize,
+    cos: &mut [f64; MAX_ORDER + 1],
+    sin: &mut [f64; MAX_ORDER + 1],
+) {
+    let (a, b2) = (clock.rate, 2.0 * clock.curvature);
+    (sin[0], cos[0]) = phase::sin_cos(frequency * clock.start);
+    for k in 0..p.min(MAX_ORDER) {
+        let scale = 1.0 / (k + 1) as f64;
+        let (rate, curvature, below) = if k > 0 {
+            (a * scale, b2 * scale, k - 1)
+        } else {
+            (a * scale, 0.0, 0)
+        };
+        let tau_cos = rate * cos[k] + curvature * cos[below];
+        let tau_sin = rate * sin[k] + curvature * sin[below];
+        cos[k + 1] = -frequency * tau_sin;
+        sin[k + 1] = frequency * tau_cos;
+    }
+}
+
 /// The separation `Z(t(s))`'s coefficients `0..=2` (`Z` constant or a linear ramp in `t`, `t`
 /// quadratic in `s`: the higher ones vanish).
 #[inline]
@@ -187,7 +225,7 @@ fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
 }
 
 /// The Taylor coefficients of the flow of Eq. 1 with the force `force` (`N` modes `modes`,
-/// drive `w` rad/us, separation `separation`) in the clock offset `s` of `clock`, through the
+/// drives `drive`, separation `separation`) in the clock offset `s` of `clock`, through the
 /// state held in the constant terms of `series` (`2N` components, `q_i`, `q_i'` in nm, nm/us);
 /// `false` (series unusable) if the order exceeds [`MAX_ORDER`], the state is on the wrong
 /// side of the force's surface (Hertz: `d >= d_c` where the clock runs at a finite rate; van
@@ -200,7 +238,7 @@ fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
 pub(crate) fn contact_state_series(
     modes: &[ModalConstants],
     force: SeriesForce,
-    drive_frequency: f64,
+    drive: &SeriesDrive,
     separation: &Separation,
     clock: &ClockPolynomial,
     series: &mut TaylorSeries,
@@ -210,8 +248,7 @@ pub(crate) fn contact_state_series(
     }
     let separation = shifted_separation(separation, clock, force);
     // The common mode counts as constants, so that the loops over modes unroll.
-    let mut run =
-        |modes| state_recurrence(modes, force, drive_frequency, &separation, clock, series);
+    let mut run = |modes| state_recurrence(modes, force, drive, &separation, clock, series);
     match modes.len() {
         1 => run(&modes[..1]),
         2 => run(&modes[..2]),
@@ -287,7 +324,7 @@ fn force_coefficient(
 fn state_recurrence(
     modes: &[ModalConstants],
     law: SeriesForce,
-    drive_frequency: f64,
+    drive: &SeriesDrive,
     separation: &[f64; 3],
     clock: &ClockPolynomial,
     series: &mut TaylorSeries,
@@ -302,7 +339,15 @@ fn state_recurrence(
     // The auxiliary series; twice as long for the hydration force's complex exponential.
     let mut root = [0.0; 2 * (MAX_ORDER + 1)];
     let mut force = [0.0; MAX_ORDER + 1];
+    let drive_frequency = drive.frequency;
     (sin[0], cos[0]) = phase::sin_cos(drive_frequency * clock.start);
+    // A bimodal drive's second phase series (MODEL.md section 14).
+    let (second_frequency, second_factor) = drive.second.unwrap_or((0.0, 0.0));
+    let mut second_cos = [0.0; MAX_ORDER + 1];
+    let mut second_sin = [0.0; MAX_ORDER + 1];
+    if drive.second.is_some() {
+        phase_series(second_frequency, clock, p, &mut second_cos, &mut second_sin);
+    }
     let x = series.coefficients_mut();
     // The sum of every coefficient and force, finite only if each of them is (or rejecting
     // coefficients near f64::MAX, of no use either).
@@ -311,7 +356,8 @@ fn state_recurrence(
         let (done, rest) = x.split_at_mut((k + 1) * n);
         let (earlier, row) = done.split_at(k * n);
         let next = &mut rest[..n];
-        delta[k] = indentation_coefficient(separation, row, k);
+        // An acoustic drive's base motion `Y cos(w t)` is in the gap (MODEL.md section 14).
+        delta[k] = indentation_coefficient(separation, row, k) - drive.base_amplitude * cos[k];
         match force_coefficient(law, &mut root, &delta, k, onset) {
             Some(value) => force[k] = value,
             None => return false,
@@ -332,6 +378,12 @@ fn state_recurrence(
         let tau_force = rate * force[k] + curvature * force[below];
         cos[k + 1] = -drive_frequency * tau_sin;
         sin[k + 1] = drive_frequency * tau_cos;
+        // Both drives' factor `cos(w t) + (F_1b / F_1) cos(w_b t)`, times tau.
+        let tau_drive = if drive.second.is_some() {
+            tau_cos + second_factor * (rate * second_cos[k] + curvature * second_cos[below])
+        } else {
+            tau_cos
+        };
         for ((m, out), (qv, previous_qv)) in modes
             .iter()
             .zip(next.chunks_exact_mut(2))
@@ -340,7 +392,7 @@ fn state_recurrence(
             let tau_q = rate * qv[0] + curvature * previous_qv[0];
             let tau_v = rate * qv[1] + curvature * previous_qv[1];
             out[0] = tau_v;
-            out[1] = m.drive_acceleration * tau_cos + m.omega_squared_over_stiffness * tau_force
+            out[1] = m.drive_acceleration * tau_drive + m.omega_squared_over_stiffness * tau_force
                 - m.omega_squared * tau_q
                 - m.damping * tau_v;
             total += out[0] + out[1];
@@ -351,7 +403,8 @@ fn state_recurrence(
 
 /// The Taylor coefficients of the tangent matrix `V` (`2N` rows: the transition matrix's
 /// columns, then, with `parameter_column`, `dx/dZ`) along the contact flow whose state series is
-/// `state` (from [`contact_state_series`] with the same arguments): `dV/ds = tau J(t(s), x(s))
+/// `state` (from [`contact_state_series`] with the same arguments; the drives enter only
+/// through an acoustic drive's base motion in the gap): `dV/ds = tau J(t(s), x(s))
 /// V` (`+ tau df/dZ` on the parameter column), `J`'s contact part being `(w_i^2/k_i) F_ts'(d)`
 /// on every `q_j` with `F_ts' = -(3/2) c r` (Hertz) or `2 A / d^3` (van der Waals). Each coefficient of `tangents` is `V`'s row-major
 /// matrix (component `row * columns + column`); the constant terms hold `V` at the step start.
@@ -360,6 +413,7 @@ fn state_recurrence(
 pub(crate) fn contact_tangent_series(
     modes: &[ModalConstants],
     force: SeriesForce,
+    drive: &SeriesDrive,
     separation: &Separation,
     clock: &ClockPolynomial,
     state: &TaylorSeries,
@@ -376,12 +430,18 @@ pub(crate) fn contact_tangent_series(
     // (`F' = -(3/2) c r`), `u^3 = 1/d^3` for van der Waals (`F' = 2 A u^3`).
     let mut delta = [0.0; MAX_ORDER + 1];
     let mut root = [0.0; MAX_ORDER + 1];
+    // An acoustic drive's base motion `Y cos(w t)` in the gap (MODEL.md section 14).
+    let mut base = [0.0; MAX_ORDER + 1];
+    if drive.base_amplitude != 0.0 {
+        let mut sin = [0.0; MAX_ORDER + 1];
+        phase_series(drive.frequency, clock, p, &mut base, &mut sin);
+    }
     for (k, (d, row)) in delta[..=p]
         .iter_mut()
         .zip(state.coefficients().chunks_exact(n))
         .enumerate()
     {
-        *d = indentation_coefficient(&separation, row, k);
+        *d = indentation_coefficient(&separation, row, k) - drive.base_amplitude * base[k];
     }
     let slope = match force {
         SeriesForce::Hertz { coefficient, .. } => {

@@ -53,9 +53,13 @@ pub struct ModeIntegrals {
 
 impl FreeFlightEnergy {
     /// The closed form for `model`'s free flight; `None` when a mode is within 0.1% of critical
-    /// damping (as [`crate::model::free_flight_fourier::FreeFlightFourier::new`]), where the
-    /// caller integrates numerically instead.
+    /// damping or under a bimodal drive (as
+    /// [`crate::model::free_flight_fourier::FreeFlightFourier::new`]), where the caller
+    /// integrates numerically instead.
     pub fn new(model: &TappingModel) -> Option<Self> {
+        if model.second_drive().is_some() {
+            return None;
+        }
         let drive = model.drive();
         let modes = model
             .cantilever()

@@ -102,8 +102,12 @@ pub struct FreeFlightFourier {
 
 impl FreeFlightFourier {
     /// The closed form for `model`'s free flight; `None` when a mode is within 0.1% of critical
-    /// damping (`Q_i` near 1/2), where the caller should integrate numerically instead.
+    /// damping (`Q_i` near 1/2), or under a bimodal drive (two drive frequencies, MODEL.md
+    /// section 14), where the caller should integrate numerically instead.
     pub fn new(model: &TappingModel) -> Option<Self> {
+        if model.second_drive().is_some() {
+            return None;
+        }
         let drive = model.drive();
         let modes = model
             .cantilever()

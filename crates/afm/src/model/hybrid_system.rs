@@ -8,7 +8,6 @@ use crate::contact::ForceSlopes;
 use nalgebra::DMatrix;
 
 use super::{TappingModel, CLIPPED, GAP_SURFACE, RELEASE_SURFACE};
-use crate::model::phase;
 
 impl HybridSystem for TappingModel {
     /// `2N`, plus 1 for a standard linear solid's state `rho` (MODEL.md section 9).
@@ -31,7 +30,7 @@ impl HybridSystem for TappingModel {
     /// sphere 0 in free flight and `c (-d)^{3/2}`, finite on both sides, in contact).
     #[inline(always)]
     fn vector_field(&self, mode: Mode, t: f64, x: &[f64], dxdt: &mut [f64]) {
-        let drive = phase::cos(self.drive.angular_frequency * t);
+        let drive = self.drive_factor(t);
         let force = if !self.plain_hertz {
             self.force_slopes(mode, t, x).force
         } else if Self::in_contact(mode) {
@@ -82,7 +81,7 @@ impl HybridSystem for TappingModel {
             }
             return;
         }
-        let drive = phase::cos(self.drive.angular_frequency * t);
+        let drive = self.drive_factor(t);
         let slopes = self.force_slopes(mode, t, x);
         self.modal_field(drive, slopes.force, x, dxdt);
         self.modal_jacobian(slopes.gap_slope, slopes.rate_slope, jacobian.as_mut_slice());
@@ -113,7 +112,7 @@ impl HybridSystem for TappingModel {
             self.relaxing_tangent_rates(mode, t, x, tangents, tangent_rates, parameter_column);
             return;
         }
-        let drive = phase::cos(self.drive.angular_frequency * t);
+        let drive = self.drive_factor(t);
         let slopes = self.force_slopes(mode, t, x);
         self.modal_field(drive, slopes.force, x, dxdt);
         if slopes.rate_slope == 0.0 {
@@ -123,15 +122,15 @@ impl HybridSystem for TappingModel {
         }
     }
 
-    /// `h_0 = d - d_c = Z(t) + sum_i q_i - d_c`, nm (a standard linear solid's
+    /// `h_0 = d - d_c = Z(t) + y_base(t) + sum_i q_i - d_c`, nm (a standard linear solid's
     /// `h_0 = d + sigma`, `sigma = rho^{2/3}` its unrecovered depth); a clipped Kelvin-Voigt
-    /// law's `h_1 = -d - tau d'`, nm (MODEL.md section 9).
+    /// law's `h_1 = -d - tau d'`, nm (MODEL.md sections 9 and 14).
     fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
             self.gap(t, x) - self.contact_gap_nm()
                 + self.force.law.surface_depth_nm(self.sample_state(x))
         } else {
-            -self.gap(t, x) - self.release_time() * self.gap_rate(x)
+            -self.gap(t, x) - self.release_time() * self.gap_rate_at(t, x)
         }
     }
 
@@ -140,20 +139,21 @@ impl HybridSystem for TappingModel {
     /// `dh_1/dt = -d' - tau d''` with `d'' = sum_i q_i''` of mode `mode` (`Z'' = 0`).
     fn switching_rate(&self, k: usize, mode: Mode, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
-            self.gap_rate(x) + self.surface_depth_rate(mode, t, x)
+            self.gap_rate_at(t, x) + self.surface_depth_rate(mode, t, x)
         } else {
-            -self.gap_rate(x) - self.release_time() * self.gap_acceleration(mode, t, x)
+            -self.gap_rate_at(t, x) - self.release_time() * self.gap_acceleration(mode, t, x)
         }
     }
 
     /// `grad h_0` = 1 on every `q_i`, 0 on every `q_i'` (and `d sigma/d rho = (2/3)
-    /// rho^{-1/3}` on a standard linear solid's `rho`); `dh_0/dt|_x = Z'(t)`; `dh_0/dZ = 1`.
-    /// `grad h_1` = -1 on every `q_i`, `-tau` on every `q_i'`; `dh_1/dt|_x = -Z'(t)`;
+    /// rho^{-1/3}` on a standard linear solid's `rho`); `dh_0/dt|_x = Z'(t) + y_base'(t)`;
+    /// `dh_0/dZ = 1`. `grad h_1` = -1 on every `q_i`, `-tau` on every `q_i'`;
+    /// `dh_1/dt|_x = -Z'(t) - y_base'(t) - tau y_base''(t)`;
     /// `dh_1/dZ = -1`.
     fn switching_gradient(
         &self,
         k: usize,
-        _t: f64,
+        t: f64,
         x: &[f64],
         gradient: &mut [f64],
     ) -> SwitchingPartials {
@@ -174,7 +174,8 @@ impl HybridSystem for TappingModel {
             };
         }
         SwitchingPartials {
-            t: sign * self.separation.rate(),
+            t: sign * (self.separation.rate() + self.base_velocity(t))
+                + on_rate * self.base.as_ref().map_or(0.0, |base| base.acceleration(t)),
             p: sign,
         }
     }

@@ -7,12 +7,15 @@ use std::f64::consts::PI;
 use hybrid::{HybridSystem, Mode};
 
 mod accelerations;
+pub mod base_motion;
 pub mod cantilever;
 pub mod case;
+pub mod commensurate;
 pub(crate) mod contact_series;
 #[cfg(test)]
 mod contact_series_tests;
 pub mod drive;
+pub mod drive_spec;
 pub mod eigenmode;
 pub mod film_validity;
 pub mod free_flight;
@@ -25,6 +28,7 @@ pub(crate) mod modal_constants;
 pub mod phase;
 pub mod sample;
 mod sample_relaxation;
+pub mod second_drive;
 pub mod separation;
 #[cfg(test)]
 mod tests;
@@ -33,15 +37,20 @@ pub mod trigonometric;
 use crate::contact::spec::tip_sample_force;
 use crate::contact::{ContactLaw, ForceSlopes, HertzShape, HertzTip, TipSampleForce};
 use crate::error::AfmError;
+use crate::model::base_motion::{
+    acoustic_cantilever, beam_participation, inertial_force_per_nm, BaseMotion,
+};
 use crate::model::cantilever::Cantilever;
 use crate::model::case::check_case_numbers;
 use crate::model::case::Case;
 use crate::model::drive::Drive;
+use crate::model::drive_spec::{bimodal_ratio, DriveSpec};
 use crate::model::free_response::FreeResponse;
 use crate::model::hertz_contact::effective_modulus_gpa;
 use crate::model::hertz_contact::HertzContact;
 use crate::model::modal_constants::{grid_spacing, ModalConstants, KEPT_GRIDS};
 use crate::model::sample::Sample;
+use crate::model::second_drive::SecondDrive;
 use crate::model::separation::Separation;
 use crate::validation::invalid;
 
@@ -76,6 +85,12 @@ pub struct TappingModel {
     /// Taylor series, half-power surface, exact free flight).
     plain_hertz: bool,
     drive: Drive,
+    /// The drive as the case states it (MODEL.md sections 3 and 14).
+    drive_spec: DriveSpec,
+    /// An acoustic drive's base motion `y_base(t)` (MODEL.md section 14).
+    base: Option<BaseMotion>,
+    /// A bimodal drive's second drive (MODEL.md section 14).
+    second: Option<SecondDrive>,
     free_amplitude_nm: f64,
     free_response: FreeResponse,
     grazing_separation_nm: f64,
@@ -100,6 +115,28 @@ impl TappingModel {
         drive_frequency_khz: Option<f64>,
         separation: Separation,
     ) -> Result<Self, AfmError> {
+        Self::with_drive(
+            cantilever,
+            sample,
+            free_amplitude_nm,
+            drive_frequency_khz,
+            &DriveSpec::Direct,
+            separation,
+        )
+    }
+
+    /// As [`TappingModel::new`], with the drive `drive_spec` (MODEL.md section 14): for an
+    /// acoustic drive the base amplitude `Y` is solved from `A0` and the model's cantilever
+    /// carries the base motion's effective forcing ratios; a bimodal drive adds its second drive
+    /// and the model's period becomes the common period `q T`.
+    pub fn with_drive(
+        cantilever: Cantilever,
+        sample: Sample,
+        free_amplitude_nm: f64,
+        drive_frequency_khz: Option<f64>,
+        drive_spec: &DriveSpec,
+        separation: Separation,
+    ) -> Result<Self, AfmError> {
         cantilever.validate(&format!("cantilever `{}`", cantilever.name))?;
         sample.validate(&format!("sample `{}`", sample.name))?;
         check_case_numbers("model parameters", free_amplitude_nm, drive_frequency_khz)?;
@@ -117,15 +154,51 @@ impl TappingModel {
                 ),
             ));
         }
+        let drive_file = format!("the drive of cantilever `{}`", cantilever.name);
+        drive_spec.validate(&drive_file, &cantilever, frequency_khz)?;
+        let (cantilever, base) = match drive_spec {
+            DriveSpec::Acoustic { base_participation } => {
+                let participation = match base_participation {
+                    Some(factors) => factors.clone(),
+                    None => beam_participation(&cantilever, &drive_file)?,
+                };
+                let w = crate::model::eigenmode::angular_frequency_rad_per_us(frequency_khz);
+                let acoustic = acoustic_cantilever(&cantilever, &participation, w);
+                let per_nm = inertial_force_per_nm(&cantilever, &participation, w)[0];
+                (acoustic, Some((participation, w, per_nm)))
+            }
+            _ => (cantilever, None),
+        };
         let drive = Drive::for_free_amplitude(&cantilever, free_amplitude_nm, frequency_khz)?;
-        let free_response = FreeResponse::new(&cantilever, &drive);
+        let base = base.map(|(participation, angular_frequency, per_nm)| BaseMotion {
+            amplitude_nm: drive.force_nn / per_nm,
+            angular_frequency,
+            participation,
+        });
+        let second = match drive_spec {
+            DriveSpec::Bimodal {
+                second_frequency_khz,
+                second_free_amplitude_nm,
+            } => Some(SecondDrive::new(
+                &cantilever,
+                &drive,
+                *second_frequency_khz,
+                *second_free_amplitude_nm,
+                bimodal_ratio(&drive_file, frequency_khz, *second_frequency_khz)?,
+            )?),
+            _ => None,
+        };
+        let free_response = FreeResponse::new(&cantilever, &drive)
+            .with_base_amplitude(base.as_ref().map_or(0.0, |b| b.amplitude_nm))
+            .with_second_drive(second.as_ref());
 
         // A quarter of the shortest period present: the undamped modal periods (each no longer
-        // than the damped one) and the drive period.
+        // than the damped one) and the drive periods.
         let shortest_period = cantilever
             .modes
             .iter()
             .map(|mode| 2.0 * PI / mode.angular_frequency())
+            .chain(second.as_ref().map(|s| 2.0 * PI / s.angular_frequency))
             .fold(drive.period_us(), f64::min);
         let exact_step_limit = 0.25 * shortest_period;
         let modes: Vec<ModalConstants> = cantilever
@@ -184,6 +257,9 @@ impl TappingModel {
             cantilever,
             sample,
             drive,
+            drive_spec: drive_spec.clone(),
+            base,
+            second,
             free_amplitude_nm,
             free_response,
             grazing_separation_nm,
@@ -197,18 +273,20 @@ impl TappingModel {
     /// The model of a resolved [`Case`] at separation `Z = Z_G1` (first contact); change it
     /// with [`TappingModel::set_separation`].
     pub fn from_case(case: &Case) -> Result<Self, AfmError> {
-        let mut model = Self::new(
+        let mut model = Self::with_drive(
             case.cantilever.clone(),
             case.sample.clone(),
             case.free_amplitude_nm,
             case.drive_frequency_khz,
+            &case.drive,
             Separation::Constant(0.0),
         )?;
         model.separation = Separation::Constant(model.grazing_separation_nm);
         Ok(model)
     }
 
-    /// The cantilever.
+    /// The cantilever. Under an acoustic drive its forcing ratios are the base motion's
+    /// effective ones, `r_i = k_i gamma_i w_1^2 / (k_1 gamma_1 w_i^2)` (MODEL.md section 14).
     pub fn cantilever(&self) -> &Cantilever {
         &self.cantilever
     }
@@ -260,9 +338,57 @@ impl TappingModel {
         self.drive.frequency_khz
     }
 
-    /// Drive period `T = 2 pi / w`, us.
+    /// The orbit's forcing period, us: the drive period `T = 2 pi / w`, or for a bimodal drive
+    /// of ratio `p / q` the common period `q T` (MODEL.md section 14). Every "per period"
+    /// observable is per this period.
     pub fn period_us(&self) -> f64 {
-        self.drive.period_us()
+        self.drive.period_us() * self.periods_per_orbit_period() as f64
+    }
+
+    /// The number `q` of first-drive periods in [`TappingModel::period_us`]: 1, or a bimodal
+    /// drive's denominator.
+    pub fn periods_per_orbit_period(&self) -> u32 {
+        self.second.as_ref().map_or(1, |s| s.ratio.denominator)
+    }
+
+    /// The drive as the case states it (MODEL.md sections 3 and 14).
+    pub fn drive_spec(&self) -> &DriveSpec {
+        &self.drive_spec
+    }
+
+    /// An acoustic drive's base motion `y_base(t) = Y cos(w t)` (MODEL.md section 14).
+    pub fn base_motion(&self) -> Option<&BaseMotion> {
+        self.base.as_ref()
+    }
+
+    /// A bimodal drive's second drive (MODEL.md section 14).
+    pub fn second_drive(&self) -> Option<&SecondDrive> {
+        self.second.as_ref()
+    }
+
+    /// The drive factor `D(t)` of Eq. 1's forcing `F_i D(t)`: `cos(w t)`, plus
+    /// `(F_1b / F_1) cos(w_b t)` under a bimodal drive (MODEL.md section 14).
+    #[inline]
+    pub fn drive_factor(&self, t: f64) -> f64 {
+        let first = phase::cos(self.drive.angular_frequency * t);
+        match &self.second {
+            None => first,
+            Some(second) => {
+                first + second.relative_force * phase::cos(second.angular_frequency * t)
+            }
+        }
+    }
+
+    /// The base's displacement `y_base(t)` in the gap, nm: 0 but under an acoustic drive.
+    #[inline]
+    pub fn base_displacement(&self, t: f64) -> f64 {
+        self.base.as_ref().map_or(0.0, |base| base.displacement(t))
+    }
+
+    /// The base's velocity `y_base'(t)`, nm/us: 0 but under an acoustic drive.
+    #[inline]
+    pub fn base_velocity(&self, t: f64) -> f64 {
+        self.base.as_ref().map_or(0.0, |base| base.velocity(t))
     }
 
     /// The free amplitude `A0` of `u`, nm (MODEL.md section 3).
@@ -368,7 +494,7 @@ impl TappingModel {
                 Self::in_contact(mode),
                 mode & CLIPPED != 0,
                 self.gap(t, x),
-                self.gap_rate(x),
+                self.gap_rate_at(t, x),
                 self.sample_state(x),
             );
         }
@@ -465,17 +591,27 @@ impl TappingModel {
         }
     }
 
-    /// The tip-sample gap `d = Z(t) + sum_i q_i`, nm.
+    /// The tip-sample gap `d = Z(t) + y_base(t) + sum_i q_i`, nm (`y_base = 0` but under an
+    /// acoustic drive, MODEL.md section 14).
     #[inline]
     pub fn gap(&self, t: f64, x: &[f64]) -> f64 {
         self.separation.at(t)
+            + self.base_displacement(t)
             + x[..2 * self.modes.len()]
                 .chunks_exact(2)
                 .map(|mode| mode[0])
                 .sum::<f64>()
     }
 
-    /// The gap's rate `d' = Z'(t) + sum_i q_i'`, nm/us.
+    /// The gap's rate at time `t`, `d' = Z'(t) + y_base'(t) + sum_i q_i'`, nm/us (MODEL.md
+    /// section 14).
+    #[inline]
+    pub fn gap_rate_at(&self, t: f64, x: &[f64]) -> f64 {
+        self.gap_rate(x) + self.base_velocity(t)
+    }
+
+    /// The gap's rate without the base's motion, `Z'(t) + sum_i q_i'`, nm/us: `d'` but under an
+    /// acoustic drive ([`TappingModel::gap_rate_at`]).
     #[inline]
     pub fn gap_rate(&self, x: &[f64]) -> f64 {
         self.separation.rate()
@@ -493,7 +629,7 @@ impl TappingModel {
             self.hertz.force(self.gap(t, x))
         } else {
             self.force
-                .force_at(self.gap(t, x), self.gap_rate(x), self.sample_state(x))
+                .force_at(self.gap(t, x), self.gap_rate_at(t, x), self.sample_state(x))
         }
     }
 
@@ -526,11 +662,13 @@ impl TappingModel {
         }
     }
 
-    /// The sum of the modal accelerations `d'' - Z'' = sum_i q_i''` of mode `mode` (nm/us^2).
+    /// The gap's acceleration `d'' - Z'' = y_base'' + sum_i q_i''` of mode `mode` (nm/us^2).
     pub(crate) fn gap_acceleration(&self, mode: Mode, t: f64, x: &[f64]) -> f64 {
-        let drive = phase::cos(self.drive.angular_frequency * t);
+        let drive = self.drive_factor(t);
         let force = self.force_slopes(mode, t, x).force;
-        self.modes
+        let base = self.base.as_ref().map_or(0.0, |base| base.acceleration(t));
+        base + self
+            .modes
             .iter()
             .zip(x.chunks_exact(2))
             .map(|(m, state)| {
@@ -538,7 +676,7 @@ impl TappingModel {
                     - m.omega_squared * state[0]
                     - m.damping * state[1]
             })
-            .sum()
+            .sum::<f64>()
     }
 
     /// The photodiode signal `u = sum_i chi_i q_i`, nm.

@@ -20,6 +20,7 @@ use crate::contact::standard_linear_solid::StandardLinearSolid;
 use crate::error::AfmError;
 use crate::model::free_flight_energy::{FreeFlightEnergy, ModeIntegrals};
 use crate::model::free_flight_fourier::FreeFlightFourier;
+use crate::model::phase;
 use crate::model::TappingModel;
 use crate::model::{CONTACT, GAP_SURFACE};
 use crate::orbit::gauss_legendre::{ClockNode, GAUSS_LEGENDRE_8};
@@ -174,9 +175,14 @@ pub struct OrbitObservables {
     /// The impulse per drive period `(1/k) int F_ts dt` over the window, nN us.
     pub impulse_nn_us: f64,
     /// The energy dissipated in the sample per drive period,
-    /// `E_ts = -(1/k) int F_ts w' dt` over the window (`w = sum_i q_i` the tip deflection),
-    /// eV (MODEL.md section 10): zero for a conservative law, positive for a dissipative one.
+    /// `E_ts = -(1/k) int F_ts (w' + y_base') dt` over the window (`w = sum_i q_i` the tip
+    /// deflection, `y_base` an acoustic drive's base motion, else 0), eV (MODEL.md sections 10
+    /// and 14): zero for a conservative law, positive for a dissipative one.
     pub dissipated_ev: f64,
+    /// The contact force's work on the moving base per drive period,
+    /// `(1/k) int F_ts y_base' dt` over the window, eV (MODEL.md section 14; 0 but under an
+    /// acoustic drive): the modes' dissipated shares add up to `dissipated_ev + base_work_ev`.
+    pub base_work_ev: f64,
     /// The virial `V_ts = (1/(k T)) int F_ts w dt` over the window, eV.
     pub virial_ev: f64,
     /// The largest indentation `s = d_c - d` of the law's contact geometry in the window, nm
@@ -190,6 +196,19 @@ pub struct OrbitObservables {
     pub energy_balance_residual: f64,
     /// Each mode's energy balance per drive period.
     pub mode_energy: Vec<ModeEnergy>,
+    /// A bimodal drive's lock-in reading of `u` at the second frequency `w_b` over the window
+    /// (MODEL.md section 14); `None` for another drive.
+    pub second_drive: Option<SecondDriveResponse>,
+}
+
+/// The first harmonic of `u` at a bimodal drive's second frequency `w_b` over a window:
+/// `a = (2/kT) int u cos(w_b t) dt`, `b = (2/kT) int u sin(w_b t) dt` (MODEL.md section 14).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct SecondDriveResponse {
+    /// `A_b = hypot(a, b)`, nm.
+    pub amplitude_nm: f64,
+    /// The phase lag `Phi_b = atan2(b, a)`, degrees (`u ~ A_b cos(w_b t - Phi_b)`).
+    pub phase_deg: f64,
 }
 
 impl OrbitObservables {
@@ -256,6 +275,10 @@ pub struct PeriodObserver {
     virial: f64,
     /// `int s dt` over the window (`s = max(d_c - d, 0)`), nm us.
     indentation: f64,
+    /// `int F_ts y_base' dt` over the window (acoustic drive, MODEL.md section 14), nN nm.
+    base_work: f64,
+    /// A bimodal drive's `w_b` (rad/us) and `[int u cos(w_b t), int u sin(w_b t)]`.
+    second_fourier: Option<(f64, [f64; 2])>,
     /// The states at the window's start and end.
     start_state: Vec<f64>,
     end_state: Vec<f64>,
@@ -349,6 +372,10 @@ impl PeriodObserver {
             contact_work: vec![0.0; model.mode_count()],
             virial: 0.0,
             indentation: 0.0,
+            base_work: 0.0,
+            second_fourier: model
+                .second_drive()
+                .map(|second| (second.angular_frequency, [0.0, 0.0])),
             start_state: x0.to_vec(),
             end_state: vec![f64::NAN; model.dim()],
             relaxing: model.contact_force().law.standard_linear_solid().copied(),
@@ -453,6 +480,17 @@ impl PeriodObserver {
         let u = model.photodiode(state);
         let force = model.tip_sample_force(t, state);
         self.impulse += weight * force;
+        self.base_work += weight * force * model.base_velocity(t);
+        // Both drives' factor `D(t)` (MODEL.md section 14; `cos(w t)` for a single drive).
+        let drive = match &mut self.second_fourier {
+            None => cos,
+            Some((second_frequency, coefficients)) => {
+                let (sin_b, cos_b) = phase::sin_cos(*second_frequency * t);
+                coefficients[0] += weight * u * cos_b;
+                coefficients[1] += weight * u * sin_b;
+                model.drive_factor(t)
+            }
+        };
         let mut deflection = 0.0;
         for (((constants, integrals), work), mode_state) in self
             .modes
@@ -463,7 +501,7 @@ impl PeriodObserver {
         {
             let (q, velocity) = (mode_state[0], mode_state[1]);
             deflection += q;
-            integrals.drive_work += weight * constants.drive_force * cos * velocity;
+            integrals.drive_work += weight * constants.drive_force * drive * velocity;
             integrals.velocity_square += weight * velocity * velocity;
             *work += weight * force * velocity;
         }
@@ -567,7 +605,13 @@ impl PeriodObserver {
             dissipated_ev: mode_energy
                 .iter()
                 .map(|mode| mode.dissipated_share_ev)
-                .sum(),
+                .sum::<f64>()
+                - per_period * self.base_work,
+            base_work_ev: per_period * self.base_work,
+            second_drive: self.second_fourier.map(|(_, [a, b])| SecondDriveResponse {
+                amplitude_nm: scale * a.hypot(b),
+                phase_deg: b.atan2(a).to_degrees(),
+            }),
             virial_ev: NN_NM_IN_EV * self.virial / (k * self.period),
             max_indentation_nm,
             mean_indentation_nm,
