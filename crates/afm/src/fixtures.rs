@@ -42,6 +42,7 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "soft"),
     embedded!("samples", "purple-membrane"),
     embedded!("samples", "purple-membrane-film"),
+    embedded!("samples", "adhesive-soft"),
 ];
 
 const CASES: &[Embedded] = &[
@@ -52,6 +53,7 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "maclever-mica-experiment"),
     embedded!("cases", "maclever-membrane-experiment"),
     embedded!("cases", "maclever-membrane-film"),
+    embedded!("cases", "biolever-adhesive"),
 ];
 
 fn names(table: &[Embedded]) -> Vec<&'static str> {
@@ -64,14 +66,14 @@ pub fn cantilever_names() -> Vec<&'static str> {
 }
 
 /// The names of the built-in samples (`mica`, `soft`, `purple-membrane`,
-/// `purple-membrane-film`).
+/// `purple-membrane-film`, `adhesive-soft`).
 pub fn sample_names() -> Vec<&'static str> {
     names(SAMPLES)
 }
 
 /// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
 /// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
-/// `maclever-membrane-film`).
+/// `maclever-membrane-film`, `biolever-adhesive`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }

@@ -19,12 +19,12 @@ use crate::model::phase;
 /// the clipped side of its release surface) is the force-free Eq. 1.
 impl ExactFlow for TappingModel {
     fn has_exact_flow(&self, mode: Mode) -> bool {
-        mode & CONTACT == FREE_FLIGHT
+        mode & CONTACT == FREE_FLIGHT && !Self::is_attached(mode)
     }
 
     /// A quarter of the shortest of the drive period and the modal periods `2 pi / w_i`, us.
     fn exact_step_limit(&self, mode: Mode) -> f64 {
-        if mode & CONTACT == FREE_FLIGHT {
+        if self.has_exact_flow(mode) {
             self.exact_step_limit
         } else {
             f64::INFINITY
@@ -225,7 +225,7 @@ impl SwitchingStructure for TappingModel {
     /// of the cone's or punch's integer powers), and the solver integrates next to contact
     /// onset and release in the square root of the time from them.
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
-        (Self::in_contact(mode) && !Self::is_clipped(mode) && self.force.law.half_power_inside())
+        (Self::in_contact(mode) && !self.is_clipped(mode) && self.force.law.half_power_inside())
             .then_some(GAP_SURFACE)
     }
 
@@ -248,7 +248,7 @@ impl SwitchingStructure for TappingModel {
         let ContactLaw::KelvinVoigt(kv) = self.force.law else {
             return false;
         };
-        if !Self::in_contact(mode) || Self::is_clipped(mode) {
+        if !Self::in_contact(mode) || self.is_clipped(mode) {
             return false;
         }
         let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
@@ -286,8 +286,9 @@ impl SwitchingStructure for TappingModel {
     /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` with
     /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
     /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
-    /// (extrema inside the sample, the gap's minima, are always wanted), and `None` for the
-    /// release surface and wherever a force acts outside contact (the bound assumes
+    /// (extrema inside the sample, the gap's minima, are always wanted) or attached, and `None`
+    /// for Kelvin-Voigt's release surface (a hysteretic law's pull-off surface `d - d_r` has the
+    /// gap's curvature) and wherever a force acts outside contact (the bound assumes
     /// `F_ts = 0`).
     fn switching_curvature_bound(
         &self,
@@ -297,7 +298,11 @@ impl SwitchingStructure for TappingModel {
         x0: &[f64],
         _dt: f64,
     ) -> Option<f64> {
-        if Self::in_contact(mode) || k != GAP_SURFACE || self.force.acts_outside_contact() {
+        if Self::in_contact(mode)
+            || Self::is_attached(mode)
+            || (k != GAP_SURFACE && self.force.release_gap_nm().is_none())
+            || self.force.acts_outside_contact()
+        {
             return None;
         }
         let w = self.drive.angular_frequency;

@@ -1,12 +1,14 @@
 //! The tapping cantilever's core as a hybrid system: its vector field, Jacobians, parameter
 //! derivative and the gap as its one switching surface (MODEL.md section 1).
 
-use hybrid::{Accelerations, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials};
+use hybrid::{
+    Accelerations, Direction, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials,
+};
 
 use crate::contact::ForceSlopes;
 use nalgebra::DMatrix;
 
-use super::{TappingModel, CLIPPED, GAP_SURFACE, RELEASE_SURFACE};
+use super::{TappingModel, ATTACHED, CLIPPED, GAP_SURFACE, PULL_OFF_SURFACE, RELEASE_SURFACE};
 use crate::model::phase;
 
 impl HybridSystem for TappingModel {
@@ -14,9 +16,10 @@ impl HybridSystem for TappingModel {
         2 * self.modes.len()
     }
 
-    /// The contact surface, and a clipped Kelvin-Voigt law's release surface.
+    /// The contact surface, and a clipped Kelvin-Voigt law's release surface or a hysteretic
+    /// law's pull-off surface.
     fn surface_count(&self) -> usize {
-        if self.force.law.release_time_us().is_some() {
+        if self.force.law.release_time_us().is_some() || self.force.release_gap_nm().is_some() {
             2
         } else {
             1
@@ -104,9 +107,12 @@ impl HybridSystem for TappingModel {
 
     /// `h_0 = d - d_c = Z(t) + sum_i q_i - d_c`, nm; a clipped Kelvin-Voigt law's
     /// `h_1 = -d - tau d'`, nm (MODEL.md section 9).
+    /// A hysteretic law's `h_1 = d - d_r`, nm.
     fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
             self.gap(t, x) - self.contact_gap_nm()
+        } else if let Some(release) = self.force.release_gap_nm() {
+            self.gap(t, x) - release
         } else {
             -self.gap(t, x) - self.release_time() * self.gap_rate(x)
         }
@@ -114,8 +120,9 @@ impl HybridSystem for TappingModel {
 
     /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in every mode), nm/us;
     /// `dh_1/dt = -d' - tau d''` with `d'' = sum_i q_i''` of mode `mode` (`Z'' = 0`).
+    /// A hysteretic law's `dh_1/dt = d'`.
     fn switching_rate(&self, k: usize, mode: Mode, t: f64, x: &[f64]) -> f64 {
-        if k == GAP_SURFACE {
+        if k == GAP_SURFACE || self.force.release_gap_nm().is_some() {
             self.gap_rate(x)
         } else {
             -self.gap_rate(x) - self.release_time() * self.gap_acceleration(mode, t, x)
@@ -132,7 +139,8 @@ impl HybridSystem for TappingModel {
         _x: &[f64],
         gradient: &mut [f64],
     ) -> SwitchingPartials {
-        let (on_gap, on_rate, sign) = if k == RELEASE_SURFACE {
+        let hysteretic = self.force.release_gap_nm().is_some();
+        let (on_gap, on_rate, sign) = if k == RELEASE_SURFACE && !hysteretic {
             (-1.0, -self.release_time(), -1.0)
         } else {
             (1.0, 0.0, 1.0)
@@ -144,6 +152,41 @@ impl HybridSystem for TappingModel {
             t: sign * self.separation.rate(),
             p: sign,
         }
+    }
+
+    /// A hysteretic law attaches at the `Down` crossing of the contact surface and detaches at
+    /// the `Up` crossing of its pull-off surface (bit [`ATTACHED`]); every other crossing
+    /// keeps the attachment.
+    fn mode_after_crossing(&self, k: usize, direction: Direction, _mode: Mode, crossed: Mode) -> Mode {
+        if self.force.release_gap_nm().is_none() {
+            return crossed;
+        }
+        match (k, direction) {
+            (GAP_SURFACE, Direction::Down) => crossed | ATTACHED,
+            (PULL_OFF_SURFACE, Direction::Up) => crossed & !ATTACHED,
+            _ => crossed,
+        }
+    }
+
+    /// The signs of the surfaces; for a hysteretic law also [`ATTACHED`] inside contact and,
+    /// in the band `d_c <= d < d_r` where the state alone does not say, when the gap opens
+    /// (`d' > 0`: a tip rising from contact is taken as still attached, a descending one as
+    /// not yet; MODEL.md section 9).
+    fn mode_of(&self, t: f64, x: &[f64]) -> Mode {
+        let mut mode = (0..self.surface_count()).fold(0, |mode, k| {
+            if self.switching(k, t, x) < 0.0 {
+                mode | (1 << k)
+            } else {
+                mode
+            }
+        });
+        if let Some(release) = self.force.release_gap_nm() {
+            let gap = self.gap(t, x);
+            if gap < self.contact_gap_nm() || (gap < release && self.gap_rate(x) > 0.0) {
+                mode |= ATTACHED;
+            }
+        }
+        mode
     }
 
     /// The free flight's closed-form flow (where no force acts outside contact), the Taylor
@@ -164,9 +207,14 @@ impl TappingModel {
         self.force.law.release_time_us().unwrap_or(0.0)
     }
 
-    /// Whether mode `mode` is on the clipped side of the release surface.
-    pub(crate) fn is_clipped(mode: Mode) -> bool {
-        mode & CLIPPED != 0
+    /// Whether mode `mode` is on the clipped side of a Kelvin-Voigt law's release surface.
+    pub(crate) fn is_clipped(&self, mode: Mode) -> bool {
+        mode & CLIPPED != 0 && self.force.law.release_time_us().is_some()
+    }
+
+    /// Whether mode `mode` has a hysteretic law attached (bit [`ATTACHED`]).
+    pub(crate) fn is_attached(mode: Mode) -> bool {
+        mode & ATTACHED != 0
     }
 
     /// [`Self::modal_tangent_rates`] for a force with a slope in the gap rate: per column `v`

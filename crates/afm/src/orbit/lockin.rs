@@ -205,7 +205,7 @@ impl CycleLockIn {
             }
             let deflection_rate: f64 = state.chunks_exact(2).map(|mode| mode[1]).sum();
             self.contact_work +=
-                node.weight * model.tip_sample_force(node.t, state) * deflection_rate;
+                node.weight * model.tip_sample_force_in_mode(self.mode, node.t, state) * deflection_rate;
         }
     }
 

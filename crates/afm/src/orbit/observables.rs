@@ -424,7 +424,7 @@ impl PeriodObserver {
             ..
         } = *node;
         let u = model.photodiode(state);
-        let force = model.tip_sample_force(t, state);
+        let force = model.tip_sample_force_in_mode(self.mode, t, state);
         self.impulse += weight * force;
         let mut deflection = 0.0;
         for (((constants, integrals), work), mode_state) in self
