@@ -18,9 +18,8 @@ const W_MJ: f64 = 0.2;
 
 fn model_with(contact: Option<&str>, z: f64) -> TappingModel {
     let contact = contact.map_or(String::new(), |c| format!(r#", "contact": {c}"#));
-    let text = format!(
-        r#"{{"name": "test", "youngs_modulus_gpa": 1.0, "poisson_ratio": 0.3{contact}}}"#
-    );
+    let text =
+        format!(r#"{{"name": "test", "youngs_modulus_gpa": 1.0, "poisson_ratio": 0.3{contact}}}"#);
     let sample: Sample = afm::fixtures::parse_sample("test.json", &text).unwrap();
     let cantilever = builtin_cantilever("biolever").unwrap();
     TappingModel::new(cantilever, sample, 10.0, None, Separation::Constant(z)).unwrap()
@@ -183,7 +182,10 @@ fn jkr_flow_matches_the_brute_force() {
     let orbit = steady_orbit(&model, z, OrbitStart::Transient, &settings).unwrap();
     assert!(orbit.converged && orbit.multiplicity == 1);
     let jkr = Jkr::of(&model);
-    assert!(model.gap(0.0, &orbit.state) > jkr.pull_off_gap(), "t = 0 is in free flight");
+    assert!(
+        model.gap(0.0, &orbit.state) > jkr.pull_off_gap(),
+        "t = 0 is in free flight"
+    );
     let duration = 2.0 * model.period_us();
     let flow = hybrid::flow_map(
         &model,
@@ -225,8 +227,13 @@ fn jkr_dissipates_the_hysteresis_loop() {
     let probe = jkr_model(0.0);
     let z = probe.grazing_separation_nm() - 0.5;
     let model = jkr_model(z);
-    let orbit = steady_orbit(&model, z, OrbitStart::Transient, &SteadyOrbitSettings::default())
-        .unwrap();
+    let orbit = steady_orbit(
+        &model,
+        z,
+        OrbitStart::Transient,
+        &SteadyOrbitSettings::default(),
+    )
+    .unwrap();
     let observables = orbit.observables();
     let jkr = Jkr::of(&model);
     let d_po = jkr.pull_off_gap();

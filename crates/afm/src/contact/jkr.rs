@@ -98,6 +98,19 @@ impl JkrContact {
         b * b
     }
 
+    /// The coefficient `K` (nN/nm^{1/2}) of the force's square-root singularity at pull-off,
+    /// `F = F_po + K sqrt(d_po - d) + O(d_po - d)`: with `delta - delta_c = (1/2) delta''(a_c)
+    /// (a - a_c)^2`, `K = F'(a_c) sqrt(2 / delta''(a_c))`, `F'(a_c) = -2 sqrt(2 pi W E* a_c)`,
+    /// `delta''(a) = 2/R + (1/4) k a^{-3/2}`. Negative: the force falls below `F_po` inside.
+    pub fn pull_off_root_coefficient(&self) -> f64 {
+        let b = self.critical_root();
+        let a = b * b;
+        let e = self.effective_modulus_gpa;
+        let force_rate = -2.0 * (2.0 * PI * self.work_of_adhesion_nn_per_nm * e * a).sqrt();
+        let curvature = 2.0 / self.tip_radius_nm + 0.25 * self.adhesion_root() / (a * b);
+        force_rate * (2.0 / curvature).sqrt()
+    }
+
     /// The force (nN) and `dF/dd` (nN/nm) at gap `d` (nm) while in contact (`d <= d_po`):
     /// `F(a(-d))` and `dF/dd = -(dF/da) / (d delta/da)` with `dF/da = 4 E* a^2/R - (3/2)
     /// sqrt(8 pi W E* a)` and `d delta/da = 2 a/R - sqrt(pi W / (2 E* a))`. The slope is
@@ -144,7 +157,10 @@ mod tests {
         assert!((jkr.pull_off_force_nn() - pull_off).abs() < 1e-12 * pull_off.abs());
         let at_zero = -4.0 / 3.0 * PI * w * r;
         let f = jkr.force_slopes(0.0).force;
-        assert!((f - at_zero).abs() < 1e-12 * at_zero.abs(), "{f} vs {at_zero}");
+        assert!(
+            (f - at_zero).abs() < 1e-12 * at_zero.abs(),
+            "{f} vs {at_zero}"
+        );
     }
 
     /// The contact radius inverts `delta(a)` (to 1e-12 nm) from pull-off to deep indentation,

@@ -6,8 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use super::jkr::MJ_PER_M2_IN_NN_PER_NM;
 use super::{
-    CapillaryContact, ContactLaw, DmtContact, JkrContact, DoubleLayer, FilmContact, FilmCorrection, HertzShape, HertzTip,
-    KelvinVoigtContact, TipSampleForce,
+    CapillaryContact, ContactLaw, DmtContact, DoubleLayer, FilmContact, FilmCorrection, HertzShape,
+    HertzTip, JkrContact, KelvinVoigtContact, TipSampleForce,
 };
 use crate::error::AfmError;
 use crate::validation::{check, invalid, Interval};
@@ -294,8 +294,8 @@ impl ContactSpec {
             }),
             // W = 0: JKR's relations are Hertz's, and the law is Hertz's (its fast paths).
             Self::Jkr {
-                work_of_adhesion_mj_per_m2,
-            } if work_of_adhesion_mj_per_m2 == 0.0 => ContactLaw::Hertz(sphere(e, tip_radius_nm)),
+                work_of_adhesion_mj_per_m2: 0.0,
+            } => ContactLaw::Hertz(sphere(e, tip_radius_nm)),
             Self::Jkr {
                 work_of_adhesion_mj_per_m2,
             } => ContactLaw::Jkr(JkrContact {

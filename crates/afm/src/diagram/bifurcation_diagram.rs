@@ -299,7 +299,7 @@ pub fn diagram_until(
     settings: &DiagramSettings,
     interrupted: &mut dyn FnMut() -> bool,
 ) -> Result<BifurcationDiagram, AfmError> {
-    let mut diagram = branch_until(model, x0, z_start, settings, interrupted)?;
+    let (mut diagram, mut broke) = branch_until(model, x0, z_start, settings, interrupted)?;
     if model.release_gap_nm().is_none() {
         return Ok(diagram);
     }
@@ -309,7 +309,7 @@ pub fn diagram_until(
     };
     let mut system = model.clone();
     for _ in 0..MAX_JUMPS {
-        if diagram.completed || diagram.stop != stop_words(StopReason::StepTooSmall) {
+        if !broke && (diagram.completed || diagram.stop != stop_words(StopReason::StepTooSmall)) {
             break;
         }
         let Some(last) = diagram.points.last().cloned() else {
@@ -349,13 +349,28 @@ pub fn diagram_until(
         if !orbit.converged || orbit.multiplicity != 1 {
             break;
         }
-        let next = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
+        let next;
+        (next, broke) = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
         diagram.points.extend(next.points);
         diagram.special_points.extend(next.special_points);
         diagram.stop = next.stop;
         diagram.completed = next.completed;
         diagram.error = next.error;
     }
+    // The jump of the period map at a grazing of the contact surface reads, to the branch's
+    // test functions, as a fold or period doubling that cannot be located (its bracket is the
+    // jump): not a bifurcation of smooth orbits, so not reported.
+    let grazings: Vec<f64> = diagram
+        .special_points
+        .iter()
+        .filter(|p| p.label.starts_with('G'))
+        .map(|p| p.z_nm)
+        .collect();
+    diagram.special_points.retain(|p| {
+        p.converged
+            || p.label.starts_with('G')
+            || !grazings.iter().any(|z| (z - p.z_nm).abs() < 1e-6)
+    });
     Ok(diagram)
 }
 
@@ -386,14 +401,23 @@ fn branch_end_point(
     }
 }
 
-/// One branch of [`diagram_until`]: the continuation from `(x0, z_start)` until it stops.
+/// One branch of [`diagram_until`]: the continuation from `(x0, z_start)` until it stops, and
+/// whether it was stopped where `Z` turned back, at a hysteretic law's break of the branch
+/// (the point past the break and the special points not located there are dropped).
 fn branch_until(
     model: &TappingModel,
     x0: &[f64],
     z_start: f64,
     settings: &DiagramSettings,
     interrupted: &mut dyn FnMut() -> bool,
-) -> Result<BifurcationDiagram, AfmError> {
+) -> Result<(BifurcationDiagram, bool), AfmError> {
+    let hysteretic = model.release_gap_nm().is_some();
+    let sign = match settings.direction {
+        ParameterDirection::Decreasing => -1.0,
+        ParameterDirection::Increasing => 1.0,
+    };
+    let mut previous_z = z_start;
+    let mut turned = false;
     settings.validate()?;
     let mut system = model.clone();
     system.set_separation(Separation::Constant(z_start))?;
@@ -423,6 +447,7 @@ fn branch_until(
     let branch = {
         let observed = &mut observed;
         let was_interrupted = &mut was_interrupted;
+        let turned = &mut turned;
         let mut at_point = system.clone();
         Continuation::new(&problem, x0, z_start, continuation_settings)?
             .stop_when(move |point: &BranchPoint| {
@@ -430,6 +455,13 @@ fn branch_until(
                     *was_interrupted = true;
                     return true;
                 }
+                // A hysteretic law's branch breaks where the period map jumps; the
+                // corrector may converge across it onto the branch turning back.
+                if hysteretic && sign * (point.parameter - previous_z) < 0.0 {
+                    *turned = true;
+                    return true;
+                }
+                previous_z = point.parameter;
                 at_point.set_parameter(point.parameter);
                 let observables =
                     orbit_observables(&at_point, point.state.as_slice(), &integration, harmonics);
@@ -458,16 +490,33 @@ fn branch_until(
             settings.orbit.harmonics,
         )?);
     }
-    Ok(BifurcationDiagram {
-        points,
-        special_points,
-        stop: stop_words(branch.stop),
-        completed: matches!(
-            branch.stop,
-            StopReason::ParameterBound | StopReason::UserStop
-        ),
-        error: branch.error.map(|e| e.to_string()),
-    })
+    if turned {
+        let last_z = points.last().map_or(z_start, |p: &DiagramPoint| p.z_nm);
+        special_points.retain(|p| sign * (p.z_nm - last_z) <= 1e-9);
+        return Ok((
+            BifurcationDiagram {
+                points,
+                special_points,
+                stop: "the branch broke at a jump of the hysteretic contact".to_string(),
+                completed: false,
+                error: None,
+            },
+            true,
+        ));
+    }
+    Ok((
+        BifurcationDiagram {
+            points,
+            special_points,
+            stop: stop_words(branch.stop),
+            completed: matches!(
+                branch.stop,
+                StopReason::ParameterBound | StopReason::UserStop
+            ),
+            error: branch.error.map(|e| e.to_string()),
+        },
+        false,
+    ))
 }
 
 fn stop_words(stop: StopReason) -> String {

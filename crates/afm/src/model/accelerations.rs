@@ -8,7 +8,7 @@ use hybrid::{
 };
 use nalgebra::DMatrix;
 
-use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
+use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE, PULL_OFF_SURFACE};
 use crate::contact::ContactLaw;
 use crate::model::contact_series::{self, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
@@ -224,7 +224,12 @@ impl SwitchingStructure for TappingModel {
     /// half-power surface of the contact mode (not of a clipped mode, whose force is zero, nor
     /// of the cone's or punch's integer powers), and the solver integrates next to contact
     /// onset and release in the square root of the time from them.
+    /// JKR while attached: its force is `F_po + K sqrt(d_po - d) + ...` next to pull-off, so
+    /// the pull-off surface is the attached mode's half-power surface.
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
+        if let ContactLaw::Jkr(_) = self.force.law {
+            return Self::is_attached(mode).then_some(PULL_OFF_SURFACE);
+        }
         (Self::in_contact(mode) && !self.is_clipped(mode) && self.force.law.half_power_inside())
             .then_some(GAP_SURFACE)
     }
@@ -235,6 +240,9 @@ impl SwitchingStructure for TappingModel {
     /// `(dt/dsigma) dF/dd -> K = -c tau sign(s') |s'|^{1/2}` (`s' = -d'`, nm/us), and the
     /// limit of `(dt/dsigma) J v` is `(w_i^2/k_i) K sum_j v_{q_j}` on each `v_i` row (`+ K`
     /// times `(w_i^2/k_i)` on the parameter column, `dd/dZ = 1`), zero on the `q_i` rows.
+    /// JKR attached, at pull-off: `dF/dd = -K / (2 sqrt(s))`, `s = d_po - d = |d'| sigma^2`,
+    /// so `(dt/dsigma) dF/dd -> -K / |d'|^{1/2}` (`K` of
+    /// [`crate::contact::JkrContact::pull_off_root_coefficient`]), on the same rows.
     /// Every other law's Jacobian is bounded next to its surface: `false`.
     fn crossing_tangent_limit(
         &self,
@@ -245,16 +253,19 @@ impl SwitchingStructure for TappingModel {
         tangent_rates: &mut [f64],
         parameter_column: bool,
     ) -> bool {
-        let ContactLaw::KelvinVoigt(kv) = self.force.law else {
-            return false;
+        let limit = match self.force.law {
+            ContactLaw::KelvinVoigt(kv) if Self::in_contact(mode) && !self.is_clipped(mode) => {
+                let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
+                let indentation_rate = -self.gap_rate(x);
+                -c * kv.release_time_us()
+                    * indentation_rate.signum()
+                    * indentation_rate.abs().sqrt()
+            }
+            ContactLaw::Jkr(jkr) if Self::is_attached(mode) => {
+                -jkr.pull_off_root_coefficient() / self.gap_rate(x).abs().sqrt()
+            }
+            _ => return false,
         };
-        if !Self::in_contact(mode) || self.is_clipped(mode) {
-            return false;
-        }
-        let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
-        let indentation_rate = -self.gap_rate(x);
-        let limit =
-            -c * kv.release_time_us() * indentation_rate.signum() * indentation_rate.abs().sqrt();
         let n = self.dim();
         let columns = tangents.len() / n;
         for (column, (v, rate)) in tangents

@@ -157,7 +157,13 @@ impl HybridSystem for TappingModel {
     /// A hysteretic law attaches at the `Down` crossing of the contact surface and detaches at
     /// the `Up` crossing of its pull-off surface (bit [`ATTACHED`]); every other crossing
     /// keeps the attachment.
-    fn mode_after_crossing(&self, k: usize, direction: Direction, _mode: Mode, crossed: Mode) -> Mode {
+    fn mode_after_crossing(
+        &self,
+        k: usize,
+        direction: Direction,
+        _mode: Mode,
+        crossed: Mode,
+    ) -> Mode {
         if self.force.release_gap_nm().is_none() {
             return crossed;
         }
