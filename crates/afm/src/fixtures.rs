@@ -44,6 +44,7 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "purple-membrane-film"),
     embedded!("samples", "soft-viscoelastic"),
     embedded!("samples", "mica-hydration"),
+    embedded!("samples", "adhesive-soft"),
 ];
 
 const CASES: &[Embedded] = &[
@@ -58,6 +59,7 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "biolever-mica-hydration"),
     embedded!("cases", "biolever-mica-acoustic"),
     embedded!("cases", "biolever-mica-bimodal"),
+    embedded!("cases", "biolever-adhesive"),
 ];
 
 const LINES: &[Embedded] = &[embedded!("lines", "membrane-patch")];
@@ -72,15 +74,15 @@ pub fn cantilever_names() -> Vec<&'static str> {
 }
 
 /// The names of the built-in samples (`mica`, `soft`, `purple-membrane`,
-/// `purple-membrane-film`, `soft-viscoelastic`, `mica-hydration`).
+/// `purple-membrane-film`, `soft-viscoelastic`, `mica-hydration`, `adhesive-soft`).
 pub fn sample_names() -> Vec<&'static str> {
     names(SAMPLES)
 }
 
 /// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
 /// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
-/// `maclever-membrane-film`, `biolever-soft-viscoelastic`, `biolever-mica-hydration`).
-/// `maclever-membrane-film`, `biolever-mica-acoustic`, `biolever-mica-bimodal`).
+/// `maclever-membrane-film`, `biolever-soft-viscoelastic`, `biolever-mica-hydration`,
+/// `biolever-mica-acoustic`, `biolever-mica-bimodal`, `biolever-adhesive`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }

@@ -206,6 +206,8 @@ fn every_command_prints_exactly_the_documented_keys_and_types() {
         r#""contact": {"law": "hertz", "tip_shape": "cone", "cone_half_angle_deg": 20}, "electrostatic": {"debye_length_nm": 1, "tip_charge_c_per_m2": 0.02, "sample_charge_c_per_m2": 0.02, "relative_permittivity": 80}"#,
         r#""contact": {"law": "hertz", "tip_shape": "flat-punch", "punch_radius_nm": 2}"#,
         r#""contact": {"law": "standard-linear-solid", "instant_modulus_gpa": 1, "relaxed_modulus_gpa": 0.4, "relaxation_time_us": 5}, "hydration": {"pressure_mpa": 10, "layer_spacing_nm": 0.25, "decay_length_nm": 0.3}"#,
+        r#""contact": {"law": "jkr", "work_of_adhesion_mj_per_m2": 20}"#,
+        r#""contact": {"law": "capillary", "relative_humidity": 0.4, "surface_tension_mn_per_m": 72.8, "contact_angle_deg": 10, "temperature_k": 293.15, "molar_volume_m3_per_mol": 18e-6}"#,
     ];
     let mut with_laws = Vec::new();
     for (i, law) in laws.iter().enumerate() {

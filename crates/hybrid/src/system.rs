@@ -185,6 +185,23 @@ pub trait HybridSystem {
         dxdp.fill(0.0);
     }
 
+    /// The mode entered when an event on surface `k` in `direction` takes the system out of
+    /// `mode`; `crossed` is `mode` with bit `k` set to the new side of the surface, and the
+    /// default returns it. A system with a discrete state that the signs of its switching
+    /// functions do not determine (a hysteresis: a contact formed at one surface and broken at
+    /// another) keeps it in bits at or above [`HybridSystem::surface_count`], which the solver
+    /// never reads, sets or clears them here, and overrides [`HybridSystem::mode_of`] to start
+    /// an integration in the right one. Bit `k` of the result must be that of `crossed`.
+    fn mode_after_crossing(
+        &self,
+        _k: usize,
+        _direction: Direction,
+        _mode: Mode,
+        crossed: Mode,
+    ) -> Mode {
+        crossed
+    }
+
     /// The optional accelerations this system offers ([`crate::accelerations`]): closed-form
     /// flows, Taylor series, the shape of its switching functions. The default is
     /// [`Accelerations::NONE`]: the solver integrates every mode with DOP853 and samples every

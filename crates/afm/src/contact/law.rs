@@ -5,8 +5,8 @@
 use std::ops::AddAssign;
 
 use super::{
-    DmtContact, DoubleLayer, FilmContact, HertzShape, HydrationForce, KelvinVoigtContact,
-    StandardLinearSolid,
+    CapillaryContact, DmtContact, DoubleLayer, FilmContact, HertzShape, HydrationForce, JkrContact,
+    KelvinVoigtContact, StandardLinearSolid,
 };
 
 /// A force `F` (nN, repulsive positive) with its slopes `dF/dd` (nN/nm) and `dF/dd'`
@@ -52,6 +52,12 @@ pub enum ContactLaw {
     Film(FilmContact),
     /// A standard linear solid: Hertz on a relaxing sample with an internal state.
     StandardLinearSolid(StandardLinearSolid),
+    /// JKR adhesion of a sphere: formed at `d = 0` on approach, broken at the pull-off gap
+    /// `d_po > 0` on retract (a hysteresis; [`ContactLaw::release_gap_nm`]).
+    Jkr(JkrContact),
+    /// Hertz sphere plus a capillary meniscus: formed at `d = 0` on approach, ruptured at
+    /// `d_r > 0` on retract (a hysteresis; [`ContactLaw::release_gap_nm`]).
+    Capillary(CapillaryContact),
 }
 
 impl ContactLaw {
@@ -78,6 +84,32 @@ impl ContactLaw {
             Self::Dmt(dmt) => dmt.inside(gap_nm),
             Self::KelvinVoigt(kv) => kv.force_slopes(gap_nm, gap_rate),
             Self::Film(film) => film.force_slopes(gap_nm),
+            Self::Jkr(jkr) => jkr.force_slopes(gap_nm),
+            Self::Capillary(capillary) => capillary.hertz.force_slopes(gap_nm),
+        }
+    }
+
+    /// The gap `d_r > d_c` (nm) at which a hysteretic law's contact breaks on retract (JKR's
+    /// pull-off gap, the meniscus's rupture gap): the law is then attached from the `Down`
+    /// crossing of `d = d_c` to the `Up` crossing of `d = d_r`, and exerts no force otherwise
+    /// (MODEL.md section 9). `None` for every law without hysteresis.
+    pub fn release_gap_nm(&self) -> Option<f64> {
+        match self {
+            Self::Jkr(jkr) => Some(jkr.pull_off_gap_nm()),
+            Self::Capillary(capillary) => Some(capillary.rupture_gap_nm),
+            _ => None,
+        }
+    }
+
+    /// A hysteretic law's force and slopes while attached, inside contact (`inside`, `d < d_c`)
+    /// or in the band `d_c <= d < d_r`: JKR's `F(a(-d))` on both sides, Hertz minus the
+    /// meniscus force for the capillary law; [`ContactLaw::inside`] or zero for the others.
+    pub fn attached(&self, inside: bool, gap_nm: f64, gap_rate: f64) -> ForceSlopes {
+        match self {
+            Self::Jkr(jkr) => jkr.force_slopes(gap_nm),
+            Self::Capillary(capillary) => capillary.attached(inside, gap_nm),
+            _ if inside => self.inside(gap_nm, gap_rate),
+            _ => ForceSlopes::ZERO,
         }
     }
 
@@ -132,9 +164,13 @@ impl ContactLaw {
     pub fn half_power_inside(&self) -> bool {
         match self {
             Self::Hertz(shape) => shape.has_half_powers(),
-            Self::Dmt(_) | Self::KelvinVoigt(_) | Self::Film(_) | Self::StandardLinearSolid(_) => {
-                true
-            }
+            Self::Dmt(_)
+            | Self::KelvinVoigt(_)
+            | Self::Film(_)
+            | Self::StandardLinearSolid(_)
+            | Self::Capillary(_) => true,
+            // JKR's force is analytic in `d` through `d = 0`.
+            Self::Jkr(_) => false,
         }
     }
 }
@@ -156,6 +192,36 @@ impl TipSampleForce {
     /// The contact surface's gap `d_c`, nm ([`ContactLaw::contact_gap_nm`]).
     pub fn contact_gap_nm(&self) -> f64 {
         self.law.contact_gap_nm()
+    }
+
+    /// The release gap of a hysteretic law ([`ContactLaw::release_gap_nm`]).
+    pub fn release_gap_nm(&self) -> Option<f64> {
+        self.law.release_gap_nm()
+    }
+
+    /// The force and slopes of mode `(inside, clipped, attached)` with the sample's internal
+    /// state `rho` (nm^{3/2}): for a hysteretic law [`ContactLaw::attached`] while `attached`,
+    /// zero otherwise, plus the double layer and hydration force as in
+    /// [`TipSampleForce::in_region`]; for every other law [`TipSampleForce::in_region_at`].
+    pub fn in_mode(
+        &self,
+        inside: bool,
+        clipped: bool,
+        attached: bool,
+        gap_nm: f64,
+        gap_rate: f64,
+        sample_state: f64,
+    ) -> ForceSlopes {
+        if self.law.release_gap_nm().is_none() {
+            return self.in_region_at(inside, clipped, gap_nm, gap_rate, sample_state);
+        }
+        let mut total = if attached {
+            self.law.attached(inside, gap_nm, gap_rate)
+        } else {
+            ForceSlopes::ZERO
+        };
+        total += self.in_region(inside, true, gap_nm, gap_rate);
+        total
     }
 
     /// Whether any force acts outside contact (DMT's van der Waals, a double layer, a
@@ -218,6 +284,8 @@ impl TipSampleForce {
 
     /// The force (nN) at gap `d` and rate `d'` with the region taken from the gap itself
     /// (inside when `d < d_c`) and a clipped law clipped at zero: what a sampled state feels.
+    /// A hysteretic law counts as attached inside contact and detached outside (its state in
+    /// the band `d_c <= d < d_r` depends on the history: [`TipSampleForce::in_mode`]).
     pub fn force(&self, gap_nm: f64, gap_rate: f64) -> f64 {
         self.force_at(gap_nm, gap_rate, 0.0)
     }
@@ -226,6 +294,11 @@ impl TipSampleForce {
     /// when `d + sigma < d_c` (`sigma` the standard linear solid's unrecovered depth).
     pub fn force_at(&self, gap_nm: f64, gap_rate: f64, sample_state: f64) -> f64 {
         let inside = gap_nm + self.law.surface_depth_nm(sample_state) < self.contact_gap_nm();
+        if self.law.release_gap_nm().is_some() {
+            return self
+                .in_mode(inside, false, inside, gap_nm, gap_rate, sample_state)
+                .force;
+        }
         let clipped = inside
             && self
                 .law

@@ -4,15 +4,31 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::jkr::MJ_PER_M2_IN_NN_PER_NM;
 use super::{
-    ContactLaw, DmtContact, DoubleLayer, FilmContact, FilmCorrection, HertzShape, HertzTip,
-    HydrationForce, KelvinVoigtContact, StandardLinearSolid, TipSampleForce,
+    CapillaryContact, ContactLaw, DmtContact, DoubleLayer, FilmContact, FilmCorrection, HertzShape,
+    HertzTip, HydrationForce, JkrContact, KelvinVoigtContact, StandardLinearSolid, TipSampleForce,
 };
 use crate::error::AfmError;
 use crate::validation::{check, invalid, Interval};
 
 fn clip_by_default() -> bool {
     true
+}
+
+/// Water's surface tension at 20 C, mN/m (Israelachvili 2011, table 17.1).
+fn water_surface_tension() -> f64 {
+    72.8
+}
+
+/// Room temperature, K.
+fn room_temperature() -> f64 {
+    293.15
+}
+
+/// Water's molar volume, m^3/mol.
+fn water_molar_volume() -> f64 {
+    18.0e-6
 }
 
 /// The tip's shape for the Hertz law.
@@ -96,6 +112,32 @@ pub enum ContactSpec {
         relaxed_modulus_gpa: f64,
         /// `tau`, us.
         relaxation_time_us: f64,
+    },
+    /// JKR adhesion of the cantilever's spherical tip: work of adhesion `W` in mJ/m^2, range
+    /// [0, 1000]; `W = 0` is the Hertz sphere exactly (the law built is Hertz's).
+    Jkr {
+        /// `W`, mJ/m^2.
+        work_of_adhesion_mj_per_m2: f64,
+    },
+    /// Hertz sphere plus a capillary meniscus in air: relative humidity `RH` in [0.01, 0.99];
+    /// surface tension in mN/m, range (0, 500] (default water's 72.8); contact angle in deg,
+    /// range [0, 89] (default 0); temperature in K, range [250, 400] (default 293.15); the
+    /// liquid's molar volume in m^3/mol, range (0, 1e-3] (default water's 18.0e-6).
+    Capillary {
+        /// `RH`, 0 to 1.
+        relative_humidity: f64,
+        /// `gamma`, mN/m.
+        #[serde(default = "water_surface_tension")]
+        surface_tension_mn_per_m: f64,
+        /// `theta`, deg.
+        #[serde(default)]
+        contact_angle_deg: f64,
+        /// `T`, K.
+        #[serde(default = "room_temperature")]
+        temperature_k: f64,
+        /// `V_m`, m^3/mol.
+        #[serde(default = "water_molar_volume")]
+        molar_volume_m3_per_mol: f64,
     },
 }
 
@@ -224,6 +266,52 @@ impl ContactSpec {
                     Interval::closed(1e-3, 1e6, "us"),
                 )
             }
+            Self::Jkr {
+                work_of_adhesion_mj_per_m2,
+            } => check(
+                file,
+                "contact.work_of_adhesion_mj_per_m2",
+                *work_of_adhesion_mj_per_m2,
+                Interval::closed(0.0, 1000.0, "mJ/m^2"),
+            ),
+            Self::Capillary {
+                relative_humidity,
+                surface_tension_mn_per_m,
+                contact_angle_deg,
+                temperature_k,
+                molar_volume_m3_per_mol,
+            } => {
+                check(
+                    file,
+                    "contact.relative_humidity",
+                    *relative_humidity,
+                    Interval::closed(0.01, 0.99, ""),
+                )?;
+                check(
+                    file,
+                    "contact.surface_tension_mn_per_m",
+                    *surface_tension_mn_per_m,
+                    Interval::positive(500.0, "mN/m"),
+                )?;
+                check(
+                    file,
+                    "contact.contact_angle_deg",
+                    *contact_angle_deg,
+                    Interval::closed(0.0, 89.0, "deg"),
+                )?;
+                check(
+                    file,
+                    "contact.temperature_k",
+                    *temperature_k,
+                    Interval::closed(250.0, 400.0, "K"),
+                )?;
+                check(
+                    file,
+                    "contact.molar_volume_m3_per_mol",
+                    *molar_volume_m3_per_mol,
+                    Interval::positive(1e-3, "m^3/mol"),
+                )
+            }
         }
     }
 
@@ -314,7 +402,43 @@ impl ContactSpec {
                     }
                 },
             }),
+            // W = 0: JKR's relations are Hertz's, and the law is Hertz's (its fast paths).
+            Self::Jkr {
+                work_of_adhesion_mj_per_m2: 0.0,
+            } => ContactLaw::Hertz(sphere(e, tip_radius_nm)),
+            Self::Jkr {
+                work_of_adhesion_mj_per_m2,
+            } => ContactLaw::Jkr(JkrContact {
+                effective_modulus_gpa: e,
+                tip_radius_nm,
+                work_of_adhesion_nn_per_nm: work_of_adhesion_mj_per_m2 * MJ_PER_M2_IN_NN_PER_NM,
+            }),
+            Self::Capillary {
+                relative_humidity,
+                surface_tension_mn_per_m,
+                contact_angle_deg,
+                temperature_k,
+                molar_volume_m3_per_mol,
+            } => ContactLaw::Capillary(CapillaryContact::new(
+                sphere(e, tip_radius_nm),
+                tip_radius_nm,
+                relative_humidity,
+                surface_tension_mn_per_m,
+                contact_angle_deg,
+                temperature_k,
+                molar_volume_m3_per_mol,
+            )),
         }
+    }
+}
+
+/// The Hertz sphere of reduced modulus `E*` (GPa) and radius `R` (nm).
+fn sphere(effective_modulus_gpa: f64, tip_radius_nm: f64) -> HertzShape {
+    HertzShape {
+        effective_modulus_gpa,
+        tip: HertzTip::Sphere {
+            radius_nm: tip_radius_nm,
+        },
     }
 }
 

@@ -15,7 +15,7 @@ use crate::error::AfmError;
 use crate::model::separation::Separation;
 use crate::model::TappingModel;
 use crate::orbit::observables::{orbit_observables, GapMinimum, Harmonic, OrbitObservables};
-use crate::orbit::steady_orbit::SteadyOrbitSettings;
+use crate::orbit::steady_orbit::{steady_orbit, OrbitStart, SteadyOrbitSettings};
 
 /// How a diagram is computed. [`DiagramSettings::approach`] and [`DiagramSettings::retract`]
 /// give the defaults; every field is checked by [`DiagramSettings::validate`].
@@ -277,8 +277,21 @@ pub fn diagram(
     diagram_until(model, x0, z_start, settings, &mut || false)
 }
 
+/// The most jumps of a hysteretic law's diagram between its branches (MODEL.md section 9).
+const MAX_JUMPS: usize = 16;
+
 /// As [`diagram`], asking `interrupted` after every branch point whether to give up: when it
 /// answers `true` the computation ends with [`AfmError::Interrupted`].
+///
+/// With a hysteretic law (JKR, the capillary meniscus; MODEL.md section 9) the branch of
+/// period-1 orbits is broken where an orbit first touches the contact surface (a grazing
+/// `G_n`: the attachment's force sets in at a finite value) and where an attached orbit last
+/// reaches the release surface (`pull-off`: the force drops to zero there), so the period map
+/// jumps and the corrector fails just past the point. There the diagram does what the
+/// cantilever does: it takes the orbit that transients from the last branch point settle on,
+/// half a largest step further (`steady_orbit` with [`OrbitStart::AfterTransients`]), and
+/// continues from it; on a retract, the end of an attached branch that is not a located
+/// grazing is labelled `pull-off` (located to the continuation's smallest step, 1e-8).
 pub fn diagram_until(
     model: &TappingModel,
     x0: &[f64],
@@ -286,6 +299,125 @@ pub fn diagram_until(
     settings: &DiagramSettings,
     interrupted: &mut dyn FnMut() -> bool,
 ) -> Result<BifurcationDiagram, AfmError> {
+    let (mut diagram, mut broke) = branch_until(model, x0, z_start, settings, interrupted)?;
+    if model.release_gap_nm().is_none() {
+        return Ok(diagram);
+    }
+    let sign = match settings.direction {
+        ParameterDirection::Decreasing => -1.0,
+        ParameterDirection::Increasing => 1.0,
+    };
+    let mut system = model.clone();
+    for _ in 0..MAX_JUMPS {
+        if !broke && (diagram.completed || diagram.stop != stop_words(StopReason::StepTooSmall)) {
+            break;
+        }
+        let Some(last) = diagram.points.last().cloned() else {
+            break;
+        };
+        let z_jump = last.z_nm + sign * 0.5 * settings.max_step;
+        if sign * (z_jump - settings.z_limit_nm) >= 0.0 {
+            break;
+        }
+        let grazing_at_end = diagram
+            .special_points
+            .last()
+            .is_some_and(|p| p.label.starts_with('G') && (p.z_nm - last.z_nm).abs() < 1e-6);
+        // On a retract, an attached branch ends where the orbit can no longer stay attached.
+        if !grazing_at_end && sign > 0.0 && last.impacts_per_orbit > 0 {
+            system.set_parameter(last.z_nm);
+            let observables = orbit_observables(
+                &system,
+                &last.state,
+                &settings.orbit.integration,
+                settings.orbit.harmonics,
+            )?;
+            diagram
+                .special_points
+                .push(branch_end_point("pull-off", &last, &observables));
+        }
+        system.set_parameter(z_jump);
+        let orbit = steady_orbit(
+            &system,
+            z_jump,
+            OrbitStart::AfterTransients(&last.state),
+            &settings.orbit,
+        );
+        let Ok(orbit) = orbit else {
+            break;
+        };
+        if !orbit.converged || orbit.multiplicity != 1 {
+            break;
+        }
+        let next;
+        (next, broke) = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
+        diagram.points.extend(next.points);
+        diagram.special_points.extend(next.special_points);
+        diagram.stop = next.stop;
+        diagram.completed = next.completed;
+        diagram.error = next.error;
+    }
+    // The jump of the period map at a grazing of the contact surface reads, to the branch's
+    // test functions, as a fold or period doubling that cannot be located (its bracket is the
+    // jump): not a bifurcation of smooth orbits, so not reported.
+    let grazings: Vec<f64> = diagram
+        .special_points
+        .iter()
+        .filter(|p| p.label.starts_with('G'))
+        .map(|p| p.z_nm)
+        .collect();
+    diagram.special_points.retain(|p| {
+        p.converged
+            || p.label.starts_with('G')
+            || !grazings.iter().any(|z| (z - p.z_nm).abs() < 1e-6)
+    });
+    Ok(diagram)
+}
+
+/// The special point `label` at the last point `last` of a branch that ends there (a
+/// hysteretic law's pull-off): located to the continuation's smallest step.
+fn branch_end_point(
+    label: &str,
+    last: &DiagramPoint,
+    observables: &OrbitObservables,
+) -> DiagramSpecialPoint {
+    let precision = ContinuationSettings::default().min_step;
+    DiagramSpecialPoint {
+        label: label.to_string(),
+        z_nm: last.z_nm,
+        amplitude_ratio: last.amplitude_ratio,
+        phase_deg: last.phase_deg,
+        impacts_before: observables.impacts_per_window(),
+        impacts_after: 0,
+        bracket_nm: [last.z_nm - precision, last.z_nm + precision],
+        precision_nm: precision,
+        converged: true,
+        state: last.state.clone(),
+        harmonics: last.harmonics.clone(),
+        dissipated_ev: last.dissipated_ev,
+        virial_ev: last.virial_ev,
+        max_indentation_nm: last.max_indentation_nm,
+        mean_indentation_nm: last.mean_indentation_nm,
+    }
+}
+
+/// One branch of [`diagram_until`]: the continuation from `(x0, z_start)` until it stops, and
+/// whether it was stopped where `Z` turned back, at a hysteretic law's break of the branch
+/// (the point past the break and the special points not located there are dropped).
+fn branch_until(
+    model: &TappingModel,
+    x0: &[f64],
+    z_start: f64,
+    settings: &DiagramSettings,
+    interrupted: &mut dyn FnMut() -> bool,
+) -> Result<(BifurcationDiagram, bool), AfmError> {
+    let hysteretic = model.release_gap_nm().is_some();
+    let sign = match settings.direction {
+        ParameterDirection::Decreasing => -1.0,
+        ParameterDirection::Increasing => 1.0,
+    };
+    let mut previous_z = z_start;
+    let mut turned = false;
     settings.validate()?;
     let mut system = model.clone();
     system.set_separation(Separation::Constant(z_start))?;
@@ -315,6 +447,7 @@ pub fn diagram_until(
     let branch = {
         let observed = &mut observed;
         let was_interrupted = &mut was_interrupted;
+        let turned = &mut turned;
         let mut at_point = system.clone();
         Continuation::new(&problem, x0, z_start, continuation_settings)?
             .stop_when(move |point: &BranchPoint| {
@@ -322,6 +455,13 @@ pub fn diagram_until(
                     *was_interrupted = true;
                     return true;
                 }
+                // A hysteretic law's branch breaks where the period map jumps; the
+                // corrector may converge across it onto the branch turning back.
+                if hysteretic && sign * (point.parameter - previous_z) < 0.0 {
+                    *turned = true;
+                    return true;
+                }
+                previous_z = point.parameter;
                 at_point.set_parameter(point.parameter);
                 let observables =
                     orbit_observables(&at_point, point.state.as_slice(), &integration, harmonics);
@@ -350,16 +490,33 @@ pub fn diagram_until(
             settings.orbit.harmonics,
         )?);
     }
-    Ok(BifurcationDiagram {
-        points,
-        special_points,
-        stop: stop_words(branch.stop),
-        completed: matches!(
-            branch.stop,
-            StopReason::ParameterBound | StopReason::UserStop
-        ),
-        error: branch.error.map(|e| e.to_string()),
-    })
+    if turned {
+        let last_z = points.last().map_or(z_start, |p: &DiagramPoint| p.z_nm);
+        special_points.retain(|p| sign * (p.z_nm - last_z) <= 1e-9);
+        return Ok((
+            BifurcationDiagram {
+                points,
+                special_points,
+                stop: "the branch broke at a jump of the hysteretic contact".to_string(),
+                completed: false,
+                error: None,
+            },
+            true,
+        ));
+    }
+    Ok((
+        BifurcationDiagram {
+            points,
+            special_points,
+            stop: stop_words(branch.stop),
+            completed: matches!(
+                branch.stop,
+                StopReason::ParameterBound | StopReason::UserStop
+            ),
+            error: branch.error.map(|e| e.to_string()),
+        },
+        false,
+    ))
 }
 
 fn stop_words(stop: StopReason) -> String {

@@ -8,7 +8,7 @@ use hybrid::{
 };
 use nalgebra::DMatrix;
 
-use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE};
+use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE, PULL_OFF_SURFACE};
 use crate::contact::{ContactLaw, HertzShape, HertzTip};
 use crate::model::contact_series::{self, SeriesDrive, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
@@ -19,12 +19,12 @@ use crate::model::phase;
 /// the clipped side of its release surface) is the force-free Eq. 1.
 impl ExactFlow for TappingModel {
     fn has_exact_flow(&self, mode: Mode) -> bool {
-        mode & CONTACT == FREE_FLIGHT
+        mode & CONTACT == FREE_FLIGHT && !Self::is_attached(mode)
     }
 
     /// A quarter of the shortest of the drive period and the modal periods `2 pi / w_i`, us.
     fn exact_step_limit(&self, mode: Mode) -> f64 {
-        if mode & CONTACT == FREE_FLIGHT {
+        if self.has_exact_flow(mode) {
             self.exact_step_limit
         } else {
             f64::INFINITY
@@ -307,8 +307,13 @@ impl SwitchingStructure for TappingModel {
     /// half-power surface of the contact mode (not of a clipped mode, whose force is zero, nor
     /// of the cone's or punch's integer powers), and the solver integrates next to contact
     /// onset and release in the square root of the time from them.
+    /// JKR while attached: its force is `F_po + K sqrt(d_po - d) + ...` next to pull-off, so
+    /// the pull-off surface is the attached mode's half-power surface.
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
-        (Self::in_contact(mode) && !Self::is_clipped(mode) && self.force.law.half_power_inside())
+        if let ContactLaw::Jkr(_) = self.force.law {
+            return Self::is_attached(mode).then_some(PULL_OFF_SURFACE);
+        }
+        (Self::in_contact(mode) && !self.is_clipped(mode) && self.force.law.half_power_inside())
             .then_some(GAP_SURFACE)
     }
 
@@ -318,6 +323,9 @@ impl SwitchingStructure for TappingModel {
     /// `(dt/dsigma) dF/dd -> K = -c tau sign(s') |s'|^{1/2}` (`s' = -d'`, nm/us), and the
     /// limit of `(dt/dsigma) J v` is `(w_i^2/k_i) K sum_j v_{q_j}` on each `v_i` row (`+ K`
     /// times `(w_i^2/k_i)` on the parameter column, `dd/dZ = 1`), zero on the `q_i` rows.
+    /// JKR attached, at pull-off: `dF/dd = -K / (2 sqrt(s))`, `s = d_po - d = |d'| sigma^2`,
+    /// so `(dt/dsigma) dF/dd -> -K / |d'|^{1/2}` (`K` of
+    /// [`crate::contact::JkrContact::pull_off_root_coefficient`]), on the same rows.
     /// Every other law's Jacobian is bounded next to its surface: `false`.
     fn crossing_tangent_limit(
         &self,
@@ -328,16 +336,19 @@ impl SwitchingStructure for TappingModel {
         tangent_rates: &mut [f64],
         parameter_column: bool,
     ) -> bool {
-        let ContactLaw::KelvinVoigt(kv) = self.force.law else {
-            return false;
+        let limit = match self.force.law {
+            ContactLaw::KelvinVoigt(kv) if Self::in_contact(mode) && !self.is_clipped(mode) => {
+                let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
+                let indentation_rate = -self.gap_rate_at(t, x);
+                -c * kv.release_time_us()
+                    * indentation_rate.signum()
+                    * indentation_rate.abs().sqrt()
+            }
+            ContactLaw::Jkr(jkr) if Self::is_attached(mode) => {
+                -jkr.pull_off_root_coefficient() / self.gap_rate_at(t, x).abs().sqrt()
+            }
+            _ => return false,
         };
-        if !Self::in_contact(mode) || Self::is_clipped(mode) {
-            return false;
-        }
-        let c = 4.0 / 3.0 * kv.effective_modulus_gpa * kv.tip_radius_nm.sqrt();
-        let indentation_rate = -self.gap_rate_at(t, x);
-        let limit =
-            -c * kv.release_time_us() * indentation_rate.signum() * indentation_rate.abs().sqrt();
         let n = self.dim();
         let columns = tangents.len() / n;
         for (column, (v, rate)) in tangents
@@ -377,8 +388,9 @@ impl SwitchingStructure for TappingModel {
     /// standard linear solid's `|sigma''|`, below) with
     /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
     /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
-    /// (extrema inside the sample, the gap's minima, are always wanted), and `None` for the
-    /// release surface and wherever a force acts outside contact (the bound assumes
+    /// (extrema inside the sample, the gap's minima, are always wanted) or attached, and `None`
+    /// for Kelvin-Voigt's release surface (a hysteretic law's pull-off surface `d - d_r` has the
+    /// gap's curvature) and wherever a force acts outside contact (the bound assumes
     /// `F_ts = 0`).
     fn switching_curvature_bound(
         &self,
@@ -388,7 +400,11 @@ impl SwitchingStructure for TappingModel {
         x0: &[f64],
         _dt: f64,
     ) -> Option<f64> {
-        if Self::in_contact(mode) || k != GAP_SURFACE || self.force.acts_outside_contact() {
+        if Self::in_contact(mode)
+            || Self::is_attached(mode)
+            || (k != GAP_SURFACE && self.force.release_gap_nm().is_none())
+            || self.force.acts_outside_contact()
+        {
             return None;
         }
         let w = self.drive.angular_frequency;

@@ -1,13 +1,15 @@
 //! The tapping cantilever's core as a hybrid system: its vector field, Jacobians, parameter
 //! derivative and the gap as its one switching surface (MODEL.md section 1).
 
-use hybrid::{Accelerations, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials};
+use hybrid::{
+    Accelerations, Direction, HybridSystem, LinearisationBuffers, Mode, SwitchingPartials,
+};
 
 use crate::contact::standard_linear_solid::StandardLinearSolid;
 use crate::contact::ForceSlopes;
 use nalgebra::DMatrix;
 
-use super::{TappingModel, CLIPPED, GAP_SURFACE, RELEASE_SURFACE};
+use super::{TappingModel, ATTACHED, CLIPPED, GAP_SURFACE, PULL_OFF_SURFACE, RELEASE_SURFACE};
 
 impl HybridSystem for TappingModel {
     /// `2N`, plus 1 for a standard linear solid's state `rho` (MODEL.md section 9).
@@ -15,9 +17,10 @@ impl HybridSystem for TappingModel {
         2 * self.modes.len() + self.sample_state_count()
     }
 
-    /// The contact surface, and a clipped Kelvin-Voigt law's release surface.
+    /// The contact surface, and a clipped Kelvin-Voigt law's release surface or a hysteretic
+    /// law's pull-off surface.
     fn surface_count(&self) -> usize {
-        if self.force.law.release_time_us().is_some() {
+        if self.force.law.release_time_us().is_some() || self.force.release_gap_nm().is_some() {
             2
         } else {
             1
@@ -124,11 +127,14 @@ impl HybridSystem for TappingModel {
 
     /// `h_0 = d - d_c = Z(t) + y_base(t) + sum_i q_i - d_c`, nm (a standard linear solid's
     /// `h_0 = d + sigma`, `sigma = rho^{2/3}` its unrecovered depth); a clipped Kelvin-Voigt
-    /// law's `h_1 = -d - tau d'`, nm (MODEL.md sections 9 and 14).
+    /// law's `h_1 = -d - tau d'`, nm; a hysteretic law's `h_1 = d - d_r`, nm (MODEL.md
+    /// sections 9 and 14).
     fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
             self.gap(t, x) - self.contact_gap_nm()
                 + self.force.law.surface_depth_nm(self.sample_state(x))
+        } else if let Some(release) = self.force.release_gap_nm() {
+            self.gap(t, x) - release
         } else {
             -self.gap(t, x) - self.release_time() * self.gap_rate_at(t, x)
         }
@@ -137,9 +143,12 @@ impl HybridSystem for TappingModel {
     /// `dh_0/dt = Z'(t) + sum_i q_i'` (the same in every mode; plus `sigma'` of the mode's
     /// `rho'` for a standard linear solid), nm/us;
     /// `dh_1/dt = -d' - tau d''` with `d'' = sum_i q_i''` of mode `mode` (`Z'' = 0`).
+    /// A hysteretic law's `dh_1/dt = d'`.
     fn switching_rate(&self, k: usize, mode: Mode, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
             self.gap_rate_at(t, x) + self.surface_depth_rate(mode, t, x)
+        } else if self.force.release_gap_nm().is_some() {
+            self.gap_rate_at(t, x)
         } else {
             -self.gap_rate_at(t, x) - self.release_time() * self.gap_acceleration(mode, t, x)
         }
@@ -157,7 +166,8 @@ impl HybridSystem for TappingModel {
         x: &[f64],
         gradient: &mut [f64],
     ) -> SwitchingPartials {
-        let (on_gap, on_rate, sign) = if k == RELEASE_SURFACE {
+        let hysteretic = self.force.release_gap_nm().is_some();
+        let (on_gap, on_rate, sign) = if k == RELEASE_SURFACE && !hysteretic {
             (-1.0, -self.release_time(), -1.0)
         } else {
             (1.0, 0.0, 1.0)
@@ -180,6 +190,47 @@ impl HybridSystem for TappingModel {
         }
     }
 
+    /// A hysteretic law attaches at the `Down` crossing of the contact surface and detaches at
+    /// the `Up` crossing of its pull-off surface (bit [`ATTACHED`]); every other crossing
+    /// keeps the attachment.
+    fn mode_after_crossing(
+        &self,
+        k: usize,
+        direction: Direction,
+        _mode: Mode,
+        crossed: Mode,
+    ) -> Mode {
+        if self.force.release_gap_nm().is_none() {
+            return crossed;
+        }
+        match (k, direction) {
+            (GAP_SURFACE, Direction::Down) => crossed | ATTACHED,
+            (PULL_OFF_SURFACE, Direction::Up) => crossed & !ATTACHED,
+            _ => crossed,
+        }
+    }
+
+    /// The signs of the surfaces; for a hysteretic law also [`ATTACHED`] inside contact and,
+    /// in the band `d_c <= d < d_r` where the state alone does not say, when the gap opens
+    /// (`d' > 0`: a tip rising from contact is taken as still attached, a descending one as
+    /// not yet; MODEL.md section 9).
+    fn mode_of(&self, t: f64, x: &[f64]) -> Mode {
+        let mut mode = (0..self.surface_count()).fold(0, |mode, k| {
+            if self.switching(k, t, x) < 0.0 {
+                mode | (1 << k)
+            } else {
+                mode
+            }
+        });
+        if let Some(release) = self.force.release_gap_nm() {
+            let gap = self.gap(t, x);
+            if gap < self.contact_gap_nm() || (gap < release && self.gap_rate(x) > 0.0) {
+                mode |= ATTACHED;
+            }
+        }
+        mode
+    }
+
     /// The free flight's closed-form flow (where no force acts outside contact), the Taylor
     /// series of the plain Hertz contact and of DMT (`TappingModel::series_force`), and the surfaces' shape (affine; the gap's curvature
     /// bounded in force-free flight; a half-power surface in contact).
@@ -198,9 +249,14 @@ impl TappingModel {
         self.force.law.release_time_us().unwrap_or(0.0)
     }
 
-    /// Whether mode `mode` is on the clipped side of the release surface.
-    pub(crate) fn is_clipped(mode: Mode) -> bool {
-        mode & CLIPPED != 0
+    /// Whether mode `mode` is on the clipped side of a Kelvin-Voigt law's release surface.
+    pub(crate) fn is_clipped(&self, mode: Mode) -> bool {
+        mode & CLIPPED != 0 && self.force.law.release_time_us().is_some()
+    }
+
+    /// Whether mode `mode` has a hysteretic law attached (bit [`ATTACHED`]).
+    pub(crate) fn is_attached(mode: Mode) -> bool {
+        mode & ATTACHED != 0
     }
 
     /// [`Self::modal_tangent_rates`] for a force with a slope in the gap rate: per column `v`

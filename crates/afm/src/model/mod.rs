@@ -62,6 +62,15 @@ pub const CONTACT: Mode = 1;
 /// The mode bit set on the side `h_1 < 0` of a clipped Kelvin-Voigt law's release surface,
 /// where the contact force is clipped to zero (MODEL.md section 9).
 pub const CLIPPED: Mode = 2;
+/// The mode bit set while a hysteretic law (JKR, the capillary meniscus) is attached: from the
+/// `Down` crossing of the contact surface to the `Up` crossing of its release surface
+/// [`PULL_OFF_SURFACE`] (MODEL.md section 9). It is no surface's sign: the solver carries it
+/// through [`hybrid::HybridSystem::mode_after_crossing`].
+pub const ATTACHED: Mode = 4;
+/// The index of a hysteretic law's release surface `h_1 = d - d_r` (JKR's pull-off gap, the
+/// meniscus's rupture gap; the same index as Kelvin-Voigt's release surface, which no
+/// hysteretic law has).
+pub const PULL_OFF_SURFACE: usize = 1;
 /// The index of the contact switching surface `h_0 = d - d_c`.
 pub const GAP_SURFACE: usize = 0;
 /// The index of a clipped Kelvin-Voigt law's release surface `h_1 = -d - tau d'`.
@@ -490,9 +499,10 @@ impl TappingModel {
     #[inline]
     fn force_slopes(&self, mode: Mode, t: f64, x: &[f64]) -> ForceSlopes {
         if !self.plain_hertz {
-            return self.force.in_region_at(
+            return self.force.in_mode(
                 Self::in_contact(mode),
                 mode & CLIPPED != 0,
+                mode & ATTACHED != 0,
                 self.gap(t, x),
                 self.gap_rate_at(t, x),
                 self.sample_state(x),
@@ -648,6 +658,24 @@ impl TappingModel {
     /// ones: 1 for a standard linear solid, 0 otherwise.
     pub fn sample_state_count(&self) -> usize {
         usize::from(self.force.law.standard_linear_solid().is_some())
+    }
+
+    /// The tip-sample force `F_ts(d, d')`, nN, of mode `mode` at `(t, x)`: for a hysteretic law
+    /// (JKR, capillary) the attached state is the mode's ([`ATTACHED`]), which the state alone
+    /// does not give in the band `d_c <= d < d_r`.
+    #[inline]
+    pub fn tip_sample_force_in_mode(&self, mode: Mode, t: f64, x: &[f64]) -> f64 {
+        if self.force.release_gap_nm().is_some() {
+            self.force_slopes(mode, t, x).force
+        } else {
+            self.tip_sample_force(t, x)
+        }
+    }
+
+    /// The release gap `d_r` (nm) of a hysteretic law (JKR's pull-off gap, the meniscus's
+    /// rupture gap; MODEL.md section 9), `None` for every other law.
+    pub fn release_gap_nm(&self) -> Option<f64> {
+        self.force.release_gap_nm()
     }
 
     /// The tip-sample force (nN) at a gap minimum (gap rate 0) of gap `d` (nm), for a

@@ -211,8 +211,9 @@ impl CycleLockIn {
                 (sin_k, cos_k) = (sin_k * cos + cos_k * sin, cos_k * cos - sin_k * sin);
             }
             let deflection_rate: f64 = state.chunks_exact(2).map(|mode| mode[1]).sum();
-            self.contact_work +=
-                node.weight * model.tip_sample_force(node.t, state) * deflection_rate;
+            self.contact_work += node.weight
+                * model.tip_sample_force_in_mode(self.mode, node.t, state)
+                * deflection_rate;
         }
     }
 

@@ -478,7 +478,7 @@ impl PeriodObserver {
             ..
         } = *node;
         let u = model.photodiode(state);
-        let force = model.tip_sample_force(t, state);
+        let force = model.tip_sample_force_in_mode(self.mode, t, state);
         self.impulse += weight * force;
         self.base_work += weight * force * model.base_velocity(t);
         // Both drives' factor `D(t)` (MODEL.md section 14; `cos(w t)` for a single drive).

@@ -181,11 +181,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         if self.buffers.z[..n].iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t_event });
         }
-        let new_mode = if negative_after {
+        let crossed = if negative_after {
             mode | (1 << k)
         } else {
             mode & !(1 << k)
         };
+        let new_mode = system.mode_after_crossing(k, direction, mode, crossed);
         if self.sensitivity.transition() {
             self.saltation_update(k, new_mode, t_event, reset)?;
         }

@@ -1,0 +1,202 @@
+//! The JKR law (Johnson, Kendall, Roberts, Proc. R. Soc. Lond. A 324, 301 (1971); in the form
+//! of Maugis, *Contact, Adhesion and Rupture of Elastic Solids*, Springer 2000, ch. 4; MODEL.md
+//! section 9 "JKR"): a sphere of radius `R` adhering to an elastic half-space with work of
+//! adhesion `W`, parametric in the contact radius `a`.
+
+use std::f64::consts::PI;
+
+use super::ForceSlopes;
+
+/// One mJ/m^2 (= 1e-3 N/m) in nN/nm.
+pub const MJ_PER_M2_IN_NN_PER_NM: f64 = 1e-3;
+
+/// JKR contact of a sphere: at contact radius `a` (nm) the indentation and the force are
+/// `delta(a) = a^2/R - sqrt(2 pi W a / E*)` and `F(a) = 4 E* a^3 / (3 R) - sqrt(8 pi W E* a^3)`
+/// (nm, nN; `E*` in GPa = nN/nm^2, `W` in nN/nm), on the stable branch `a >= a_c`. With
+/// `b = sqrt(a)` and `k = sqrt(2 pi W / E*)` the indentation is `b^4/R - k b`, whose minimum
+/// over `b` is at `b_c^3 = k R / 4`: the contact breaks there, at the indentation
+/// `delta_c = -(3/4) k b_c = -(3/4) (pi^2 W^2 R / E*^2)^{1/3}` (the gap `d_po = -delta_c`,
+/// pull-off under fixed grips) with the force `-(5/6) pi W R`. It forms at `d = 0` on approach
+/// with the force `-(4/3) pi W R` there (`a^3 = 2 pi W R^2 / E*`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JkrContact {
+    /// The reduced modulus `E*`, GPa.
+    pub effective_modulus_gpa: f64,
+    /// The tip radius `R`, nm.
+    pub tip_radius_nm: f64,
+    /// The work of adhesion `W`, nN/nm (= N/m; the sample file gives mJ/m^2).
+    pub work_of_adhesion_nn_per_nm: f64,
+}
+
+impl JkrContact {
+    /// `k = sqrt(2 pi W / E*)`, nm^{1/2}.
+    fn adhesion_root(&self) -> f64 {
+        (2.0 * PI * self.work_of_adhesion_nn_per_nm / self.effective_modulus_gpa).sqrt()
+    }
+
+    /// `b_c = sqrt(a_c) = (k R / 4)^{1/3}`, nm^{1/2}: the square root of the contact radius at
+    /// pull-off.
+    fn critical_root(&self) -> f64 {
+        (self.adhesion_root() * self.tip_radius_nm / 4.0).cbrt()
+    }
+
+    /// The pull-off gap `d_po = (3/4) k b_c = (3/4) (pi^2 W^2 R / E*^2)^{1/3}`, nm: the
+    /// release surface, where the contact breaks on retract.
+    pub fn pull_off_gap_nm(&self) -> f64 {
+        0.75 * self.adhesion_root() * self.critical_root()
+    }
+
+    /// The force at pull-off, `-(5/6) pi W R`, nN (from [`Self::force_at_radius`] at `a_c`).
+    pub fn pull_off_force_nn(&self) -> f64 {
+        let b = self.critical_root();
+        self.force_at_radius(b * b)
+    }
+
+    /// `F(a) = 4 E* a^3 / (3 R) - sqrt(8 pi W E* a^3)`, nN, at contact radius `a` (nm).
+    pub fn force_at_radius(&self, radius_nm: f64) -> f64 {
+        let a = radius_nm;
+        let e = self.effective_modulus_gpa;
+        4.0 * e * a * a * a / (3.0 * self.tip_radius_nm)
+            - (8.0 * PI * self.work_of_adhesion_nn_per_nm * e * a * a * a).sqrt()
+    }
+
+    /// `delta(a) = a^2/R - sqrt(2 pi W a / E*)`, nm, at contact radius `a` (nm).
+    pub fn indentation_at_radius(&self, radius_nm: f64) -> f64 {
+        radius_nm * radius_nm / self.tip_radius_nm - self.adhesion_root() * radius_nm.sqrt()
+    }
+
+    /// The contact radius `a` (nm) at indentation `delta` (nm) on the stable branch: the root
+    /// `b = sqrt(a) >= b_c` of `b^4/R - k b = delta`, by Newton's method from the upper bound
+    /// `(R max(delta, 0))^{1/4} + (k R)^{1/3}`, from which the iterates decrease monotonically
+    /// (the function is convex and increasing for `b >= b_c`). Below `delta_c` (past pull-off)
+    /// it returns `a_c`.
+    pub fn contact_radius_nm(&self, indentation_nm: f64) -> f64 {
+        let r = self.tip_radius_nm;
+        let k = self.adhesion_root();
+        let critical = self.critical_root();
+        if indentation_nm <= -self.pull_off_gap_nm() {
+            return critical * critical;
+        }
+        let mut b = (r * indentation_nm.max(0.0)).sqrt().sqrt() + (k * r).cbrt();
+        for _ in 0..200 {
+            let b3 = b * b * b;
+            let value = b3 * b / r - k * b - indentation_nm;
+            let slope = 4.0 * b3 / r - k;
+            if value <= 0.0 || slope <= 0.0 {
+                break;
+            }
+            let next = (b - value / slope).max(critical);
+            if next >= b {
+                break;
+            }
+            let change = b - next;
+            b = next;
+            if change <= 1e-16 * b {
+                break;
+            }
+        }
+        b * b
+    }
+
+    /// The coefficient `K` (nN/nm^{1/2}) of the force's square-root singularity at pull-off,
+    /// `F = F_po + K sqrt(d_po - d) + O(d_po - d)`: with `delta - delta_c = (1/2) delta''(a_c)
+    /// (a - a_c)^2`, `K = F'(a_c) sqrt(2 / delta''(a_c))`, `F'(a_c) = -2 sqrt(2 pi W E* a_c)`,
+    /// `delta''(a) = 2/R + (1/4) k a^{-3/2}`. Negative: the force falls below `F_po` inside.
+    pub fn pull_off_root_coefficient(&self) -> f64 {
+        let b = self.critical_root();
+        let a = b * b;
+        let e = self.effective_modulus_gpa;
+        let force_rate = -2.0 * (2.0 * PI * self.work_of_adhesion_nn_per_nm * e * a).sqrt();
+        let curvature = 2.0 / self.tip_radius_nm + 0.25 * self.adhesion_root() / (a * b);
+        force_rate * (2.0 / curvature).sqrt()
+    }
+
+    /// The force (nN) and `dF/dd` (nN/nm) at gap `d` (nm) while in contact (`d <= d_po`):
+    /// `F(a(-d))` and `dF/dd = -(dF/da) / (d delta/da)` with `dF/da = 4 E* a^2/R - (3/2)
+    /// sqrt(8 pi W E* a)` and `d delta/da = 2 a/R - sqrt(pi W / (2 E* a))`. The slope is
+    /// unbounded at pull-off (`d delta/da = 0`); there it is evaluated with `d delta/da` floored
+    /// at `1e-12 (2 a / R)` (finite, the force continuous).
+    pub fn force_slopes(&self, gap_nm: f64) -> ForceSlopes {
+        let a = self.contact_radius_nm(-gap_nm);
+        let e = self.effective_modulus_gpa;
+        let r = self.tip_radius_nm;
+        let w = self.work_of_adhesion_nn_per_nm;
+        let force_rate = 4.0 * e * a * a / r - 1.5 * (8.0 * PI * w * e * a).sqrt();
+        let floor = 1e-12 * 2.0 * a / r;
+        let indentation_rate = (2.0 * a / r - (PI * w / (2.0 * e * a)).sqrt()).max(floor);
+        ForceSlopes {
+            force: self.force_at_radius(a),
+            gap_slope: -force_rate / indentation_rate,
+            rate_slope: 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn law() -> JkrContact {
+        JkrContact {
+            effective_modulus_gpa: 1.2,
+            tip_radius_nm: 30.0,
+            work_of_adhesion_nn_per_nm: 0.02,
+        }
+    }
+
+    /// The closed forms of Maugis 2000 (ch. 4): pull-off under fixed grips at
+    /// `delta_c = -(3/4) (pi^2 W^2 R / E*^2)^{1/3}` with `F = -(5/6) pi W R`, and `F = -(4/3) pi
+    /// W R` at zero indentation; to 1e-12 relative.
+    #[test]
+    fn pull_off_and_zero_indentation_match_the_closed_forms() {
+        let jkr = law();
+        let (w, r, e) = (0.02, 30.0, 1.2);
+        let gap = 0.75 * (PI * PI * w * w * r / (e * e)).cbrt();
+        assert!((jkr.pull_off_gap_nm() - gap).abs() < 1e-12 * gap);
+        let pull_off = -5.0 / 6.0 * PI * w * r;
+        assert!((jkr.pull_off_force_nn() - pull_off).abs() < 1e-12 * pull_off.abs());
+        let at_zero = -4.0 / 3.0 * PI * w * r;
+        let f = jkr.force_slopes(0.0).force;
+        assert!(
+            (f - at_zero).abs() < 1e-12 * at_zero.abs(),
+            "{f} vs {at_zero}"
+        );
+    }
+
+    /// The contact radius inverts `delta(a)` (to 1e-12 nm) from pull-off to deep indentation,
+    /// and the slope is the derivative of the force (central difference, step 1e-6 nm, to
+    /// 1e-6 relative).
+    #[test]
+    fn radius_inverts_the_indentation_and_the_slope_is_the_derivative() {
+        let jkr = law();
+        let lowest = -jkr.pull_off_gap_nm();
+        for i in 1..200 {
+            let delta = lowest + f64::from(i) * 0.05;
+            let a = jkr.contact_radius_nm(delta);
+            assert!((jkr.indentation_at_radius(a) - delta).abs() < 1e-12 * delta.abs().max(1.0));
+            let h = 1e-6;
+            let numeric = (jkr.force_slopes(-delta + h).force - jkr.force_slopes(-delta - h).force)
+                / (2.0 * h);
+            let slope = jkr.force_slopes(-delta).gap_slope;
+            if delta > lowest + 0.01 {
+                assert!(
+                    (numeric - slope).abs() < 1e-6 * slope.abs().max(1.0),
+                    "delta {delta}: {slope} vs {numeric}"
+                );
+            }
+        }
+    }
+
+    /// As `W -> 0` the force tends to Hertz's `(4/3) E* sqrt(R) delta^{3/2}` (W = 1e-12 nN/nm:
+    /// to 1e-3 relative at delta = 1 nm, the correction being of order `(W/(E* delta))^{1/2}`).
+    #[test]
+    fn vanishing_adhesion_tends_to_hertz() {
+        let jkr = JkrContact {
+            work_of_adhesion_nn_per_nm: 1e-12,
+            ..law()
+        };
+        let hertz = 4.0 / 3.0 * 1.2 * 30f64.sqrt();
+        let f = jkr.force_slopes(-1.0).force;
+        assert!((f - hertz).abs() < 1e-3 * hertz, "{f} vs {hertz}");
+    }
+}
