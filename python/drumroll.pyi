@@ -25,7 +25,9 @@ class Case:
     a named case's values; `Case()` is `biolever-mica`. `contact` and `electrostatic` (dicts in
     the sample files' format, MODEL.md section 9, e.g. `contact={"law": "dmt",
     "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}`) set the sample's
-    contact law and double layer (default: the sample's own, Hertz). Bad input raises ValueError (unknown
+    contact law and double layer (default: the sample's own, Hertz); `drive` (a dict in the
+    case files' format, MODEL.md section 14, e.g. `drive={"kind": "acoustic"}`) sets the
+    excitation (default: the case's own, direct). Bad input raises ValueError (unknown
     name, out-of-range value: the message names the field and its allowed range) or
     TypeError; a file that cannot be read raises OSError. Pickles (travels to Dask workers).
     """
@@ -40,6 +42,7 @@ class Case:
         drive_frequency_khz: Optional[float] = None,
         contact: Optional[Dict[str, Any]] = None,
         electrostatic: Optional[Dict[str, Any]] = None,
+        drive: Optional[Dict[str, Any]] = None,
     ) -> None: ...
     @property
     def name(self) -> str:

@@ -61,6 +61,21 @@ def test_cantilever_sample_a0_and_drive_equal_the_cli_options():
     assert case.orbit(z=9.0).to_dict() == expected
 
 
+@pytest.mark.parametrize("name", ["biolever-mica-acoustic", "biolever-mica-bimodal"])
+def test_a_drive_dict_gives_the_built_in_drive_case_numbers(name):
+    drive = drumroll.cases()["cases"][name]["drive"]
+    case = drumroll.Case("biolever-mica", drive=drive)
+    assert case.to_dict()["drive"] == drive
+    expected = cli_json("simulate", "--case", name, "--z", "8", "--json")
+    got = case.orbit(z=8.0).to_dict()
+    # Only the case's name and the command differ: every number is the drive case's.
+    for record in (got, expected):
+        record.pop("case", None)
+        for key in ("case", "command", "options"):
+            record["inputs"].pop(key, None)
+    assert got == expected
+
+
 def test_a_case_of_dicts_gives_the_named_case_numbers():
     fixtures = drumroll.cases()
     named = drumroll.Case(cantilever="maclever", sample="soft", a0=20.0)

@@ -114,3 +114,10 @@ def test_wrong_types_raise_type_errors():
         drumroll.Case("/no/such/dir/case.json")
     with pytest.raises(AttributeError, match="simulate --json"):
         case.orbit(z=12.0).no_such_key
+
+
+def test_a_bad_drive_names_the_field():
+    with pytest.raises(ValueError, match="drive"):
+        drumroll.Case("biolever-mica", drive={"kind": "magnetic"})
+    with pytest.raises(ValueError, match="second_free_amplitude_nm|drive"):
+        drumroll.Case("biolever-mica", drive={"kind": "bimodal", "second_free_amplitude_nm": -1.0})

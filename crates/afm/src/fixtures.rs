@@ -35,6 +35,7 @@ const CANTILEVERS: &[Embedded] = &[
     embedded!("cantilevers", "biolever"),
     embedded!("cantilevers", "maclever"),
     embedded!("cantilevers", "rectangular-silicon-water"),
+    embedded!("cantilevers", "silicon-air"),
 ];
 
 const SAMPLES: &[Embedded] = &[
@@ -45,6 +46,8 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "soft-viscoelastic"),
     embedded!("samples", "mica-hydration"),
     embedded!("samples", "adhesive-soft"),
+    embedded!("samples", "polymer-strong-vdw"),
+    embedded!("samples", "polymer-weak-vdw"),
 ];
 
 const CASES: &[Embedded] = &[
@@ -60,34 +63,34 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "biolever-mica-acoustic"),
     embedded!("cases", "biolever-mica-bimodal"),
     embedded!("cases", "biolever-adhesive"),
+    embedded!("cases", "silicon-air-polymer"),
 ];
 
-const LINES: &[Embedded] = &[embedded!("lines", "membrane-patch")];
+const LINES: &[Embedded] = &[
+    embedded!("lines", "membrane-patch"),
+    embedded!("lines", "polymer-blend"),
+];
 
 fn names(table: &[Embedded]) -> Vec<&'static str> {
     table.iter().map(|entry| entry.name).collect()
 }
 
-/// The names of the built-in cantilevers (`biolever`, `maclever`, `rectangular-silicon-water`).
+/// The names of the built-in cantilevers (the files in `fixtures/cantilevers/`).
 pub fn cantilever_names() -> Vec<&'static str> {
     names(CANTILEVERS)
 }
 
-/// The names of the built-in samples (`mica`, `soft`, `purple-membrane`,
-/// `purple-membrane-film`, `soft-viscoelastic`, `mica-hydration`, `adhesive-soft`).
+/// The names of the built-in samples (the files in `fixtures/samples/`).
 pub fn sample_names() -> Vec<&'static str> {
     names(SAMPLES)
 }
 
-/// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
-/// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
-/// `maclever-membrane-film`, `biolever-soft-viscoelastic`, `biolever-mica-hydration`,
-/// `biolever-mica-acoustic`, `biolever-mica-bimodal`, `biolever-adhesive`).
+/// The names of the built-in cases (the files in `fixtures/cases/`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }
 
-/// The names of the built-in scan lines (`membrane-patch`; MODEL.md section 12).
+/// The names of the built-in scan lines (the files in `fixtures/lines/`; MODEL.md section 12).
 pub fn line_names() -> Vec<&'static str> {
     names(LINES)
 }

@@ -197,16 +197,19 @@ fn first_contact_separation_matches_brute_force_sampling() {
         );
         let mut x = vec![0.0; dim];
         let z_g1 = model.grazing_separation_nm();
-        // The golden-section refinement converges to ~sqrt(eps) in t, i.e. ~eps in value.
+        // First contact is where the lowest gap reaches the contact surface `d_c` (0 but for
+        // DMT's `a0`). The golden-section refinement converges to ~sqrt(eps) in t, i.e. ~eps
+        // in value.
+        let contact_gap = model.contact_gap_nm();
         assert!(
-            (z_g1 + lowest).abs() < 1e-9 * z_g1,
+            (z_g1 - contact_gap + lowest).abs() < 1e-9 * z_g1,
             "{name}: {z_g1} vs {}",
-            -lowest
+            contact_gap - lowest
         );
-        // At Z = Z_G1 the free gap's minimum is zero, i.e. the model's gap vanishes there.
+        // At Z = Z_G1 the free gap's minimum is `d_c`, i.e. the model's gap touches it there.
         let t_low = free.lowest_gap_time_us();
         free.state_at(t_low, &mut x);
-        assert!(model.gap(t_low, &x).abs() < 1e-12 * z_g1);
+        assert!((model.gap(t_low, &x) - contact_gap).abs() < 1e-12 * z_g1);
         // First contact is not at Z = A0 (MODEL.md section 5).
         println!(
             "{name}: Z_G1 = {z_g1:.9} nm, A0 = {} nm",

@@ -404,3 +404,85 @@ fn engaging_past_the_fold_near_first_contact_is_marked_as_a_jump() {
         "{error}"
     );
 }
+
+/// The `Z` where the stable parts of `diagram` cross `A/A0 = ratio`, by linear interpolation
+/// between consecutive stable points (branch order).
+fn stable_crossings(diagram: &afm::BifurcationDiagram, ratio: f64) -> Vec<(f64, f64)> {
+    diagram
+        .points
+        .windows(2)
+        .filter(|pair| pair[0].stable && pair[1].stable)
+        .filter_map(|pair| {
+            let (r0, r1) = (pair[0].amplitude_ratio, pair[1].amplitude_ratio);
+            ((r0 - ratio) * (r1 - ratio) <= 0.0 && r0 != r1).then(|| {
+                let s = (ratio - r0) / (r1 - r0);
+                let z = pair[0].z_nm + s * (pair[1].z_nm - pair[0].z_nm);
+                let phase = pair[0].phase_deg + s * (pair[1].phase_deg - pair[0].phase_deg);
+                (z, phase)
+            })
+        })
+        .collect()
+}
+
+#[test]
+fn where_attractive_and_repulsive_orbits_coexist_trace_and_retrace_differ_as_the_branches_say() {
+    // The silicon-air cantilever over the strong van der Waals polymer is bistable: its
+    // approach branch (the diagram, independent of the scan's walk) crosses A/A0 = 0.8 on two
+    // stable parts, the attractive regime (phase above 90 deg) at the larger Z and the
+    // repulsive one (below 90 deg) beyond the fold. The built-in blend line engages in the
+    // attractive regime (the first crossing, as a slow approach does), is pushed into the
+    // repulsive regime over the weak polymer (one orbit at every Z) and stays there over the
+    // strong polymer after it, so the retrace reads the strong polymer at the repulsive Z
+    // everywhere while the trace read it at the attractive Z first. Tolerances: the Illinois
+    // refinement's 1e-9 nm between scan passes; 2e-3 nm against the linear interpolation of
+    // branch points A0/250 = 0.04 nm apart; 0.05 deg on the interpolated phase.
+    let case = builtin_case("silicon-air-polymer").unwrap();
+    let model = TappingModel::from_case(&case).unwrap();
+    let diagram = afm::approach_diagram(&model, &afm::DiagramSettings::approach(&model)).unwrap();
+    let crossings = stable_crossings(&diagram, 0.8);
+    assert_eq!(crossings.len(), 2, "{crossings:?}");
+    let (attractive, repulsive) = (crossings[0], crossings[1]);
+    assert!(attractive.1 > 90.0 && repulsive.1 < 90.0, "{crossings:?}");
+    assert!(attractive.0 - repulsive.0 > 0.5, "{crossings:?}");
+
+    let line = ScanLine::builtin("polymer-blend").unwrap();
+    let settings = ScanSettings {
+        directions: ScanDirections::Both,
+        ..ScanSettings::new(0.8, 6)
+    };
+    let pixels = ideal_scan(&case, &line, &settings).unwrap();
+    let (trace, retrace): (Vec<_>, Vec<_>) = pixels
+        .iter()
+        .partition(|p| p.direction == ScanDirection::Trace);
+    let near = |z: f64, reference: (f64, f64), phase: f64| {
+        (z - reference.0).abs() < 2e-3 && (phase - reference.1).abs() < 0.05
+    };
+    for pixel in &pixels {
+        assert!((pixel.amplitude_ratio - 0.8).abs() < 1e-6, "{pixel:?}");
+        assert!(pixel.jump.is_none(), "{pixel:?}");
+    }
+    // Trace: attractive on the first strong segment, repulsive on the last one.
+    for pixel in &trace[..2] {
+        assert!(near(pixel.z_nm, attractive, pixel.phase_deg), "{pixel:?}");
+    }
+    for pixel in &trace[4..] {
+        assert!(near(pixel.z_nm, repulsive, pixel.phase_deg), "{pixel:?}");
+    }
+    // Retrace (from the trace's end): repulsive on both strong segments.
+    for pixel in retrace.iter().filter(|p| p.sample == "polymer-strong-vdw") {
+        assert!(near(pixel.z_nm, repulsive, pixel.phase_deg), "{pixel:?}");
+    }
+    // The weak polymer reads the same both ways; the first segment differs by the branches.
+    let weak: Vec<f64> = pixels
+        .iter()
+        .filter(|p| p.sample == "polymer-weak-vdw")
+        .map(|p| p.z_nm)
+        .collect();
+    assert!(weak.iter().all(|z| (z - weak[0]).abs() < 1e-9), "{weak:?}");
+    let first_trace = trace[0].z_nm;
+    let first_retrace = retrace.iter().find(|p| p.index == 0).unwrap().z_nm;
+    assert!(
+        (first_trace - first_retrace - (attractive.0 - repulsive.0)).abs() < 4e-3,
+        "{first_trace} {first_retrace}"
+    );
+}

@@ -94,7 +94,9 @@ fn with_contact_law(
 /// (`biolever-mica`), as on the command line. `contact` and `electrostatic` (dicts in the
 /// sample files' format, MODEL.md section 9: `contact={"law": "dmt",
 /// "hamaker_constant_j": 5e-22, "intermolecular_distance_nm": 0.165}`) set the sample's
-/// contact law and double layer; without them the sample's own (Hertz by default).
+/// contact law and double layer; without them the sample's own (Hertz by default). `drive`
+/// (a dict in the case files' format, MODEL.md section 14: `drive={"kind": "acoustic"}`)
+/// sets the excitation; without it the case's own (direct by default).
 #[pyclass(module = "drumroll", frozen)]
 pub struct Case {
     /// The resolved case and its model.
@@ -104,7 +106,7 @@ pub struct Case {
 #[pymethods]
 impl Case {
     #[new]
-    #[pyo3(signature = (name_or_path=None, *, cantilever=None, sample=None, a0=None, drive_frequency_khz=None, contact=None, electrostatic=None))]
+    #[pyo3(signature = (name_or_path=None, *, cantilever=None, sample=None, a0=None, drive_frequency_khz=None, contact=None, electrostatic=None, drive=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -115,6 +117,7 @@ impl Case {
         drive_frequency_khz: Option<f64>,
         contact: Option<Bound<'_, pyo3::types::PyDict>>,
         electrostatic: Option<Bound<'_, pyo3::types::PyDict>>,
+        drive: Option<Bound<'_, pyo3::types::PyDict>>,
     ) -> PyResult<Self> {
         let has_dict = matches!(cantilever, Some(Reference::Dict(_)))
             || matches!(sample, Some(Reference::Dict(_)));
@@ -164,6 +167,14 @@ impl Case {
         };
         if contact.is_some() || electrostatic.is_some() {
             case.sample = with_contact_law(&case.sample, contact, electrostatic)?;
+        }
+        if let Some(drive) = drive {
+            case.drive = serde_json::from_value(py_to_json(drive.as_any())?).map_err(|e| {
+                pyo3::exceptions::PyValueError::new_err(format!(
+                    "the Python arguments: field `drive`: {e} (a case file's drive object: \
+                     {{\"kind\": \"direct\" | \"acoustic\" | \"bimodal\", ...}}, MODEL.md section 14)"
+                ))
+            })?;
         }
         let resolved = py
             .allow_threads(|| Resolved::new(case))

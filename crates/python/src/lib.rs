@@ -40,6 +40,7 @@ fn cases(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
             "sample": case.sample,
             "free_amplitude_nm": case.free_amplitude_nm,
             "drive_frequency_khz": case.drive_frequency_khz,
+            "drive": case.drive,
         });
         table.set_item(name, json_to_py(py, &value)?)?;
     }

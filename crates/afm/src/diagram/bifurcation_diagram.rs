@@ -30,6 +30,11 @@ pub struct DiagramSettings {
     pub z_limit_nm: f64,
     /// An approach also stops once `A/A0` falls below this ratio (default 0.3). In `[0, 1)`.
     pub min_amplitude_ratio: f64,
+    /// How far in `Z` (nm) below the point where `A/A0` fell below `min_amplitude_ratio` the
+    /// approach goes on before it stops there (default 0: at once). A branch that turns at a
+    /// fold within this margin and comes back above the ratio (the attractive regime's fold
+    /// and the repulsive branch beyond it, MODEL.md section 12) is followed on; `>= 0`.
+    pub ratio_floor_margin_nm: f64,
     /// Largest arclength step in the `(x, Z)` space, nm and nm/us (default `A0 / 250`, so that
     /// a diagram from first contact to `A/A0 = 0.3` has several hundred points). `> 0`.
     pub max_step: f64,
@@ -47,6 +52,7 @@ impl DiagramSettings {
             direction: ParameterDirection::Decreasing,
             z_limit_nm: 0.05 * a0,
             min_amplitude_ratio: 0.3,
+            ratio_floor_margin_nm: 0.0,
             max_step: a0 / 250.0,
             max_points: 20_000,
         }
@@ -84,6 +90,13 @@ impl DiagramSettings {
                 "min_amplitude_ratio",
                 self.min_amplitude_ratio.to_string(),
                 "0 <= ratio < 1",
+            ));
+        }
+        if !(self.ratio_floor_margin_nm.is_finite() && self.ratio_floor_margin_nm >= 0.0) {
+            return Err(invalid(
+                "ratio_floor_margin_nm",
+                self.ratio_floor_margin_nm.to_string(),
+                ">= 0, finite, nm",
             ));
         }
         if !(self.max_step.is_finite() && self.max_step > 0.0) {
@@ -439,6 +452,9 @@ fn branch_until(
     };
     let a0 = model.free_amplitude_nm();
     let min_ratio = settings.min_amplitude_ratio;
+    let margin = settings.ratio_floor_margin_nm;
+    // The `Z` where `A/A0` last fell below `min_ratio` (none while it is above).
+    let mut below_since: Option<f64> = None;
     let integration = settings.orbit.integration.clone();
     let harmonics = settings.orbit.harmonics;
     // Observables are computed once per point, inside the stop predicate, and kept.
@@ -466,7 +482,14 @@ fn branch_until(
                 let observables =
                     orbit_observables(&at_point, point.state.as_slice(), &integration, harmonics);
                 let stop = match &observables {
-                    Ok(o) => o.amplitude_nm / a0 < min_ratio,
+                    Ok(o) if o.amplitude_nm / a0 < min_ratio => {
+                        let since = *below_since.get_or_insert(point.parameter);
+                        sign * (point.parameter - since) >= margin
+                    }
+                    Ok(_) => {
+                        below_since = None;
+                        false
+                    }
                     Err(_) => true,
                 };
                 observed.push(observables);

@@ -30,6 +30,11 @@ pub const SETTLE_PERIODS: usize = 200;
 /// of `A0`.
 pub const JUMP_PAST_FOLD: f64 = 1e-4;
 
+/// How far below the setpoint's floor `A/A0 = ratio - 0.05` the branch is followed on, as a
+/// fraction of `A0` in `Z`: far enough to pass an attractive regime's fold and reach the
+/// repulsive branch beyond it, where two stable orbits hold the setpoint (MODEL.md section 12).
+pub const RATIO_FLOOR_MARGIN: f64 = 0.25;
+
 /// The most jumps one walk makes before giving up (a feedback that never settles).
 pub const MAX_JUMPS: usize = 8;
 
@@ -55,7 +60,8 @@ struct Entry {
 
 impl SetpointBranch {
     /// The branch of `model` for the setpoint `search.ratio`: the approach diagram from first
-    /// contact down to `A/A0 = ratio - 0.05` or `Z = search.floor_fraction * A0`.
+    /// contact down to [`RATIO_FLOOR_MARGIN`]` A0` below where `A/A0` falls under
+    /// `ratio - 0.05`, or to `Z = search.floor_fraction * A0`.
     pub fn new(
         model: &TappingModel,
         search: &AmplitudeRatioSearch,
@@ -66,6 +72,7 @@ impl SetpointBranch {
             orbit: settings.clone(),
             z_limit_nm: search.floor_fraction * a0,
             min_amplitude_ratio: (search.ratio - 0.05).max(0.0),
+            ratio_floor_margin_nm: RATIO_FLOOR_MARGIN * a0,
             ..DiagramSettings::approach(model)
         };
         let diagram = approach_diagram(model, &diagram_settings)?;
