@@ -15,8 +15,8 @@
 use std::cell::RefCell;
 
 use hybrid::{
-    flow_map_observed, Direction, ExtremumKind, FlowMap, HybridSystem, Sensitivity, Settings,
-    Solver, StepOutcome,
+    flow_map_in, Direction, ExtremumKind, FlowMap, HybridSystem, Sensitivity, Settings, Solver,
+    SolverWorkspace, StepOutcome,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -46,6 +46,9 @@ pub struct HybridPeriodicProblem<S: Parametrised> {
     start_time: f64,
     settings: Settings,
     buffers: RefCell<Buffers>,
+    /// The solver's buffers, reused by every period map (`hybrid::flow_map_in`: the same run
+    /// without a new solver's allocations).
+    workspace: RefCell<SolverWorkspace>,
 }
 
 /// Scratch vectors for the virtual-minimum estimate.
@@ -101,6 +104,7 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
                 field: vec![0.0; n],
                 shifted: vec![0.0; n],
             }),
+            workspace: RefCell::new(SolverWorkspace::default()),
         })
     }
 
@@ -185,7 +189,7 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
         self.system.borrow_mut().set_parameter(p);
         let system = self.system.borrow();
         let duration = self.periods as f64 * system.period();
-        flow_map_observed(
+        flow_map_in(
             &*system,
             self.start_time,
             x,
@@ -193,6 +197,7 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
             sensitivity,
             &self.settings,
             &mut |solver: &Solver<S>, outcome: &StepOutcome| observer(solver, outcome),
+            &mut self.workspace.borrow_mut(),
         )
         .map_err(|source| ContinuationError::Hybrid {
             parameter: p,
