@@ -8,11 +8,18 @@
 //!
 //! Run with `cargo bench -p afm --bench diagram`; `-- --repetitions N` (default 5) sets the
 //! repetitions of each diagram, whose median is reported.
+//!
+//! The last table is the cost of the observables (issue 30): each diagram against the same
+//! continuation without them (`HybridPeriodicProblem` alone, no stop predicate, down to the
+//! diagram's last `Z`: the same branch points), CPU time of both in one run, and what
+//! integrating every accepted point once more for its observables (as before they were
+//! recorded during the corrector's accepted period map) would add.
 
 use afm::{
     approach_diagram, builtin_case, orbit_observables, BifurcationDiagram, DiagramSettings,
     Separation, TappingModel,
 };
+use continuation::{Continuation, ContinuationSettings, HybridPeriodicProblem, ParameterDirection};
 use hybrid::{flow_map, Sensitivity};
 use std::time::Instant;
 
@@ -87,6 +94,55 @@ fn work(model: &TappingModel, settings: &DiagramSettings, diagram: &BifurcationD
         observables_us: observables_us / samples as f64,
         accepted_maps: diagram.points.iter().map(|p| p.iterations + 1).sum(),
     }
+}
+
+/// The median CPU time (the thread's, else wall) of `repetitions` calls of `f`, seconds.
+fn median_cpu_seconds<F: FnMut()>(repetitions: usize, mut f: F) -> f64 {
+    let mut times: Vec<f64> = (0..repetitions)
+        .map(|_| {
+            let (cpu, wall) = (thread_cpu_seconds(), Instant::now());
+            f();
+            match (cpu, thread_cpu_seconds()) {
+                (Some(a), Some(b)) => b - a,
+                _ => wall.elapsed().as_secs_f64(),
+            }
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[repetitions / 2]
+}
+
+/// The approach diagram's continuation without observables: the period-1 problem alone, the
+/// diagram's continuation settings, from the same start down to `z_last` (the diagram's last
+/// point, where its `A/A0` stop ended it), no stop predicate. Returns the number of points.
+fn bare_continuation(model: &TappingModel, settings: &DiagramSettings, z_last: f64) -> usize {
+    let z_start = model.grazing_separation_nm() + 0.02 * model.free_amplitude_nm();
+    let mut system = model.clone();
+    system
+        .set_separation(Separation::Constant(z_start))
+        .expect("finite separation");
+    let problem =
+        HybridPeriodicProblem::new(system, 1, settings.orbit.integration.clone()).expect("problem");
+    let continuation_settings = ContinuationSettings {
+        initial_step: settings.max_step * 0.1,
+        max_step: settings.max_step,
+        direction: ParameterDirection::Decreasing,
+        parameter_min: z_last,
+        parameter_max: f64::INFINITY,
+        max_points: settings.max_points,
+        corrector: settings.orbit.newton.clone(),
+        ..ContinuationSettings::default()
+    };
+    Continuation::new(
+        &problem,
+        &model.free_state(),
+        z_start,
+        continuation_settings,
+    )
+    .expect("continuation")
+    .run()
+    .points
+    .len()
 }
 
 /// The issue's reference: a brute-force scipy sweep of one case, about 250 separations, about
@@ -250,6 +306,45 @@ fn main() {
         "(the rest: rejected corrector attempts, special-point location, linear algebra, \
          allocation)\n"
     );
+    println!(
+        "the observables' cost: CPU ms (medians of {repetitions}) of the diagram (observables \
+         recorded during the corrector's accepted map) and of the same continuation without \
+         them; 'again' = one more integration per point for its observables (the way before)"
+    );
+    println!(
+        "{:<15} {:>8} {:>13} {:>14} {:>9} {:>10} {:>12}",
+        "case", "points", "with obs. ms", "without ms", "extra %", "again ms", "again extra %"
+    );
+    for (name, _, work, points) in &breakdown {
+        let model =
+            TappingModel::from_case(&builtin_case(name).expect("built-in case")).expect("model");
+        let settings = DiagramSettings::approach(&model);
+        let z_last = approach_diagram(&model, &settings)
+            .expect("diagram")
+            .points
+            .last()
+            .expect("a point")
+            .z_nm;
+        let with = median_cpu_seconds(repetitions, || {
+            std::hint::black_box(approach_diagram(&model, &settings).expect("diagram"));
+        });
+        let mut bare_points = 0;
+        let without = median_cpu_seconds(repetitions, || {
+            bare_points = std::hint::black_box(bare_continuation(&model, &settings, z_last));
+        });
+        let again = *points as f64 * work.observables_us * 1e-6;
+        println!(
+            "{:<15} {:>8} {:>13.1} {:>14.1} {:>9.1} {:>10.1} {:>12.1}",
+            name,
+            format!("{points}/{bare_points}"),
+            with * 1e3,
+            without * 1e3,
+            100.0 * (with / without - 1.0),
+            again * 1e3,
+            100.0 * again / without,
+        );
+    }
+    println!();
     let per_case = total / CASES.len() as f64;
     println!(
         "vs a brute-force scipy sweep of one case ({SCIPY_SWEEP_POINTS} Z values in \

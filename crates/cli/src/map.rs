@@ -2,7 +2,10 @@
 //! fold and period-doubling points of the approach diagram continued from the case's own value
 //! over a range (`afm::map::regime_map`), as curves in the `(p, Z)` and `(p, A/A0)` planes.
 
-use afm::{regime_map, Case, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings, TappingModel};
+use afm::{
+    regime_map, Case, MapCodim2Point, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings,
+    TappingModel,
+};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
@@ -65,6 +68,10 @@ pub struct MapArgs {
     /// Write the curve points to this CSV file (one row per point).
     #[arg(long, value_name = "FILE.csv")]
     pub csv: Option<PathBuf>,
+    /// Write the codimension-two points to this CSV file (one row per point, with the
+    /// observables of the orbit there).
+    #[arg(long, value_name = "FILE.csv")]
+    pub codim2_csv: Option<PathBuf>,
     /// Draw the map in the (PARAM, Z) and (PARAM, A/A0) planes; the format follows the
     /// extension (.svg, .png or .pdf).
     #[arg(long, value_name = "FILE.svg|.png|.pdf")]
@@ -92,6 +99,11 @@ pub fn run(args: &MapArgs) -> Result<()> {
         .as_ref()
         .map(|p| output_path(p, "csv", "--csv"))
         .transpose()?;
+    let codim2_csv_path = args
+        .codim2_csv
+        .as_ref()
+        .map(|p| output_path(p, "csv", "--codim2-csv"))
+        .transpose()?;
     let plot_path = args
         .plot
         .as_ref()
@@ -113,6 +125,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
     if let Some(path) = csv_path {
         write_atomically(&path, csv_text(&map.curves)?.as_bytes())?;
+    }
+    if let Some(path) = codim2_csv_path {
+        write_atomically(&path, codim2_csv_text(&map.codim2_points)?.as_bytes())?;
     }
     if let Some(path) = plot_path {
         path.write(&map_figure(axis, &map, grid.as_ref())?)?;
@@ -320,6 +335,45 @@ pub const CSV_COLUMNS: [&str; 15] = [
     "mean_indentation_nm",
     "energy_balance_residual",
 ];
+
+/// The CSV columns of `map --codim2-csv` after `label`: the scalar keys of a JSON
+/// codimension-two point, in this order (docs/output-schema.md); the harmonics' columns follow
+/// them.
+pub const CODIM2_CSV_COLUMNS: [&str; 12] = [
+    "curve",
+    "parameter",
+    "z_nm",
+    "amplitude_ratio",
+    "phase_deg",
+    "precision",
+    "converged",
+    "dissipated_ev",
+    "virial_ev",
+    "max_indentation_nm",
+    "mean_indentation_nm",
+    "energy_balance_residual",
+];
+
+/// The CSV of the codimension-two points (`map --codim2-csv`): `label`, then
+/// [`CODIM2_CSV_COLUMNS`], then `harmonic_<n>_amplitude_nm` and
+/// `harmonic_<n>_phase_deg` for `n = 1..N` (the JSON point's `harmonics[n - 1]`).
+pub fn codim2_csv_text(points: &[MapCodim2Point]) -> Result<String> {
+    let count = points.first().map_or(0, |point| point.harmonics.len());
+    let mut text = format!("label,{}", CODIM2_CSV_COLUMNS.join(","));
+    text.push_str(&harmonic_columns(count));
+    text.push('\n');
+    for point in points {
+        let value = serde_json::to_value(point)?;
+        // `curve` is a label like the first column's, written bare.
+        let labels = format!("{},{}", point.label, point.curve);
+        push_csv_row(&mut text, &labels, &value, &CODIM2_CSV_COLUMNS[1..]);
+        // The row's newline moves after the harmonics.
+        text.pop();
+        push_harmonic_cells(&mut text, &point.harmonics, count);
+        text.push('\n');
+    }
+    Ok(text)
+}
 
 /// The figure `map --plot` draws (SVG): the map in the `(PARAM, Z)` and `(PARAM, A/A0)`
 /// planes, with the cells of a `drumroll grid` result under the curves when `grid` is given.

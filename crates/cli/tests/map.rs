@@ -181,6 +181,24 @@ fn the_plot_names_regions_shades_the_bistable_area_and_marks_cusps() {
         .map(|p| number(p, "parameter"))
         .collect();
     assert_eq!(cusps.len(), 2, "{cusps:?}");
+    // The codimension-two points carry the contrast observables of their orbit (issue 30):
+    // Hertz on mica is conservative, so no energy is dissipated (to 1e-12 eV, MODEL.md
+    // section 10), the orbit's energy balance closes to 1e-9, and the first harmonic is the
+    // point's A/A0 (A0 = 20 nm, the case's) and phase.
+    for point in map["codim2_points"].as_array().expect("codim-2 points") {
+        assert!(number(point, "dissipated_ev").abs() < 1e-12, "{point}");
+        assert!(number(point, "energy_balance_residual") < 1e-9, "{point}");
+        assert!(number(point, "virial_ev").is_finite());
+        assert!(number(point, "max_indentation_nm") >= number(point, "mean_indentation_nm"));
+        let harmonics = point["harmonics"].as_array().expect("harmonics");
+        assert_eq!(harmonics.len(), 4);
+        let first = &harmonics[0];
+        assert!(
+            (number(first, "amplitude_nm") / 20.0 - number(point, "amplitude_ratio")).abs() < 1e-12
+        );
+        assert_eq!(number(first, "phase_deg"), number(point, "phase_deg"));
+        assert_eq!(point["state"].as_array().expect("state").len(), 4);
+    }
     let svg = std::fs::read_to_string(&plot).expect("svg");
     for text in [
         "1 impact",

@@ -526,6 +526,60 @@ fn csv_columns_are_the_documented_json_keys_in_order() {
     assert_eq!(listed, header);
     assert!(written.lines().skip(1).all(|l| l.starts_with("G2,")));
 
+    // map's codimension-two CSV: `label`, then the documented point keys in order, then the
+    // harmonics; the MAClever on mica's fold curve over Q1 = 1..8 has two cusps.
+    let codim2_csv = directory.path().join("codim2.csv");
+    stdout_of(&[
+        "map",
+        "--case",
+        "maclever-mica",
+        "--vary",
+        "quality-factor-1",
+        "--from",
+        "1",
+        "--to",
+        "8",
+        "--labels",
+        "fold",
+        "--points",
+        "10",
+        "--codim2-csv",
+        codim2_csv.to_str().expect("utf-8 path"),
+    ]);
+    let written = std::fs::read_to_string(&codim2_csv).expect("CSV");
+    let full_header: Vec<&str> = written.lines().next().expect("header").split(',').collect();
+    let (header, harmonic_columns): (Vec<&str>, Vec<&str>) = full_header
+        .iter()
+        .partition(|column| !column.starts_with("harmonic_"));
+    assert_eq!(harmonic_columns.len(), 8);
+    assert_eq!(&full_header[..header.len()], &header[..]);
+    assert_eq!(header[0], "label");
+    let map_keys = &schema["`drumroll map --json`"];
+    for column in &header[1..] {
+        let types = map_keys
+            .get(&format!("codim2_points[].{column}"))
+            .unwrap_or_else(|| panic!("codim-2 CSV column `{column}` is no JSON point key"));
+        assert!(!types.contains("array") && !types.contains("object"));
+    }
+    let section = text
+        .split("## `drumroll map --codim2-csv FILE`")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .expect("the codim-2 CSV section");
+    let listed: Vec<&str> = section
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|word| header.contains(word))
+        .collect();
+    assert_eq!(listed, header);
+    let rows: Vec<&str> = written.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{written}");
+    assert!(rows.iter().all(|row| row.starts_with("cusp,fold,")));
+    assert!(rows
+        .iter()
+        .all(|row| row.split(',').count() == full_header.len()));
+
     // approach's CSV header is the documented line, each column a record key.
     let sweep = stdout_of(&["approach", "--from", "8.8", "--to", "8.79", "--rate", "10"]);
     let full_header = sweep.lines().next().expect("header");

@@ -123,7 +123,13 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
     };
     loop {
         let p = u[n];
-        let map = match problem.period_map(&u.as_slice()[..n], p) {
+        // After a Newton update the evaluation is usually the converged one.
+        let evaluated = if iterations > 0 {
+            problem.period_map_likely_accepted(&u.as_slice()[..n], p)
+        } else {
+            problem.period_map(&u.as_slice()[..n], p)
+        };
+        let map = match evaluated {
             Ok(map) => map,
             Err(e) if recoverable(&e) => return Ok(failed(u, iterations, None, f64::INFINITY)),
             Err(e) => return Err(e),

@@ -14,7 +14,10 @@
 
 use std::cell::RefCell;
 
-use hybrid::{flow_map, Direction, ExtremumKind, FlowMap, HybridSystem, Sensitivity, Settings};
+use hybrid::{
+    flow_map_in, Direction, ExtremumKind, FlowMap, HybridSystem, Sensitivity, Settings, Solver,
+    SolverWorkspace, StepOutcome,
+};
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::ContinuationError;
@@ -43,6 +46,9 @@ pub struct HybridPeriodicProblem<S: Parametrised> {
     start_time: f64,
     settings: Settings,
     buffers: RefCell<Buffers>,
+    /// The solver's buffers, reused by every period map (`hybrid::flow_map_in`: the same run
+    /// without a new solver's allocations).
+    workspace: RefCell<SolverWorkspace>,
 }
 
 /// Scratch vectors for the virtual-minimum estimate.
@@ -98,6 +104,7 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
                 field: vec![0.0; n],
                 shifted: vec![0.0; n],
             }),
+            workspace: RefCell::new(SolverWorkspace::default()),
         })
     }
 
@@ -163,16 +170,34 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
         p: f64,
         sensitivity: Sensitivity,
     ) -> Result<FlowMap, ContinuationError> {
+        self.flow_observed(x, p, sensitivity, &mut |_: &Solver<S>, _: &StepOutcome| {})
+    }
+
+    /// As [`HybridPeriodicProblem::flow`], calling `observer` after every step of the solver
+    /// (as `hybrid::flow_map_observed` does): the same flow map, with whatever the observer
+    /// records along it.
+    ///
+    /// # Errors
+    /// [`ContinuationError::Hybrid`] if the integration fails.
+    pub fn flow_observed(
+        &self,
+        x: &[f64],
+        p: f64,
+        sensitivity: Sensitivity,
+        observer: &mut dyn FnMut(&Solver<S>, &StepOutcome),
+    ) -> Result<FlowMap, ContinuationError> {
         self.system.borrow_mut().set_parameter(p);
         let system = self.system.borrow();
         let duration = self.periods as f64 * system.period();
-        flow_map(
+        flow_map_in(
             &*system,
             self.start_time,
             x,
             duration,
             sensitivity,
             &self.settings,
+            &mut |solver: &Solver<S>, outcome: &StepOutcome| observer(solver, outcome),
+            &mut self.workspace.borrow_mut(),
         )
         .map_err(|source| ContinuationError::Hybrid {
             parameter: p,
@@ -206,6 +231,24 @@ impl<S: Parametrised> PeriodicProblem for HybridPeriodicProblem<S> {
     }
 
     fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError> {
+        self.period_map_observed(x, p, &mut |_: &Solver<S>, _: &StepOutcome| {})
+    }
+}
+
+impl<S: Parametrised> HybridPeriodicProblem<S> {
+    /// The period map at `(x, p)` ([`PeriodicProblem::period_map`]), calling `observer` after
+    /// every step of the integration (as [`HybridPeriodicProblem::flow_observed`]): the same
+    /// map, and what the observer records along the orbit it integrates (the AFM diagram's
+    /// observables of an accepted point, without integrating the point once more).
+    ///
+    /// # Errors
+    /// As [`PeriodicProblem::period_map`].
+    pub fn period_map_observed(
+        &self,
+        x: &[f64],
+        p: f64,
+        observer: &mut dyn FnMut(&Solver<S>, &StepOutcome),
+    ) -> Result<PeriodMap, ContinuationError> {
         let n = self.dim();
         if x.len() != n {
             return Err(ContinuationError::DimensionMismatch {
@@ -214,7 +257,7 @@ impl<S: Parametrised> PeriodicProblem for HybridPeriodicProblem<S> {
                 found: x.len(),
             });
         }
-        let flow = self.flow(x, p, Sensitivity::TransitionAndParameter)?;
+        let flow = self.flow_observed(x, p, Sensitivity::TransitionAndParameter, observer)?;
         let system = self.system.borrow();
         let k = system.contact_surface();
         let duration = self.periods as f64 * system.period();

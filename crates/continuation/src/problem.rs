@@ -65,6 +65,22 @@ pub trait PeriodicProblem {
     /// Any failure to evaluate the map (for a hybrid problem, a failed integration) as a
     /// [`ContinuationError`], typically [`ContinuationError::PeriodMapFailed`].
     fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError>;
+
+    /// As [`PeriodicProblem::period_map`], at a point the corrector expects to accept: an
+    /// evaluation after a Newton update, which converges there unless Newton needs more
+    /// iterations. A problem may do more here that only an accepted point needs (the AFM
+    /// diagram records the orbit's observables during the same integration); the map itself
+    /// must be the same as `period_map`'s. Default: `period_map`.
+    ///
+    /// # Errors
+    /// As [`PeriodicProblem::period_map`].
+    fn period_map_likely_accepted(
+        &self,
+        x: &[f64],
+        p: f64,
+    ) -> Result<PeriodMap, ContinuationError> {
+        self.period_map(x, p)
+    }
 }
 
 /// Check the dimensions and finiteness of a period map returned by `problem` at parameter `p`.

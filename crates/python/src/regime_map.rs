@@ -156,6 +156,7 @@ pub fn compute_regime_map(
         harmonics: options.harmonics,
         json: true,
         csv: None,
+        codim2_csv: None,
         plot: None,
         grid_file: None,
     };

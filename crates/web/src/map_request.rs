@@ -81,6 +81,7 @@ impl MapRequest {
             harmonics: drumroll::approach::DEFAULT_HARMONICS,
             json: true,
             csv: None,
+            codim2_csv: None,
             plot: None,
             grid_file: None,
         }

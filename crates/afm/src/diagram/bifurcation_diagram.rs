@@ -5,12 +5,13 @@
 //! `|dZ| < 1e-9 nm` (MODEL.md section 5).
 
 use continuation::{
-    BranchPoint, Continuation, ContinuationSettings, HybridPeriodicProblem, ParameterDirection,
-    Parametrised, SpecialPoint, SpecialPointKind, StopReason,
+    BranchPoint, Continuation, ContinuationSettings, ParameterDirection, Parametrised,
+    SpecialPoint, SpecialPointKind, StopReason,
 };
 use nalgebra::Complex;
 use serde::Serialize;
 
+use crate::diagram::observed_problem::ObservedPeriodProblem;
 use crate::error::AfmError;
 use crate::model::separation::Separation;
 use crate::model::TappingModel;
@@ -434,8 +435,11 @@ fn branch_until(
     settings.validate()?;
     let mut system = model.clone();
     system.set_separation(Separation::Constant(z_start))?;
-    let problem =
-        HybridPeriodicProblem::new(system.clone(), 1, settings.orbit.integration.clone())?;
+    let problem = ObservedPeriodProblem::new(
+        &system,
+        &settings.orbit.integration,
+        settings.orbit.harmonics,
+    )?;
     let (parameter_min, parameter_max) = match settings.direction {
         ParameterDirection::Decreasing => (settings.z_limit_nm, f64::INFINITY),
         ParameterDirection::Increasing => (f64::NEG_INFINITY, settings.z_limit_nm),
@@ -455,16 +459,15 @@ fn branch_until(
     let margin = settings.ratio_floor_margin_nm;
     // The `Z` where `A/A0` last fell below `min_ratio` (none while it is above).
     let mut below_since: Option<f64> = None;
-    let integration = settings.orbit.integration.clone();
-    let harmonics = settings.orbit.harmonics;
-    // Observables are computed once per point, inside the stop predicate, and kept.
+    // Observables are recorded by the corrector's accepted evaluation (or computed once if it
+    // did not record them), read inside the stop predicate, and kept.
     let mut observed: Vec<Result<OrbitObservables, AfmError>> = Vec::new();
     let mut was_interrupted = false;
     let branch = {
         let observed = &mut observed;
         let was_interrupted = &mut was_interrupted;
         let turned = &mut turned;
-        let mut at_point = system.clone();
+        let observing = &problem;
         Continuation::new(&problem, x0, z_start, continuation_settings)?
             .stop_when(move |point: &BranchPoint| {
                 if interrupted() {
@@ -478,9 +481,7 @@ fn branch_until(
                     return true;
                 }
                 previous_z = point.parameter;
-                at_point.set_parameter(point.parameter);
-                let observables =
-                    orbit_observables(&at_point, point.state.as_slice(), &integration, harmonics);
+                let observables = observing.observables(point.state.as_slice(), point.parameter);
                 let stop = match &observables {
                     Ok(o) if o.amplitude_nm / a0 < min_ratio => {
                         let since = *below_since.get_or_insert(point.parameter);

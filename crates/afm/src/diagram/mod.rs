@@ -2,4 +2,5 @@
 //! pseudo-arclength continuation (MODEL.md section 6), and one quasi-static row of the
 //! brute-force grid (a sweep by transients at fixed `Z`s).
 pub mod bifurcation_diagram;
+pub mod observed_problem;
 pub mod quasi_static;

@@ -171,6 +171,26 @@ pub struct MapCodim2Point {
     pub precision: f64,
     /// Whether the location converged.
     pub converged: bool,
+    /// Phase lag of the first harmonic there, degrees.
+    pub phase_deg: f64,
+    /// Energy dissipated in the sample per drive period, `-int F_ts w' dt`, eV (MODEL.md
+    /// section 10; 0 for a conservative law).
+    pub dissipated_ev: f64,
+    /// The virial `(1/T) int F_ts w dt`, eV (MODEL.md section 10).
+    pub virial_ev: f64,
+    /// The largest indentation of the law's contact geometry over the period, nm (0 without
+    /// contact).
+    pub max_indentation_nm: f64,
+    /// The mean indentation over the time in contact, nm (0 without contact).
+    pub mean_indentation_nm: f64,
+    /// The largest mode's energy-balance residual over the total damping loss (MODEL.md
+    /// section 10).
+    pub energy_balance_residual: f64,
+    /// Harmonics `n = 1..N` of `u` (`N = settings.diagram.orbit.harmonics`; MODEL.md
+    /// section 10).
+    pub harmonics: Vec<Harmonic>,
+    /// The orbit's state at `t = 0` (nm, nm/us).
+    pub state: Vec<f64>,
 }
 
 /// A computed regime map.
@@ -342,14 +362,14 @@ pub fn regime_map(
             settings.diagram.orbit.harmonics,
         )?);
         for point in &curve.codim2_points {
-            let (_, observables) = observe(
+            let (state, observables) = observe(
                 &family,
                 point.second_parameter,
                 point.parameter,
                 point.state.as_slice(),
                 point.section_time,
                 &integration,
-                1,
+                settings.diagram.orbit.harmonics,
             )?;
             codim2_points.push(MapCodim2Point {
                 label: point.kind.label().to_string(),
@@ -360,6 +380,14 @@ pub fn regime_map(
                 impacts: [point.impacts.0, point.impacts.1],
                 precision: point.precision,
                 converged: point.converged,
+                phase_deg: observables.phase_deg,
+                dissipated_ev: observables.dissipated_ev,
+                virial_ev: observables.virial_ev,
+                max_indentation_nm: observables.max_indentation_nm,
+                mean_indentation_nm: observables.mean_indentation_nm,
+                energy_balance_residual: observables.energy_balance_residual,
+                harmonics: observables.harmonics,
+                state,
             });
         }
     }
