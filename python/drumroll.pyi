@@ -273,7 +273,9 @@ class RegimeMap:
         """Each curve's ends by label: reason, parameter, z_nm (nm), error."""
     @property
     def codim2_points(self) -> List[Dict[str, Any]]:
-        """The codimension-two points met on the curves."""
+        """The codimension-two points met on the curves, each with the observables of its
+        orbit (`phase_deg`, `dissipated_ev`, `virial_ev`, indentations, `harmonics`, `state`),
+        as `map --json` prints them."""
     @property
     def parameter_info(self) -> Dict[str, Any]:
         """name, unit, from, to, case_value of the varied parameter."""
