@@ -35,6 +35,7 @@ const CANTILEVERS: &[Embedded] = &[
     embedded!("cantilevers", "biolever"),
     embedded!("cantilevers", "maclever"),
     embedded!("cantilevers", "rectangular-silicon-water"),
+    embedded!("cantilevers", "rectangular-silicon-air"),
 ];
 
 const SAMPLES: &[Embedded] = &[
@@ -45,6 +46,7 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "soft-viscoelastic"),
     embedded!("samples", "mica-hydration"),
     embedded!("samples", "adhesive-soft"),
+    embedded!("samples", "mica-humid"),
 ];
 
 const CASES: &[Embedded] = &[
@@ -60,6 +62,7 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "biolever-mica-acoustic"),
     embedded!("cases", "biolever-mica-bimodal"),
     embedded!("cases", "biolever-adhesive"),
+    embedded!("cases", "rectangular-air-mica-humid"),
 ];
 
 const LINES: &[Embedded] = &[embedded!("lines", "membrane-patch")];
@@ -68,13 +71,15 @@ fn names(table: &[Embedded]) -> Vec<&'static str> {
     table.iter().map(|entry| entry.name).collect()
 }
 
-/// The names of the built-in cantilevers (`biolever`, `maclever`, `rectangular-silicon-water`).
+/// The names of the built-in cantilevers (`biolever`, `maclever`, `rectangular-silicon-water`,
+/// `rectangular-silicon-air`).
 pub fn cantilever_names() -> Vec<&'static str> {
     names(CANTILEVERS)
 }
 
 /// The names of the built-in samples (`mica`, `soft`, `purple-membrane`,
-/// `purple-membrane-film`, `soft-viscoelastic`, `mica-hydration`, `adhesive-soft`).
+/// `purple-membrane-film`, `soft-viscoelastic`, `mica-hydration`, `adhesive-soft`,
+/// `mica-humid`).
 pub fn sample_names() -> Vec<&'static str> {
     names(SAMPLES)
 }
@@ -82,7 +87,8 @@ pub fn sample_names() -> Vec<&'static str> {
 /// The names of the built-in cases (`biolever-mica`, `biolever-soft`, `maclever-mica`,
 /// `maclever-soft`, `maclever-mica-experiment`, `maclever-membrane-experiment`,
 /// `maclever-membrane-film`, `biolever-soft-viscoelastic`, `biolever-mica-hydration`,
-/// `biolever-mica-acoustic`, `biolever-mica-bimodal`, `biolever-adhesive`).
+/// `biolever-mica-acoustic`, `biolever-mica-bimodal`, `biolever-adhesive`,
+/// `rectangular-air-mica-humid`).
 pub fn case_names() -> Vec<&'static str> {
     names(CASES)
 }
