@@ -207,15 +207,9 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
         let a = self.problem.flow(x, p, q, t0, s - t0, sensitivity)?;
         // The second leg continues in the mode the first ended in (at the grazing `d = 0`,
         // `d' = 0` a hysteretic system's mode_of cannot tell attached from free).
-        let b = self.problem.flow_in(
-            &a.state,
-            Some(a.mode),
-            p,
-            q,
-            s,
-            t0 + d - s,
-            sensitivity,
-        )?;
+        let b = self
+            .problem
+            .flow_in(&a.state, Some(a.mode), p, q, s, t0 + d - s, sensitivity)?;
         Ok((a, b, d))
     }
 
