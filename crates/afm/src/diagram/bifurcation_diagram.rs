@@ -370,13 +370,18 @@ pub fn diagram_until(
 /// The most steps of [`settle_on_period_one`]'s walk past a branch break.
 const MAX_WALK_STEPS: usize = 100;
 
+/// The recurrence periods of each step of [`settle_on_period_one`]'s walk after the first
+/// (the first uses the settings' own): the walk looks for a stable period-1 orbit, not for the
+/// period-k attractors it passes.
+const WALK_RECURRENCE_PERIODS: usize = 400;
+
 /// The steady period-1 orbit the cantilever settles on past a hysteretic law's branch break:
 /// transients from `state` at `z_jump`, polished by Newton (`steady_orbit` with
 /// [`OrbitStart::AfterTransients`]); where they settle on no stable period-1 orbit (a
 /// dissipative attachment in a high-Q cantilever taps only every few periods just below
 /// `G1`: each tap's loss, the loop's area, exceeds what one period's drive can replace) the
-/// walk goes on in steps of `A0 / 100` in the direction of `sign`, each from the last state the
-/// transients reached, until a stable period-1 orbit converges, `Z` passes `z_limit_nm`, or
+/// walk goes on in steps of `A0 / 100` in the direction of `sign`, each from the state the
+/// previous step reported (its recurrence search cut to [`WALK_RECURRENCE_PERIODS`]), until a stable period-1 orbit converges, `Z` passes `z_limit_nm`, or
 /// [`MAX_WALK_STEPS`] steps. Returns the `Z` and the orbit.
 fn settle_on_period_one(
     system: &mut TappingModel,
@@ -388,16 +393,28 @@ fn settle_on_period_one(
     let step = system.free_amplitude_nm() / 100.0;
     let mut z = z_jump;
     let mut from = state.to_vec();
+    // Only a stable period-1 orbit ends the walk: past its first step, the search for another
+    // attractor by recurrence is cut to WALK_RECURRENCE_PERIODS periods.
+    let walking = SteadyOrbitSettings {
+        recurrence_periods: settings
+            .orbit
+            .recurrence_periods
+            .min(WALK_RECURRENCE_PERIODS),
+        ..settings.orbit.clone()
+    };
+    let mut first = true;
     for _ in 0..MAX_WALK_STEPS {
         if sign * (z - settings.z_limit_nm) >= 0.0 {
             return None;
         }
         system.set_parameter(z);
+        let orbit_settings = if first { &settings.orbit } else { &walking };
+        first = false;
         let orbit = steady_orbit(
             system,
             z,
             OrbitStart::AfterTransients(&from),
-            &settings.orbit,
+            orbit_settings,
         )
         .ok()?;
         if orbit.converged && orbit.multiplicity == 1 && orbit.stable {
