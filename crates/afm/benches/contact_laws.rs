@@ -1,8 +1,9 @@
 //! Benchmark of the contact laws (MODEL.md section 9): the approach diagram
 //! (`DiagramSettings::approach`) of the Biolever and the MAClever on the soft sample with a DMT
 //! law (H = 5e-22 J, a0 = 0.165 nm), a clipped Kelvin-Voigt law (eta = 100 Pa s), a standard
-//! linear solid (E0 = 1 GPa, Einf = 0.4 GPa, tau = 5 us) and Hertz with the hydration force
-//! (10 MPa, 0.25 nm, 0.3 nm), against the Hertz diagram of the same case. Target: each within 3 times the Hertz time.
+//! linear solid (E0 = 1 GPa, Einf = 0.4 GPa, tau = 5 us), Hertz with the hydration force
+//! (10 MPa, 0.25 nm, 0.3 nm) and JKR (W = 0.5 mJ/m^2, the `adhesive-soft` sample), against the
+//! Hertz diagram of the same case. Target: each within 3 times the Hertz time.
 //!
 //! Run with `cargo bench -p afm --bench contact_laws`; `-- --repetitions N` (default 5) sets
 //! the repetitions of each diagram, whose median thread CPU time is reported.
@@ -84,6 +85,10 @@ fn main() {
             Some(
                 r#"{"law": "hertz"}, "hydration": {"pressure_mpa": 10, "layer_spacing_nm": 0.25, "decay_length_nm": 0.3}"#,
             ),
+        ),
+        (
+            "jkr",
+            Some(r#"{"law": "jkr", "work_of_adhesion_mj_per_m2": 0.5}"#),
         ),
     ];
     for (cantilever, a0) in [("biolever", 10.0), ("maclever", 20.0)] {

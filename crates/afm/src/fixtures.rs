@@ -36,6 +36,7 @@ const CANTILEVERS: &[Embedded] = &[
     embedded!("cantilevers", "maclever"),
     embedded!("cantilevers", "rectangular-silicon-water"),
     embedded!("cantilevers", "silicon-air"),
+    embedded!("cantilevers", "rectangular-silicon-air"),
 ];
 
 const SAMPLES: &[Embedded] = &[
@@ -48,6 +49,7 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "adhesive-soft"),
     embedded!("samples", "polymer-strong-vdw"),
     embedded!("samples", "polymer-weak-vdw"),
+    embedded!("samples", "mica-humid"),
 ];
 
 const CASES: &[Embedded] = &[
@@ -64,6 +66,7 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "biolever-mica-bimodal"),
     embedded!("cases", "biolever-adhesive"),
     embedded!("cases", "silicon-air-polymer"),
+    embedded!("cases", "rectangular-air-mica-humid"),
 ];
 
 const LINES: &[Embedded] = &[

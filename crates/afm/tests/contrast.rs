@@ -87,12 +87,12 @@ fn energy_balance_closes_on_every_case_and_law() {
         model
             .set_separation(Separation::Constant(z))
             .expect("separation");
-        checked.push((name.to_string(), orbit(&model), model.mode_count()));
+        checked.push((name.to_string(), model.mode_count(), orbit(&model)));
     }
     for (name, contact, z) in LAWS {
-        checked.push((name.to_string(), orbit(&model_with(contact, z, 2)), 2));
+        checked.push((name.to_string(), 2, orbit(&model_with(contact, z, 2))));
     }
-    for (name, orbit, modes) in &checked {
+    for (name, modes, orbit) in &checked {
         let whole = orbit.observables();
         assert!(!whole.impacts.is_empty(), "{name}: no contact");
         assert!(
@@ -104,7 +104,7 @@ fn energy_balance_closes_on_every_case_and_law() {
         for period in &orbit.periods {
             assert!(period.energy_balance_residual < 1e-9, "{name}");
         }
-        assert_eq!(whole.mode_energy.len(), *modes);
+        assert_eq!(whole.mode_energy.len(), *modes, "{name}");
         // The shares add up to the dissipation (and, under an acoustic drive, the contact
         // force's work on the moving base, MODEL.md section 14).
         let shares: f64 = whole

@@ -121,12 +121,18 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
     }
 
     /// `h`, `dh/dt` at `(s, y)` and their derivatives in state, time and `p`.
-    fn gap_at(&self, s: f64, y: &[f64], p: f64, q: f64) -> Result<GapAt, ContinuationError> {
+    fn gap_at(
+        &self,
+        s: f64,
+        y: &[f64],
+        mode: hybrid::Mode,
+        p: f64,
+        q: f64,
+    ) -> Result<GapAt, ContinuationError> {
         let n = y.len();
         let (h, gradient, partials, rate, rate_gradient, rate_t, field) =
             self.problem.with_system(p, q, |system| {
                 let k = system.contact_surface();
-                let mode = system.mode_of(s, y);
                 let rate_at = |t: f64, state: &[f64]| system.switching_rate(k, mode, t, state);
                 let mut gradient = vec![0.0; n];
                 let partials = system.switching_gradient(k, s, y, &mut gradient);
@@ -159,7 +165,7 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
         let rate_p = |pp: f64| {
             self.problem.with_system(pp, q, |system| {
                 let k = system.contact_surface();
-                system.switching_rate(k, system.mode_of(s, y), s, y)
+                system.switching_rate(k, mode, s, y)
             })
         };
         let rate_dp = (rate_p(p + e)? - rate_p(p - e)?) / (2.0 * e);
@@ -199,9 +205,11 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
             });
         }
         let a = self.problem.flow(x, p, q, t0, s - t0, sensitivity)?;
+        // The second leg continues in the mode the first ended in (at the grazing `d = 0`,
+        // `d' = 0` a hysteretic system's mode_of cannot tell attached from free).
         let b = self
             .problem
-            .flow(&a.state, p, q, s, t0 + d - s, sensitivity)?;
+            .flow_in(&a.state, Some(a.mode), p, q, s, t0 + d - s, sensitivity)?;
         Ok((a, b, d))
     }
 
@@ -221,10 +229,10 @@ impl<'a, F: SystemFamily> Defining<'a, F> {
             gradients,
             time,
             parameter: partial_p,
-        } = self.gap_at(s, &a.state, p, q)?;
+        } = self.gap_at(s, &a.state, a.mode, p, q)?;
         let dq = Self::q_step(q);
         let (aq, bq, _) = self.split_flows(x, s, p, q + dq, Sensitivity::None)?;
-        let values_q = self.gap_at(s, &aq.state, p, q + dq)?.values;
+        let values_q = self.gap_at(s, &aq.state, aq.mode, p, q + dq)?.values;
         let m = n + 3;
         let mut residual = DVector::zeros(n + 2);
         let mut jacobian = DMatrix::zeros(n + 2, m);

@@ -187,8 +187,37 @@ impl<F: SystemFamily> TwoParameterProblem<F> {
         duration: f64,
         sensitivity: Sensitivity,
     ) -> Result<FlowMap, ContinuationError> {
-        self.on_member(p, q, |system| {
-            flow_map(system, t_from, x, duration, sensitivity, &self.settings)
+        self.flow_in(x, None, p, q, t_from, duration, sensitivity)
+    }
+
+    /// As [`Self::flow`], started in `mode` if given (the mode an earlier flow ended in, its
+    /// [`FlowMap::mode`]: a period map split at a grazing continues in it, as the state alone
+    /// does not tell a hysteretic system's mode there), else in the system's `mode_of`.
+    ///
+    /// # Errors
+    /// As [`Self::flow`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn flow_in(
+        &self,
+        x: &[f64],
+        mode: Option<hybrid::Mode>,
+        p: f64,
+        q: f64,
+        t_from: f64,
+        duration: f64,
+        sensitivity: Sensitivity,
+    ) -> Result<FlowMap, ContinuationError> {
+        self.on_member(p, q, |system| match mode {
+            Some(mode) => hybrid::flow_map_from_mode(
+                system,
+                t_from,
+                x,
+                mode,
+                duration,
+                sensitivity,
+                &self.settings,
+            ),
+            None => flow_map(system, t_from, x, duration, sensitivity, &self.settings),
         })?
         .map_err(|source| ContinuationError::Hybrid {
             parameter: p,

@@ -8,7 +8,7 @@ use crate::event::{Event, Extremum};
 use crate::sensitivity::Sensitivity;
 use crate::settings::Settings;
 use crate::solver::{Solver, Statistics, StepOutcome};
-use crate::system::HybridSystem;
+use crate::system::{HybridSystem, Mode};
 use crate::workspace::SolverWorkspace;
 
 /// The result of integrating over `[t0, t0 + duration]`.
@@ -27,6 +27,8 @@ pub struct FlowMap {
     pub extrema: Vec<Extremum>,
     /// Work counters.
     pub statistics: Statistics,
+    /// The mode at `t0 + duration` (for [`flow_map_from_mode`] to continue the flow in it).
+    pub mode: Mode,
 }
 
 /// Integrate `system` from `(t0, x0)` over `duration` (system time units, `>= 0`).
@@ -106,6 +108,64 @@ where
     S: HybridSystem + ?Sized,
     O: FnMut(&Solver<S>, &StepOutcome),
 {
+    flow_map_in_mode(
+        system,
+        t0,
+        x0,
+        None,
+        duration,
+        sensitivity,
+        settings,
+        observer,
+        workspace,
+    )
+}
+
+/// As [`flow_map`], started in `mode` instead of the mode [`HybridSystem::mode_of`] gives at
+/// `(t0, x0)` ([`Solver::set_mode`]): the continuation of a flow that ended in `mode` (its
+/// [`FlowMap::mode`]), for a hysteretic system whose mode the state alone does not tell.
+///
+/// # Errors
+/// As [`flow_map`].
+pub fn flow_map_from_mode<S: HybridSystem + ?Sized>(
+    system: &S,
+    t0: f64,
+    x0: &[f64],
+    mode: Mode,
+    duration: f64,
+    sensitivity: Sensitivity,
+    settings: &Settings,
+) -> Result<FlowMap, HybridError> {
+    flow_map_in_mode(
+        system,
+        t0,
+        x0,
+        Some(mode),
+        duration,
+        sensitivity,
+        settings,
+        &mut |_: &Solver<S>, _: &StepOutcome| {},
+        &mut SolverWorkspace::default(),
+    )
+}
+
+/// [`flow_map_in`] in `mode` if given, else in [`HybridSystem::mode_of`]'s.
+#[allow(clippy::too_many_arguments)]
+fn flow_map_in_mode<S, O>(
+    system: &S,
+    t0: f64,
+    x0: &[f64],
+    mode: Option<Mode>,
+    duration: f64,
+    sensitivity: Sensitivity,
+    settings: &Settings,
+    observer: &mut O,
+    workspace: &mut SolverWorkspace,
+) -> Result<FlowMap, HybridError>
+where
+    S: HybridSystem + ?Sized,
+    O: FnMut(&Solver<S>, &StepOutcome),
+{
     let t_end = t0 + duration;
     if !duration.is_finite() || duration < 0.0 || !t_end.is_finite() {
         return Err(HybridError::InvalidEndTime { t: t0, t_end });
@@ -118,6 +178,9 @@ where
         settings.clone(),
         std::mem::take(workspace),
     )?;
+    if let Some(mode) = mode {
+        solver.set_mode(mode);
+    }
     let mut events = Vec::new();
     let mut extrema = Vec::new();
     loop {
@@ -137,6 +200,7 @@ where
         events,
         extrema,
         statistics: *solver.statistics(),
+        mode: solver.mode(),
     };
     *workspace = solver.into_workspace();
     Ok(map)

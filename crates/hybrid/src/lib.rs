@@ -140,7 +140,7 @@ pub use accelerations::{Accelerations, ExactFlow, SwitchingStructure, TaylorExpa
 pub use clock::Clock;
 pub use error::HybridError;
 pub use event::{Event, Extremum, ExtremumKind};
-pub use flow_map::{flow_map, flow_map_in, flow_map_observed, FlowMap};
+pub use flow_map::{flow_map, flow_map_from_mode, flow_map_in, flow_map_observed, FlowMap};
 pub use sensitivity::{LinearisationBuffers, Sensitivity};
 pub use settings::{SensitivityMethod, Settings};
 pub use solver::{Solver, Statistics, StepOutcome};

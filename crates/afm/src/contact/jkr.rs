@@ -26,18 +26,43 @@ pub struct JkrContact {
     pub tip_radius_nm: f64,
     /// The work of adhesion `W`, nN/nm (= N/m; the sample file gives mJ/m^2).
     pub work_of_adhesion_nn_per_nm: f64,
+    /// `k = sqrt(2 pi W / E*)`, nm^{1/2}, computed once by [`Self::new`].
+    adhesion_root: f64,
+    /// `b_c = (k R / 4)^{1/3}`, nm^{1/2}.
+    critical_root: f64,
+    /// `(k R)^{1/3}`, nm^{1/2}: the adhesion's part of the start of [`Self::contact_radius_nm`].
+    adhesion_reach: f64,
 }
 
 impl JkrContact {
+    /// The law of reduced modulus `E*` (GPa), tip radius `R` (nm) and work of adhesion `W`
+    /// (nN/nm), with its constants `k`, `b_c` and `(k R)^{1/3}` computed once (the force is
+    /// evaluated at every stage of every integration step).
+    pub fn new(
+        effective_modulus_gpa: f64,
+        tip_radius_nm: f64,
+        work_of_adhesion_nn_per_nm: f64,
+    ) -> Self {
+        let adhesion_root = (2.0 * PI * work_of_adhesion_nn_per_nm / effective_modulus_gpa).sqrt();
+        Self {
+            effective_modulus_gpa,
+            tip_radius_nm,
+            work_of_adhesion_nn_per_nm,
+            adhesion_root,
+            critical_root: (adhesion_root * tip_radius_nm / 4.0).cbrt(),
+            adhesion_reach: (adhesion_root * tip_radius_nm).cbrt(),
+        }
+    }
+
     /// `k = sqrt(2 pi W / E*)`, nm^{1/2}.
     fn adhesion_root(&self) -> f64 {
-        (2.0 * PI * self.work_of_adhesion_nn_per_nm / self.effective_modulus_gpa).sqrt()
+        self.adhesion_root
     }
 
     /// `b_c = sqrt(a_c) = (k R / 4)^{1/3}`, nm^{1/2}: the square root of the contact radius at
     /// pull-off.
     fn critical_root(&self) -> f64 {
-        (self.adhesion_root() * self.tip_radius_nm / 4.0).cbrt()
+        self.critical_root
     }
 
     /// The pull-off gap `d_po = (3/4) k b_c = (3/4) (pi^2 W^2 R / E*^2)^{1/3}`, nm: the
@@ -66,18 +91,27 @@ impl JkrContact {
     }
 
     /// The contact radius `a` (nm) at indentation `delta` (nm) on the stable branch: the root
-    /// `b = sqrt(a) >= b_c` of `b^4/R - k b = delta`, by Newton's method from the upper bound
-    /// `(R max(delta, 0))^{1/4} + (k R)^{1/3}`, from which the iterates decrease monotonically
-    /// (the function is convex and increasing for `b >= b_c`). Below `delta_c` (past pull-off)
-    /// it returns `a_c`.
+    /// `b = sqrt(a) >= b_c` of `b^4/R - k b = delta`, by Newton's method from an upper bound,
+    /// from which the iterates decrease monotonically (the function is convex and increasing
+    /// for `b >= b_c`): `b_u = (R max(delta, 0))^{1/4} + (k R)^{1/3}` tightened by one step of
+    /// the fixed point `b = (R (delta + k b))^{1/4}` (increasing in `b`, so `b_u`'s image is
+    /// still above the root). Below `delta_c` (past pull-off) it returns `a_c`.
     pub fn contact_radius_nm(&self, indentation_nm: f64) -> f64 {
+        let b = self.contact_root(indentation_nm);
+        b * b
+    }
+
+    /// `b = sqrt(a)` (nm^{1/2}) at indentation `delta` (nm): the Newton iteration of
+    /// [`Self::contact_radius_nm`].
+    fn contact_root(&self, indentation_nm: f64) -> f64 {
         let r = self.tip_radius_nm;
-        let k = self.adhesion_root();
-        let critical = self.critical_root();
+        let k = self.adhesion_root;
+        let critical = self.critical_root;
         if indentation_nm <= -self.pull_off_gap_nm() {
-            return critical * critical;
+            return critical;
         }
-        let mut b = (r * indentation_nm.max(0.0)).sqrt().sqrt() + (k * r).cbrt();
+        let loose = (r * indentation_nm.max(0.0)).sqrt().sqrt() + self.adhesion_reach;
+        let mut b = (r * (indentation_nm + k * loose)).sqrt().sqrt().min(loose);
         for _ in 0..200 {
             let b3 = b * b * b;
             let value = b3 * b / r - k * b - indentation_nm;
@@ -95,7 +129,7 @@ impl JkrContact {
                 break;
             }
         }
-        b * b
+        b
     }
 
     /// The coefficient `K` (nN/nm^{1/2}) of the force's square-root singularity at pull-off,
@@ -117,15 +151,20 @@ impl JkrContact {
     /// unbounded at pull-off (`d delta/da = 0`); there it is evaluated with `d delta/da` floored
     /// at `1e-12 (2 a / R)` (finite, the force continuous).
     pub fn force_slopes(&self, gap_nm: f64) -> ForceSlopes {
-        let a = self.contact_radius_nm(-gap_nm);
+        // In b = sqrt(a), with sqrt(8 pi W E*) = 2 E* k and sqrt(pi W / (2 E*)) = k / 2, the
+        // relations above need no further square roots.
+        let b = self.contact_root(-gap_nm);
+        let (a, b3) = (b * b, b * b * b);
         let e = self.effective_modulus_gpa;
         let r = self.tip_radius_nm;
-        let w = self.work_of_adhesion_nn_per_nm;
-        let force_rate = 4.0 * e * a * a / r - 1.5 * (8.0 * PI * w * e * a).sqrt();
+        let k = self.adhesion_root;
+        let adhesion = 2.0 * e * k; // sqrt(8 pi W E*), nN/nm^{3/2}
+        let force = 4.0 * e * b3 * b3 / (3.0 * r) - adhesion * b3;
+        let force_rate = 4.0 * e * a * a / r - 1.5 * adhesion * b;
         let floor = 1e-12 * 2.0 * a / r;
-        let indentation_rate = (2.0 * a / r - (PI * w / (2.0 * e * a)).sqrt()).max(floor);
+        let indentation_rate = (2.0 * a / r - 0.5 * k / b).max(floor);
         ForceSlopes {
-            force: self.force_at_radius(a),
+            force,
             gap_slope: -force_rate / indentation_rate,
             rate_slope: 0.0,
         }
@@ -137,11 +176,7 @@ mod tests {
     use super::*;
 
     fn law() -> JkrContact {
-        JkrContact {
-            effective_modulus_gpa: 1.2,
-            tip_radius_nm: 30.0,
-            work_of_adhesion_nn_per_nm: 0.02,
-        }
+        JkrContact::new(1.2, 30.0, 0.02)
     }
 
     /// The closed forms of Maugis 2000 (ch. 4): pull-off under fixed grips at
@@ -191,10 +226,7 @@ mod tests {
     /// to 1e-3 relative at delta = 1 nm, the correction being of order `(W/(E* delta))^{1/2}`).
     #[test]
     fn vanishing_adhesion_tends_to_hertz() {
-        let jkr = JkrContact {
-            work_of_adhesion_nn_per_nm: 1e-12,
-            ..law()
-        };
+        let jkr = JkrContact::new(1.2, 30.0, 1e-12);
         let hertz = 4.0 / 3.0 * 1.2 * 30f64.sqrt();
         let f = jkr.force_slopes(-1.0).force;
         assert!((f - hertz).abs() < 1e-3 * hertz, "{f} vs {hertz}");

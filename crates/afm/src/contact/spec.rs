@@ -408,11 +408,11 @@ impl ContactSpec {
             } => ContactLaw::Hertz(sphere(e, tip_radius_nm)),
             Self::Jkr {
                 work_of_adhesion_mj_per_m2,
-            } => ContactLaw::Jkr(JkrContact {
-                effective_modulus_gpa: e,
+            } => ContactLaw::Jkr(JkrContact::new(
+                e,
                 tip_radius_nm,
-                work_of_adhesion_nn_per_nm: work_of_adhesion_mj_per_m2 * MJ_PER_M2_IN_NN_PER_NM,
-            }),
+                work_of_adhesion_mj_per_m2 * MJ_PER_M2_IN_NN_PER_NM,
+            )),
             Self::Capillary {
                 relative_humidity,
                 surface_tension_mn_per_m,

@@ -16,7 +16,7 @@ use crate::error::AfmError;
 use crate::model::separation::Separation;
 use crate::model::TappingModel;
 use crate::orbit::observables::{orbit_observables, GapMinimum, Harmonic, OrbitObservables};
-use crate::orbit::steady_orbit::{steady_orbit, OrbitStart, SteadyOrbitSettings};
+use crate::orbit::steady_orbit::{steady_orbit, OrbitStart, SteadyOrbit, SteadyOrbitSettings};
 
 /// How a diagram is computed. [`DiagramSettings::approach`] and [`DiagramSettings::retract`]
 /// give the defaults; every field is checked by [`DiagramSettings::validate`].
@@ -303,7 +303,8 @@ const MAX_JUMPS: usize = 16;
 /// reaches the release surface (`pull-off`: the force drops to zero there), so the period map
 /// jumps and the corrector fails just past the point. There the diagram does what the
 /// cantilever does: it takes the orbit that transients from the last branch point settle on,
-/// half a largest step further (`steady_orbit` with [`OrbitStart::AfterTransients`]), and
+/// half a largest step further (`steady_orbit` with [`OrbitStart::AfterTransients`]; past a
+/// band where they settle on no stable period-1 orbit, [`settle_on_period_one`]), and
 /// continues from it; on a retract, the end of an attached branch that is not a located
 /// grazing is labelled `pull-off` (located to the continuation's smallest step, 1e-8).
 pub fn diagram_until(
@@ -350,19 +351,11 @@ pub fn diagram_until(
                 .special_points
                 .push(branch_end_point("pull-off", &last, &observables));
         }
-        system.set_parameter(z_jump);
-        let orbit = steady_orbit(
-            &system,
-            z_jump,
-            OrbitStart::AfterTransients(&last.state),
-            &settings.orbit,
-        );
-        let Ok(orbit) = orbit else {
+        let Some((z_jump, orbit)) =
+            settle_on_period_one(&mut system, &last.state, z_jump, sign, settings)
+        else {
             break;
         };
-        if !orbit.converged || orbit.multiplicity != 1 {
-            break;
-        }
         let next;
         (next, broke) = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
         diagram.points.extend(next.points);
@@ -386,6 +379,65 @@ pub fn diagram_until(
             || !grazings.iter().any(|z| (z - p.z_nm).abs() < 1e-6)
     });
     Ok(diagram)
+}
+
+/// The most steps of [`settle_on_period_one`]'s walk past a branch break.
+const MAX_WALK_STEPS: usize = 100;
+
+/// The recurrence periods of each step of [`settle_on_period_one`]'s walk after the first
+/// (the first uses the settings' own): the walk looks for a stable period-1 orbit, not for the
+/// period-k attractors it passes.
+const WALK_RECURRENCE_PERIODS: usize = 400;
+
+/// The steady period-1 orbit the cantilever settles on past a hysteretic law's branch break:
+/// transients from `state` at `z_jump`, polished by Newton (`steady_orbit` with
+/// [`OrbitStart::AfterTransients`]); where they settle on no stable period-1 orbit (a
+/// dissipative attachment in a high-Q cantilever taps only every few periods just below
+/// `G1`: each tap's loss, the loop's area, exceeds what one period's drive can replace) the
+/// walk goes on in steps of `A0 / 100` in the direction of `sign`, each from the state the
+/// previous step reported (its recurrence search cut to [`WALK_RECURRENCE_PERIODS`]), until a stable period-1 orbit converges, `Z` passes `z_limit_nm`, or
+/// [`MAX_WALK_STEPS`] steps. Returns the `Z` and the orbit.
+fn settle_on_period_one(
+    system: &mut TappingModel,
+    state: &[f64],
+    z_jump: f64,
+    sign: f64,
+    settings: &DiagramSettings,
+) -> Option<(f64, SteadyOrbit)> {
+    let step = system.free_amplitude_nm() / 100.0;
+    let mut z = z_jump;
+    let mut from = state.to_vec();
+    // Only a stable period-1 orbit ends the walk: past its first step, the search for another
+    // attractor by recurrence is cut to WALK_RECURRENCE_PERIODS periods.
+    let walking = SteadyOrbitSettings {
+        recurrence_periods: settings
+            .orbit
+            .recurrence_periods
+            .min(WALK_RECURRENCE_PERIODS),
+        ..settings.orbit.clone()
+    };
+    let mut first = true;
+    for _ in 0..MAX_WALK_STEPS {
+        if sign * (z - settings.z_limit_nm) >= 0.0 {
+            return None;
+        }
+        system.set_parameter(z);
+        let orbit_settings = if first { &settings.orbit } else { &walking };
+        first = false;
+        let orbit = steady_orbit(
+            system,
+            z,
+            OrbitStart::AfterTransients(&from),
+            orbit_settings,
+        )
+        .ok()?;
+        if orbit.converged && orbit.multiplicity == 1 && orbit.stable {
+            return Some((z, orbit));
+        }
+        from = orbit.state;
+        z += sign * step;
+    }
+    None
 }
 
 /// The special point `label` at the last point `last` of a branch that ends there (a

@@ -405,6 +405,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         Ok(())
     }
 
+    /// Continue in `mode` instead of the mode [`HybridSystem::mode_of`] gave at the start: for
+    /// a flow that continues another one's end (a period map split at a grazing), where the
+    /// state alone does not tell a hysteretic system's mode (the attached bit of a contact
+    /// that forms at one surface and breaks at another; [`HybridSystem::mode_after_crossing`]).
+    /// Call it before the first step.
+    pub fn set_mode(&mut self, mode: Mode) {
+        self.mode = mode;
+    }
+
     /// Current time (system time units).
     pub fn t(&self) -> f64 {
         self.t
