@@ -133,6 +133,21 @@ fn parse<T: DeserializeOwned>(file: &str, text: &str) -> Result<T, AfmError> {
     })
 }
 
+/// Read the file at `path` and parse it with `parse(file, text, directory)`: `file` names it in
+/// errors, `directory` (the file's own) resolves the relative paths written in it. The one
+/// loader of the files that name other files (scan lines, rasters).
+pub(crate) fn load_relative<T>(
+    path: &Path,
+    parse: impl FnOnce(&str, &str, Option<&Path>) -> Result<T, AfmError>,
+) -> Result<T, AfmError> {
+    let text = read(path)?;
+    parse(
+        &path.display().to_string(),
+        &text,
+        Some(path.parent().unwrap_or_else(|| Path::new(""))),
+    )
+}
+
 fn read(path: &Path) -> Result<String, AfmError> {
     std::fs::read_to_string(path).map_err(|source| AfmError::Io {
         file: path.display().to_string(),

@@ -21,7 +21,8 @@ use serde::Deserialize;
 
 use crate::error::AfmError;
 use crate::fixtures::{
-    builtin_line_text, builtin_sample, line_names, load_sample, parse_json, sample_names,
+    builtin_line_text, builtin_sample, line_names, load_relative, load_sample, parse_json,
+    sample_names,
 };
 use crate::model::sample::Sample;
 use crate::validation::{check, invalid, Interval};
@@ -179,15 +180,7 @@ impl ScanLine {
 
     /// Load a line file from `path` (sample paths in it relative to its directory).
     pub fn load(path: &Path) -> Result<Self, AfmError> {
-        let text = std::fs::read_to_string(path).map_err(|source| AfmError::Io {
-            file: path.display().to_string(),
-            source,
-        })?;
-        Self::parse(
-            &path.display().to_string(),
-            &text,
-            Some(path.parent().unwrap_or_else(|| Path::new(""))),
-        )
+        load_relative(path, Self::parse)
     }
 
     /// The built-in line `name` (`fixtures/lines/`).

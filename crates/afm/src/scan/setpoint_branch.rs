@@ -12,7 +12,7 @@
 //! another attractor, and the walk resumes from there. Where two stable orbits coexist at the
 //! setpoint, the scan stays on the one it came from.
 
-use crate::diagram::bifurcation_diagram::{approach_diagram, BifurcationDiagram, DiagramSettings};
+use crate::diagram::bifurcation_diagram::{approach_diagram, BifurcationDiagram};
 use crate::error::AfmError;
 use crate::model::TappingModel;
 use crate::orbit::steady_orbit::{
@@ -61,14 +61,7 @@ impl SetpointBranch {
         search: &AmplitudeRatioSearch,
         settings: &SteadyOrbitSettings,
     ) -> Result<Self, AfmError> {
-        let a0 = model.free_amplitude_nm();
-        let diagram_settings = DiagramSettings {
-            orbit: settings.clone(),
-            z_limit_nm: search.floor_fraction * a0,
-            min_amplitude_ratio: (search.ratio - 0.05).max(0.0),
-            ..DiagramSettings::approach(model)
-        };
-        let diagram = approach_diagram(model, &diagram_settings)?;
+        let diagram = approach_diagram(model, &search.diagram_settings(model, settings))?;
         let mut stable_parts = Vec::new();
         let mut start: Option<usize> = None;
         for (index, point) in diagram.points.iter().enumerate() {
