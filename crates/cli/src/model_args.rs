@@ -128,11 +128,11 @@ pub fn named_case(name: &str, frequency_overridden: bool) -> Result<Case> {
 /// A cantilever named on the command line: a cantilever file (a path ending in `.json`, or an
 /// existing file) or a built-in cantilever; its warnings printed.
 pub fn cantilever_of(reference: &str) -> Result<Cantilever> {
-    let cantilever = if is_file_reference(reference) {
-        fixtures::load_cantilever(Path::new(reference))?
-    } else {
-        fixtures::builtin_cantilever(reference)?
-    };
+    let cantilever = file_or_builtin(
+        reference,
+        fixtures::load_cantilever,
+        fixtures::builtin_cantilever,
+    )?;
     warn_all(cantilever.warnings(reference));
     Ok(cantilever)
 }
@@ -140,13 +140,22 @@ pub fn cantilever_of(reference: &str) -> Result<Cantilever> {
 /// A sample named on the command line: a sample file or a built-in sample; its warnings
 /// printed.
 pub fn sample_of(reference: &str) -> Result<Sample> {
-    let sample = if is_file_reference(reference) {
-        fixtures::load_sample(Path::new(reference))?
-    } else {
-        fixtures::builtin_sample(reference)?
-    };
+    let sample = file_or_builtin(reference, fixtures::load_sample, fixtures::builtin_sample)?;
     warn_all(sample.warnings(reference));
     Ok(sample)
+}
+
+/// `load` the file `reference` names, or else the built-in `builtin(reference)`.
+fn file_or_builtin<T>(
+    reference: &str,
+    load: fn(&Path) -> Result<T, afm::AfmError>,
+    builtin: fn(&str) -> Result<T, afm::AfmError>,
+) -> Result<T> {
+    Ok(if is_file_reference(reference) {
+        load(Path::new(reference))?
+    } else {
+        builtin(reference)?
+    })
 }
 
 /// The case of `cantilever` tapping `sample` with the free amplitude `a0_nm` (nm), directly
