@@ -190,8 +190,13 @@ pub fn apply_overrides(
             eprintln!("drumroll: warning: --drive-frequency {warning}");
         }
     }
-    case.validate("the command line")
-        .context("invalid model parameters")?;
+    // A case file's bimodal drive may not be commensurate with an overriding frequency: the
+    // error names the option that made it so.
+    let source = match drive_frequency {
+        Some(frequency) => format!("the command line (--drive-frequency {frequency})"),
+        None => String::from("the command line"),
+    };
+    case.validate(&source).context("invalid model parameters")?;
     Ok(case)
 }
 
