@@ -1558,3 +1558,138 @@ fn generated_scan_and_measurement_files_never_panic_hang_or_leave_files_and_are_
         "{tally:?}"
     );
 }
+
+/// Run the binary on `args` in `dir`; its success and standard error.
+fn drumroll_in(dir: &Path, args: &[&str]) -> (bool, String) {
+    let output = assert_cmd::Command::cargo_bin("drumroll")
+        .expect("binary built")
+        .current_dir(dir)
+        .args(args)
+        .timeout(BINARY_TIMEOUT)
+        .output()
+        .expect("runs");
+    (
+        output.status.success(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+/// The inputs the fuzzer found, each once as a user types it: every refusal names the file or
+/// option, the field and what is allowed; a byte-order mark is accepted; a refused scan leaves
+/// an existing `--out` file as it was.
+#[test]
+fn inputs_found_by_the_fuzzer_are_named_or_accepted() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let at = |name: &str| dir.path().join(name);
+    let measured = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/measurements/maclever-mica-synthetic.csv"
+    );
+    let text = std::fs::read_to_string(measured).expect("fixture");
+
+    // --significance out of range named by the option (was "command line: field `significance`").
+    let (ok, stderr) = drumroll_in(
+        dir.path(),
+        &["detect", "--data", measured, "--significance", "10"],
+    );
+    assert!(
+        !ok && stderr.contains("--significance 10: allowed (0, 0.5]"),
+        "{stderr}"
+    );
+    // A window so large that 4 windows overflowed: refused with its range.
+    let (ok, stderr) = drumroll_in(
+        dir.path(),
+        &[
+            "detect",
+            "--data",
+            measured,
+            "--window",
+            "18446744073709551615",
+        ],
+    );
+    assert!(
+        !ok && stderr.contains("--window") && stderr.contains("6 to 100000"),
+        "{stderr}"
+    );
+    // A byte-order mark before the header is skipped (was "missing column z_nm").
+    std::fs::write(at("bom.csv"), format!("\u{feff}{text}")).expect("write");
+    let (ok, stderr) = drumroll_in(dir.path(), &["detect", "--data", "bom.csv"]);
+    assert!(ok, "{stderr}");
+    // Too many rows: refused naming the file, `rows` and the limit (was minutes of work).
+    let mut many = String::from("z_nm,amplitude_nm,phase_deg\n");
+    for i in 0..=afm::fit::measurement::MAX_ROWS {
+        many.push_str(&format!("{},20,90\n", 1e5 - i as f64));
+    }
+    std::fs::write(at("many.csv"), many).expect("write");
+    let (ok, stderr) = drumroll_in(dir.path(), &["detect", "--data", "many.csv"]);
+    assert!(
+        !ok && stderr.contains("many.csv: field `rows` = 50001")
+            && stderr.contains("at most 50000"),
+        "{stderr}"
+    );
+    // Not UTF-8: the file, the line, the column and the byte.
+    let mut latin1 = text.clone().into_bytes();
+    let second_line = text.find('\n').expect("lines") + 1;
+    latin1.insert(second_line + 3, 0xe9);
+    std::fs::write(at("latin1.csv"), latin1).expect("write");
+    let (ok, stderr) = drumroll_in(dir.path(), &["detect", "--data", "latin1.csv"]);
+    assert!(
+        !ok && stderr.contains("latin1.csv: not UTF-8 text at line 2, column 4 (byte 0xe9)"),
+        "{stderr}"
+    );
+
+    // An inline segment sample that is no object: its field and what is allowed (was "data
+    // did not match any variant of untagged enum SampleReference").
+    std::fs::write(
+        at("line.json"),
+        r#"{"segments": [{"from_nm": 0, "to_nm": 100, "height_nm": 0, "sample": 3}]}"#,
+    )
+    .expect("write");
+    std::fs::write(at("out.csv"), "the previous output\n").expect("write");
+    let (ok, stderr) = drumroll_in(
+        dir.path(),
+        &[
+            "scan",
+            "--line",
+            "line.json",
+            "--pixels",
+            "2",
+            "--out",
+            "out.csv",
+        ],
+    );
+    assert!(
+        !ok && stderr
+            .contains("field `segments[0].sample` = 3 is invalid; allowed: a built-in sample"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(at("out.csv")).expect("kept"),
+        "the previous output\n"
+    );
+    assert!(
+        leftovers(dir.path()).is_empty(),
+        "{:?}",
+        leftovers(dir.path())
+    );
+
+    // A bimodal case made incommensurate by --drive-frequency: the option is named (was "the
+    // command line: field `drive.second_frequency_khz`").
+    let (ok, stderr) = drumroll_in(
+        dir.path(),
+        &[
+            "simulate",
+            "--case",
+            "biolever-mica-bimodal",
+            "--drive-frequency",
+            "9.31",
+            "--z",
+            "8",
+        ],
+    );
+    assert!(
+        !ok && stderr.contains("--drive-frequency 9.31")
+            && stderr.contains("drive.second_frequency_khz"),
+        "{stderr}"
+    );
+}
