@@ -11,14 +11,16 @@
 //! but not integrated, so that an input stays quick). Files may start with a UTF-8 byte-order
 //! mark, and a case file's references may be `.` or a name that is no file.
 //!
-//! To cover a new input file (a scan line file, a measurement CSV, a new contact law's sample
-//! object): add a generator beside [`cantilever_text`] (clean values near typical ones, and
-//! when not clean the malformed, extreme and wrong-typed values of [`json_number`] and
-//! [`json_name`]), a field of [`Input`] for it, write it in [`run_one`] next to `lever.json`,
-//! and push it through the command's own parsing and checks there, with [`check_rejection`]
-//! on every refusal.
+//! A second test draws scan line files, raster files and measurement CSVs with `scan` and
+//! `detect` options ([`file_input`]), and every sample file may carry a contact law, a
+//! hydration force and a double layer, every case file a `drive`. To cover a new input file:
+//! add a generator beside [`line_text`] (clean values near typical ones, and when not clean
+//! the malformed, extreme and wrong-typed values of [`json_number`] and [`json_name`]), a
+//! field of [`FileInput`] for it, write it in [`run_file_one`], and push it through the
+//! command's own parsing and checks there, with [`check_rejection`] on every refusal.
 //!
-//! `cargo test --release -p drumroll --test fuzz_inputs` runs [`DEFAULT_CASES`] inputs;
+//! `cargo test --release -p drumroll --test fuzz_inputs` runs [`DEFAULT_CASES`] and
+//! [`DEFAULT_FILE_CASES`] inputs;
 //! `DRUMROLL_FUZZ_CASES=100000 cargo test --release -p drumroll --test fuzz_inputs -- --nocapture`
 //! is the long run (it prints the count, the rejections and the slowest input).
 
