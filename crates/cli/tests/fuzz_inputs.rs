@@ -844,19 +844,25 @@ fn run_diagram(
     Ok(())
 }
 
-#[test]
-fn generated_inputs_never_panic_hang_or_leave_files_and_every_rejection_is_named() {
+/// A runner of `DRUMROLL_FUZZ_CASES` inputs, else `default_cases`, shrinking a failure at
+/// most 200 steps, keeping no failure file.
+fn runner(default_cases: u32) -> TestRunner {
     let cases = std::env::var("DRUMROLL_FUZZ_CASES")
         .ok()
         .and_then(|n| n.parse().ok())
-        .unwrap_or(DEFAULT_CASES);
-    let dir = tempfile::tempdir().expect("temporary directory");
-    let mut runner = TestRunner::new(Config {
+        .unwrap_or(default_cases);
+    TestRunner::new(Config {
         cases,
         failure_persistence: None,
         max_shrink_iters: 200,
         ..Config::default()
-    });
+    })
+}
+
+#[test]
+fn generated_inputs_never_panic_hang_or_leave_files_and_every_rejection_is_named() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let mut runner = runner(DEFAULT_CASES);
     let tally = std::cell::RefCell::new(Tally::default());
     let started = Instant::now();
     let result = runner.run(&input(), |input| {
@@ -1518,17 +1524,8 @@ fn run_file_one(input: &FileInput, dir: &Path, tally: &mut FileTally) -> Result<
 
 #[test]
 fn generated_scan_and_measurement_files_never_panic_hang_or_leave_files_and_are_named() {
-    let cases = std::env::var("DRUMROLL_FUZZ_CASES")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(DEFAULT_FILE_CASES);
     let dir = tempfile::tempdir().expect("temporary directory");
-    let mut runner = TestRunner::new(Config {
-        cases,
-        failure_persistence: None,
-        max_shrink_iters: 200,
-        ..Config::default()
-    });
+    let mut runner = runner(DEFAULT_FILE_CASES);
     let tally = std::cell::RefCell::new(FileTally::default());
     let started = Instant::now();
     let result = runner.run(&file_input(), |input| {
