@@ -139,10 +139,55 @@ fn parse<T: DeserializeOwned>(file: &str, text: &str) -> Result<T, AfmError> {
     })
 }
 
+/// Read the file at `path` and parse it with `parse(file, text, directory)`: `file` names it in
+/// errors, `directory` (the file's own) resolves the relative paths written in it. The one
+/// loader of the files that name other files (scan lines, rasters).
+pub(crate) fn load_relative<T>(
+    path: &Path,
+    parse: impl FnOnce(&str, &str, Option<&Path>) -> Result<T, AfmError>,
+) -> Result<T, AfmError> {
+    let text = read(path)?;
+    parse(
+        &path.display().to_string(),
+        &text,
+        Some(path.parent().unwrap_or_else(|| Path::new(""))),
+    )
+}
+
 fn read(path: &Path) -> Result<String, AfmError> {
-    std::fs::read_to_string(path).map_err(|source| AfmError::Io {
+    read_text(path)
+}
+
+/// The text of the file at `path`. A file that is not UTF-8 (saved in another encoding, or
+/// not text) is an [`AfmError::Io`] naming the file, the line and column of the first byte
+/// that is not, and that byte.
+pub(crate) fn read_text(path: &Path) -> Result<String, AfmError> {
+    let io = |source| AfmError::Io {
         file: path.display().to_string(),
         source,
+    };
+    let bytes = std::fs::read(path).map_err(io)?;
+    String::from_utf8(bytes).map_err(|error| {
+        let at = error.utf8_error().valid_up_to();
+        let bytes = error.as_bytes();
+        let before = &bytes[..at];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |newline| newline + 1);
+        let column = String::from_utf8_lossy(&before[line_start..])
+            .chars()
+            .count()
+            + 1;
+        io(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "not UTF-8 text at line {line}, column {column} (byte 0x{:02x}): save the file \
+                 as UTF-8",
+                bytes[at]
+            ),
+        ))
     })
 }
 

@@ -1,18 +1,17 @@
 //! Steady orbits and grazing points of the non-Hertz contact laws (MODEL.md section 9) against
-//! a brute force written here: fixed-step RK4 on the model's vector field, with each crossing
-//! of a switching surface located by bisection of the step and the step split there, a step 64
-//! times finer in contact, and the lock-in integrals by the trapezoidal rule on the uniform
-//! grid. It shares with drumroll only the field `f_m(t, x)` and the switching functions, not
-//! the solver, its event location, Newton or continuation.
+//! the shared brute force of `brute_force/`: fixed-step RK4 on the model's vector field, with
+//! each crossing of a switching surface located by bisection of the step and the step split
+//! there, a step 64 times finer in contact, and the lock-in integrals by the trapezoidal rule
+//! on the uniform grid. It shares with drumroll only the field `f_m(t, x)` and the switching
+//! functions, not the solver, its event location, Newton or continuation.
+
+mod brute_force;
+use brute_force::{brute_force, grazing_by_bisection_within};
 
 use afm::{
     approach_diagram, builtin_cantilever, steady_orbit, DiagramSettings, OrbitStart, Sample,
     Separation, SteadyOrbitSettings, TappingModel,
 };
-use hybrid::{HybridSystem, Mode};
-
-/// Grid steps per drive period outside contact.
-const STEPS_PER_PERIOD: usize = 40_000;
 
 fn model_with(contact: &str, z: f64) -> TappingModel {
     let text = format!(
@@ -23,106 +22,14 @@ fn model_with(contact: &str, z: f64) -> TappingModel {
     TappingModel::new(cantilever, sample, 10.0, None, Separation::Constant(z)).unwrap()
 }
 
-fn rk4_step(model: &TappingModel, mode: Mode, t: f64, x: &[f64], h: f64, out: &mut [f64]) {
-    let n = x.len();
-    let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let mut y = vec![0.0; n];
-    model.vector_field(mode, t, x, &mut k1);
-    for i in 0..n {
-        y[i] = x[i] + 0.5 * h * k1[i];
-    }
-    model.vector_field(mode, t + 0.5 * h, &y, &mut k2);
-    for i in 0..n {
-        y[i] = x[i] + 0.5 * h * k2[i];
-    }
-    model.vector_field(mode, t + 0.5 * h, &y, &mut k3);
-    for i in 0..n {
-        y[i] = x[i] + h * k3[i];
-    }
-    model.vector_field(mode, t + h, &y, &mut k4);
-    for i in 0..n {
-        out[i] = x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-    }
-}
-
-/// Advance `(t, x, mode)` by `h` in RK4 substeps (64 of them in contact), splitting a substep
-/// at every switching-surface crossing found by bisection on its length (to 1e-15 periods).
-fn advance(model: &TappingModel, mode: &mut Mode, t: &mut f64, x: &mut [f64], h: f64, period: f64) {
-    let end = *t + h;
-    let mut next = vec![0.0; x.len()];
-    while *t < end - 1e-12 * period {
-        let sub = if *mode & 1 != 0 { h / 64.0 } else { h };
-        let step = sub.min(end - *t);
-        rk4_step(model, *mode, *t, x, step, &mut next);
-        let landed = model.mode_of(*t + step, &next);
-        if landed == *mode {
-            x.copy_from_slice(&next);
-            *t += step;
-            continue;
-        }
-        // Bisect for the first time the mode changes.
-        let (mut lo, mut hi) = (0.0, step);
-        while hi - lo > 1e-15 * period {
-            let mid = 0.5 * (lo + hi);
-            rk4_step(model, *mode, *t, x, mid, &mut next);
-            if model.mode_of(*t + mid, &next) == *mode {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        rk4_step(model, *mode, *t, x, hi, &mut next);
-        x.copy_from_slice(&next);
-        *t += hi;
-        *mode = model.mode_of(*t, x);
-    }
-    *t = end;
-}
-
-/// Integrate `periods` drive periods from `x0` at t = 0; return the last period's A/A0 and
-/// phase (deg) of u, and the local minima of `h_0 = d - d_c` over it (parabola through the
-/// three grid points around each).
-fn brute_force(model: &TappingModel, x0: &[f64], periods: usize) -> (f64, f64, Vec<f64>) {
-    let period = model.period_us();
-    let w = model.drive_angular_frequency();
-    let h = period / STEPS_PER_PERIOD as f64;
-    let mut x = x0.to_vec();
-    let mut t = 0.0;
-    let mut mode = model.mode_of(0.0, &x);
-    let (mut a, mut b) = (0.0, 0.0);
-    let mut heights = Vec::with_capacity(STEPS_PER_PERIOD + 1);
-    for p in 0..periods {
-        let last = p + 1 == periods;
-        for i in 0..STEPS_PER_PERIOD {
-            if last {
-                let u = model.photodiode(&x);
-                let tk = i as f64 * h;
-                a += u * (w * tk).cos();
-                b += u * (w * tk).sin();
-                heights.push(model.switching(0, t, &x));
-            }
-            advance(model, &mut mode, &mut t, &mut x, h, period);
-        }
-    }
-    heights.push(model.switching(0, t, &x));
-    let scale = 2.0 / STEPS_PER_PERIOD as f64;
-    let ratio = scale * a.hypot(b) / model.free_amplitude_nm();
-    let phase = b.atan2(a).to_degrees();
-    let minima = heights
-        .windows(3)
-        .filter(|w| w[1] < w[0] && w[1] <= w[2])
-        .map(|w| w[1] - (w[2] - w[0]).powi(2) / (8.0 * (w[0] - 2.0 * w[1] + w[2])))
-        .collect();
-    (ratio, phase, minima)
-}
-
 fn check_orbit(contact: &str, z: f64) {
     let model = model_with(contact, z);
     let settings = SteadyOrbitSettings::default();
     let orbit = steady_orbit(&model, z, OrbitStart::Approach, &settings).unwrap();
     assert!(orbit.converged && orbit.multiplicity == 1, "{contact}");
     let observables = orbit.observables();
-    let (ratio, phase, _) = brute_force(&model, &orbit.state, 3);
+    let last = brute_force(&model, &orbit.state, 3);
+    let (ratio, phase) = (last.amplitude_ratio, last.phase_deg);
     assert!(
         (ratio - observables.amplitude_ratio).abs() < 1e-6,
         "{contact}: A/A0 {ratio} vs {}",
@@ -166,26 +73,7 @@ fn check_grazing(contact: &str, label: &str) {
         .find(|p| p.label == label)
         .expect("the grazing on the approach");
     assert!(g2.converged);
-    let nearest = |z: f64| {
-        let mut at = model.clone();
-        at.set_separation(Separation::Constant(z)).unwrap();
-        let (_, _, minima) = brute_force(&at, &g2.state, 12);
-        minima
-            .into_iter()
-            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
-            .unwrap()
-    };
-    let (mut below, mut above) = (g2.z_nm - 2e-3, g2.z_nm + 2e-3);
-    assert!(nearest(below) < 0.0 && nearest(above) > 0.0);
-    while above - below > 2e-8 {
-        let mid = 0.5 * (below + above);
-        if nearest(mid) < 0.0 {
-            below = mid;
-        } else {
-            above = mid;
-        }
-    }
-    let z = 0.5 * (below + above);
+    let z = grazing_by_bisection_within(&model, &g2.state, g2.z_nm, 2e-3, 12);
     assert!(
         (z - g2.z_nm).abs() < 1e-7,
         "{contact}: G2 {} vs brute force {z}",

@@ -3,11 +3,13 @@
 
 use afm::fit::measurement::Measurement;
 use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings};
-use anyhow::Result;
+use afm::validation::Interval;
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::{json, Value};
 
 use crate::measurement_args::MeasurementArgs;
+use crate::option_ranges::OptionRange;
 use crate::output::print_stdout;
 
 /// Options of `drumroll detect`.
@@ -48,18 +50,38 @@ pub fn detect_json(measurement: &Measurement, detection: &Detection, significanc
     })
 }
 
+/// The most rows on each side of a test window `--window` takes.
+pub const MAX_WINDOW: usize = 100_000;
+
+/// The detection settings of `--significance` and `--window`, checked (errors name the
+/// option and its allowed range).
+///
+/// # Errors
+/// A significance outside `(0, 0.5]`, a window from 1 to 5 or above [`MAX_WINDOW`].
+pub fn detection_settings(args: &DetectArgs) -> Result<DetectionSettings> {
+    OptionRange::new("--significance", Interval::left_open(0.0, 0.5, ""))
+        .check(args.significance)?;
+    if args.window != 0 && !(6..=MAX_WINDOW).contains(&args.window) {
+        bail!(
+            "--window {}: allowed: 0 (automatic) or 6 to {MAX_WINDOW} rows",
+            args.window
+        );
+    }
+    Ok(DetectionSettings {
+        significance: args.significance,
+        half_window: args.window,
+    })
+}
+
 /// Run `drumroll detect`.
 ///
 /// # Errors
 /// A bad file or option.
 pub fn run(args: &DetectArgs) -> Result<()> {
+    let settings = detection_settings(args)?;
     let measurement = args.measurement.read(args.a0)?;
-    let settings = DetectionSettings {
-        significance: args.significance,
-        half_window: args.window,
-    };
-    settings.validate("command line")?;
-    let detection = detect_transitions(&measurement.approach, measurement.a0_nm, &settings)?;
+    let detection = detect_transitions(&measurement.approach, measurement.a0_nm, &settings)
+        .with_context(|| format!("--data {}", args.measurement.data))?;
     if args.json {
         let object = detect_json(&measurement, &detection, args.significance);
         print_stdout(&format!("{}\n", serde_json::to_string_pretty(&object)?))?;

@@ -1,7 +1,7 @@
 //! The command-line options that choose the cantilever, sample and drive: a built-in or file
 //! case, or a cantilever file and a sample file with a free amplitude.
 
-use afm::{fixtures, Case, TappingModel};
+use afm::{fixtures, Cantilever, Case, Sample, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -67,72 +67,24 @@ impl ModelArgs {
 
     /// Check `--a0` and `--drive-frequency` against the option range table.
     fn check_overrides(&self) -> Result<()> {
-        if let Some(a0) = self.a0 {
-            option_ranges::A0.check(a0)?;
-        }
-        if let Some(frequency) = self.drive_frequency {
-            // The warning, if any, comes with the cantilever's range in `resolve`.
-            option_ranges::DRIVE_FREQUENCY.warning(frequency)?;
-        }
-        Ok(())
+        check_overrides(self.a0, self.drive_frequency)
     }
 
     /// The case named `name` (or built from `--cantilever` and `--sample`), overrides applied
     /// and checked.
     fn resolve(&self, name: Option<&str>) -> Result<Case> {
-        let mut case = match (name, &self.cantilever, &self.sample) {
-            (Some(name), None, None) => {
-                let case = fixtures::find_case(name)?;
-                warn_all(case.warnings(name));
-                if self.drive_frequency.is_none() {
-                    // The case's own drive against its cantilever's range, blamed on the case
-                    // (an override is checked below, on the command line's account).
-                    case.validate(name).context("invalid model parameters")?;
-                }
-                case
-            }
+        let case = match (name, &self.cantilever, &self.sample) {
+            (Some(name), None, None) => named_case(name, self.drive_frequency.is_some())?,
             (None, Some(cantilever), Some(sample)) => {
                 let Some(a0) = self.a0 else {
                     bail!("--cantilever and --sample need --a0 (the free amplitude, nm)");
                 };
-                let cantilever_model = if is_file_reference(cantilever) {
-                    fixtures::load_cantilever(Path::new(cantilever))?
-                } else {
-                    fixtures::builtin_cantilever(cantilever)?
-                };
-                warn_all(cantilever_model.warnings(cantilever));
-                let sample_model = if is_file_reference(sample) {
-                    fixtures::load_sample(Path::new(sample))?
-                } else {
-                    fixtures::builtin_sample(sample)?
-                };
-                warn_all(sample_model.warnings(sample));
-                Case {
-                    name: format!("{}-{}", cantilever_model.name, sample_model.name),
-                    description: String::from("from the command line"),
-                    cantilever: cantilever_model,
-                    sample: sample_model,
-                    free_amplitude_nm: a0,
-                    drive_frequency_khz: None,
-                    drive: afm::model::drive_spec::DriveSpec::Direct,
-                }
+                case_of(cantilever_of(cantilever)?, sample_of(sample)?, a0)
             }
             (None, None, None) => fixtures::builtin_case(DEFAULT_CASE)?,
             _ => bail!("give either --case, or --cantilever with --sample and --a0"),
         };
-        if let Some(a0) = self.a0 {
-            case.free_amplitude_nm = a0;
-        }
-        if let Some(frequency) = self.drive_frequency {
-            option_ranges::drive_frequency_for(&case.cantilever).check(frequency)?;
-            case.drive_frequency_khz = Some(frequency);
-            if let Some(warning) = case.drive_warning() {
-                eprintln!("drumroll: warning: --drive-frequency {warning}");
-            }
-        }
-        case.validate("the command line")
-            .context("invalid model parameters")?;
-        Ok(case)
+        apply_overrides(case, self.a0, self.drive_frequency)
     }
 
     /// The tapping model of the resolved case, at first contact `Z = Z_G1`.
@@ -146,6 +98,106 @@ pub fn model_of(case: Case) -> Result<(Case, TappingModel)> {
     let model = TappingModel::from_case(&case)
         .with_context(|| format!("cannot build the model of case `{}`", case.name))?;
     Ok((case, model))
+}
+
+/// Check the `--a0` (nm) and `--drive-frequency` (kHz) overrides against the option range
+/// table (the drive frequency's range for the cantilever is checked by [`apply_overrides`]).
+pub fn check_overrides(a0: Option<f64>, drive_frequency: Option<f64>) -> Result<()> {
+    if let Some(a0) = a0 {
+        option_ranges::A0.check(a0)?;
+    }
+    if let Some(frequency) = drive_frequency {
+        // The warning, if any, comes with the cantilever's range in `apply_overrides`.
+        option_ranges::DRIVE_FREQUENCY.warning(frequency)?;
+    }
+    Ok(())
+}
+
+/// The built-in case or case file `name`, its warnings printed; its own drive frequency is
+/// checked against its cantilever's range (blamed on the case) unless `frequency_overridden`
+/// (an override is checked by [`apply_overrides`], on the command line's account).
+pub fn named_case(name: &str, frequency_overridden: bool) -> Result<Case> {
+    let case = fixtures::find_case(name)?;
+    warn_all(case.warnings(name));
+    if !frequency_overridden {
+        case.validate(name).context("invalid model parameters")?;
+    }
+    Ok(case)
+}
+
+/// A cantilever named on the command line: a cantilever file (a path ending in `.json`, or an
+/// existing file) or a built-in cantilever; its warnings printed.
+pub fn cantilever_of(reference: &str) -> Result<Cantilever> {
+    let cantilever = file_or_builtin(
+        reference,
+        fixtures::load_cantilever,
+        fixtures::builtin_cantilever,
+    )?;
+    warn_all(cantilever.warnings(reference));
+    Ok(cantilever)
+}
+
+/// A sample named on the command line: a sample file or a built-in sample; its warnings
+/// printed.
+pub fn sample_of(reference: &str) -> Result<Sample> {
+    let sample = file_or_builtin(reference, fixtures::load_sample, fixtures::builtin_sample)?;
+    warn_all(sample.warnings(reference));
+    Ok(sample)
+}
+
+/// `load` the file `reference` names, or else the built-in `builtin(reference)`.
+fn file_or_builtin<T>(
+    reference: &str,
+    load: fn(&Path) -> Result<T, afm::AfmError>,
+    builtin: fn(&str) -> Result<T, afm::AfmError>,
+) -> Result<T> {
+    Ok(if is_file_reference(reference) {
+        load(Path::new(reference))?
+    } else {
+        builtin(reference)?
+    })
+}
+
+/// The case of `cantilever` tapping `sample` with the free amplitude `a0_nm` (nm), directly
+/// driven at the default frequency (MODEL.md section 14), named `CANTILEVER-SAMPLE`.
+pub fn case_of(cantilever: Cantilever, sample: Sample, a0_nm: f64) -> Case {
+    Case {
+        name: format!("{}-{}", cantilever.name, sample.name),
+        description: String::from("from the command line"),
+        cantilever,
+        sample,
+        free_amplitude_nm: a0_nm,
+        drive_frequency_khz: None,
+        drive: afm::model::drive_spec::DriveSpec::Direct,
+    }
+}
+
+/// `case` with the `--a0` (nm) and `--drive-frequency` (kHz) overrides applied, the frequency
+/// checked against the cantilever's range (and warned about far from every mode), and the
+/// whole case validated on the command line's account.
+pub fn apply_overrides(
+    mut case: Case,
+    a0: Option<f64>,
+    drive_frequency: Option<f64>,
+) -> Result<Case> {
+    if let Some(a0) = a0 {
+        case.free_amplitude_nm = a0;
+    }
+    if let Some(frequency) = drive_frequency {
+        option_ranges::drive_frequency_for(&case.cantilever).check(frequency)?;
+        case.drive_frequency_khz = Some(frequency);
+        if let Some(warning) = case.drive_warning() {
+            eprintln!("drumroll: warning: --drive-frequency {warning}");
+        }
+    }
+    // A case file's bimodal drive may not be commensurate with an overriding frequency: the
+    // error names the option that made it so.
+    let source = match drive_frequency {
+        Some(frequency) => format!("the command line (--drive-frequency {frequency})"),
+        None => String::from("the command line"),
+    };
+    case.validate(&source).context("invalid model parameters")?;
+    Ok(case)
 }
 
 /// Print each warning on stderr.

@@ -10,14 +10,15 @@ use afm::scan::pixel::ScanPixel;
 use afm::scan::raster::ScanRaster;
 use afm::scan::settings::{ScanDirections, ScanSettings, MAX_PIXELS};
 use afm::validation::Interval;
-use afm::{fixtures, Case, TappingModel};
+use afm::{Case, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
 use crate::inputs::orbit_inputs_json;
-use crate::option_ranges::{self, OptionRange};
+use crate::model_args::{apply_overrides, cantilever_of, case_of, check_overrides, named_case};
+use crate::option_ranges::OptionRange;
 use crate::output::{check_writable, print_stdout, push_csv_row, write_atomically};
 use crate::plot::{render_svg, FigureFile};
 use crate::progress::{note, Progress};
@@ -153,40 +154,21 @@ impl ScanArgs {
     /// The case: `--case` (default maclever-membrane-experiment) or `--cantilever` with
     /// `--a0`, overrides applied; its sample is the line's first material.
     pub fn case(&self, line: &ScanLine) -> Result<Case> {
-        if let Some(a0) = self.a0 {
-            option_ranges::A0.check(a0)?;
-        }
+        check_overrides(self.a0, self.drive_frequency)?;
         let mut case = match &self.cantilever {
-            Some(name) => {
-                let path = Path::new(name);
-                let cantilever = if path.extension().is_some_and(|e| e == "json") || path.exists() {
-                    fixtures::load_cantilever(path)?
-                } else {
-                    fixtures::builtin_cantilever(name)?
-                };
-                Case {
-                    name: format!("{}-{}", cantilever.name, line.name),
-                    description: String::from("from the command line"),
-                    cantilever,
-                    sample: line.materials[0].clone(),
-                    free_amplitude_nm: self.a0.unwrap_or(1.0),
-                    drive_frequency_khz: None,
-                    drive: afm::model::drive_spec::DriveSpec::Direct,
-                }
+            Some(reference) => {
+                let a0 = self.a0.unwrap_or(1.0);
+                let mut case = case_of(cantilever_of(reference)?, line.materials[0].clone(), a0);
+                case.name = format!("{}-{}", case.cantilever.name, line.name);
+                case
             }
-            None => fixtures::find_case(self.case.as_deref().unwrap_or(DEFAULT_CASE))?,
+            None => named_case(
+                self.case.as_deref().unwrap_or(DEFAULT_CASE),
+                self.drive_frequency.is_some(),
+            )?,
         };
         case.sample = line.materials[0].clone();
-        if let Some(a0) = self.a0 {
-            case.free_amplitude_nm = a0;
-        }
-        if let Some(frequency) = self.drive_frequency {
-            option_ranges::drive_frequency_for(&case.cantilever).check(frequency)?;
-            case.drive_frequency_khz = Some(frequency);
-        }
-        case.validate("the command line")
-            .context("invalid model parameters")?;
-        Ok(case)
+        apply_overrides(case, self.a0, self.drive_frequency)
     }
 
     /// The scan settings, every option checked.

@@ -7,58 +7,18 @@
 //! and a bad cantilever reference in a case file.
 
 mod common;
-use common::{drumroll, reseal};
+use common::{drumroll, grid_words, reseal, SLOW_GRID, SMALL_GRID};
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// A small grid: 4 rows (A0 = 9.5 to 11 nm) of 13 separations (11 down to 8 nm) on the
-/// Biolever on mica, on one thread (so that row `i` is line `i + 2` of its part).
-const SMALL: [&str; 19] = [
-    "grid",
-    "--case",
-    "biolever-mica",
-    "--vary",
-    "a0",
-    "--from",
-    "9.5",
-    "--to",
-    "11",
-    "--steps",
-    "4",
-    "--z-from",
-    "11",
-    "--z-to",
-    "8",
-    "--z-steps",
-    "13",
-    "--threads",
-    "1",
-];
-
-/// A grid that runs for seconds: 12 rows of 200 cells on one thread.
-const SLOW: [&str; 19] = [
-    "grid",
-    "--case",
-    "biolever-mica",
-    "--vary",
-    "tip-radius",
-    "--from",
-    "10",
-    "--to",
-    "40",
-    "--steps",
-    "12",
-    "--z-from",
-    "12",
-    "--z-to",
-    "1",
-    "--z-steps",
-    "200",
-    "--threads",
-    "1",
-];
+/// [`SMALL_GRID`] on one thread (so that row `i` is line `i + 2` of its part), then `more`.
+fn small<'a>(more: &[&'a str]) -> Vec<&'a str> {
+    let mut words = grid_words(&SMALL_GRID, &["--threads", "1"]);
+    words.extend(more);
+    words
+}
 
 /// Run `drumroll ARGS`; its success and standard error.
 fn run(args: &[&str], extra: &[&Path]) -> (bool, String) {
@@ -109,8 +69,7 @@ fn wait_for_content(path: &Path, child: &mut Child) {
 fn a_second_writer_on_a_grid_part_refuses_at_once_and_the_first_is_untouched() {
     let directory = tempfile::tempdir().expect("temporary directory");
     let part = directory.path().join("part.jsonl");
-    let mut sharded: Vec<&str> = SLOW.to_vec();
-    sharded.extend(["--shard", "0/1", "--output"]);
+    let sharded = grid_words(&SLOW_GRID, &["--shard", "0/1", "--output"]);
     let mut first = start(&sharded, &part);
     wait_for_content(&part, &mut first);
     let (ok, stderr) = run(&sharded, &[&part]);
@@ -145,8 +104,7 @@ fn a_second_writer_on_a_grid_part_refuses_at_once_and_the_first_is_untouched() {
 
     // The same through a single run's work file `FILE.part`.
     let map = directory.path().join("single.jsonl");
-    let mut whole: Vec<&str> = SLOW.to_vec();
-    whole.push("--output");
+    let whole = grid_words(&SLOW_GRID, &["--output"]);
     let mut first = start(&whole, &map);
     let work = directory.path().join("single.jsonl.part");
     wait_for_content(&work, &mut first);
@@ -189,11 +147,10 @@ fn a_second_approach_on_the_same_out_refuses_and_the_first_finishes_complete() {
     assert!(last_z <= 6.0 + 0.01, "the sweep ended at {last_z} nm");
 }
 
-/// A part of [`SMALL`] with every row: header, then rows 0 to 3 on lines 2 to 5.
+/// A part of [`SMALL_GRID`] with every row: header, then rows 0 to 3 on lines 2 to 5.
 fn small_part(directory: &Path, name: &str) -> PathBuf {
     let part = directory.join(name);
-    let mut args: Vec<&str> = SMALL.to_vec();
-    args.extend(["--shard", "0/1", "--output"]);
+    let args = small(&["--shard", "0/1", "--output"]);
     let (ok, stderr) = run(&args, &[&part]);
     assert!(ok, "{stderr}");
     part
@@ -345,8 +302,7 @@ fn merge_and_resume_check_every_row_against_the_header() {
         assert!(stderr.contains("damaged.jsonl"), "{what}: {stderr}");
         assert!(!output.exists(), "{what}: no map from a refused merge");
         // Resuming the damaged part is refused the same way, saying how to recover.
-        let mut args: Vec<&str> = SMALL.to_vec();
-        args.extend(["--shard", "0/1", "--output"]);
+        let args = small(&["--shard", "0/1", "--output"]);
         let (ok, stderr) = run(&args, &[&damaged]);
         assert!(!ok, "{what}: resumed");
         assert!(stderr.contains(expected[0]), "{what}: {stderr}");
@@ -376,8 +332,7 @@ fn merge_and_resume_check_every_row_against_the_header() {
     let mut without_row_2 = good.clone();
     without_row_2.remove(3);
     std::fs::write(&resumed, without_row_2.concat()).expect("write");
-    let mut args: Vec<&str> = SMALL.to_vec();
-    args.extend(["--shard", "0/1", "--output"]);
+    let args = small(&["--shard", "0/1", "--output"]);
     let (ok, stderr) = run(&args, &[&resumed]);
     assert!(ok, "{stderr}");
     assert!(

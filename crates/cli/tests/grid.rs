@@ -3,37 +3,16 @@
 //! bad options are refused by name, and the regime boundaries agree with `continue`.
 
 mod common;
-use common::{drumroll, json_of, number, reseal};
+use common::{drumroll, grid_words, json_of, number, reseal, SLOW_GRID, SMALL_GRID};
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-
-/// A small grid on the Biolever on mica: 4 free amplitudes, Z from 11 down to 8 nm in 13
-/// steps, approach and retract (through first contact and G2 in every row).
-const SMALL: [&str; 16] = [
-    "--case",
-    "biolever-mica",
-    "--vary",
-    "a0",
-    "--from",
-    "9.5",
-    "--to",
-    "11",
-    "--steps",
-    "4",
-    "--z-from",
-    "11",
-    "--z-to",
-    "8",
-    "--z-steps",
-    "13",
-];
 
 /// Run `drumroll grid ARGS --retract --output FILE EXTRA...` and require success.
 fn grid(output: &Path, extra: &[&str]) {
     let result = drumroll()
         .arg("grid")
-        .args(SMALL)
+        .args(SMALL_GRID)
         .arg("--retract")
         .arg("--output")
         .arg(output)
@@ -181,7 +160,7 @@ fn merge_refuses_other_grids_and_names_missing_rows() {
     // A part of a grid with another Z resolution.
     let other = drumroll()
         .arg("grid")
-        .args(&SMALL[..15])
+        .args(&SMALL_GRID[..15])
         .args(["14", "--retract", "--shard", "1/3", "--output"])
         .arg(&parts[1])
         .output()
@@ -196,36 +175,22 @@ fn merge_refuses_other_grids_and_names_missing_rows() {
     assert!(!output.exists());
 
     // Resuming into a part file of another grid is refused too, naming the option.
-    let stderr = failure(&[
-        "grid",
-        "--case",
-        "biolever-mica",
-        "--vary",
-        "a0",
-        "--from",
-        "9.5",
-        "--to",
-        "11",
-        "--steps",
-        "4",
-        "--z-from",
-        "11",
-        "--z-to",
-        "8",
-        "--z-steps",
-        "13",
-        "--shard",
-        "1/3",
-        "--output",
-        parts[1].to_str().expect("utf-8"),
-    ]);
+    let stderr = failure(&grid_words(
+        &SMALL_GRID,
+        &[
+            "--shard",
+            "1/3",
+            "--output",
+            parts[1].to_str().expect("utf-8"),
+        ],
+    ));
     assert!(
         stderr.contains("--output") && stderr.contains("other inputs"),
         "{stderr}"
     );
 }
 
-/// A bad-input case: options replaced in [`SMALL`] (option, new value), options added, and
+/// A bad-input case: options replaced in [`SMALL_GRID`] (option, new value), options added, and
 /// the texts the error must contain.
 type BadCase<'a> = (&'a [(&'a str, &'a str)], &'a [&'a str], &'a [&'a str]);
 
@@ -237,7 +202,7 @@ fn bad_options_are_refused_by_name() {
     let with = |replace: &[(&str, &str)], extra: &[&str]| {
         let mut args: Vec<String> = ["grid".to_string()]
             .into_iter()
-            .chain(SMALL.iter().map(|s| s.to_string()))
+            .chain(SMALL_GRID.iter().map(|s| s.to_string()))
             .collect();
         for (option, value) in replace {
             let at = args.iter().position(|a| a == option).expect("option") + 1;
@@ -458,32 +423,11 @@ fn a_run_killed_mid_row_resumes_into_the_same_map() {
     // are in its work file, then run again to the end.
     let directory = tempfile::tempdir().expect("temporary directory");
     let at = |name: &str| directory.path().join(name);
-    let options = [
-        "grid",
-        "--case",
-        "biolever-mica",
-        "--vary",
-        "tip-radius",
-        "--from",
-        "10",
-        "--to",
-        "40",
-        "--steps",
-        "12",
-        "--z-from",
-        "12",
-        "--z-to",
-        "1",
-        "--z-steps",
-        "200",
-        "--threads",
-        "1",
-        "--output",
-    ];
+    let options = grid_words(&SLOW_GRID, &["--output"]);
     let killed = at("killed.jsonl");
     let work = at("killed.jsonl.part");
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_drumroll"))
-        .args(options)
+        .args(&options)
         .arg(&killed)
         .stdout(std::process::Stdio::null())
         .spawn()
@@ -508,7 +452,7 @@ fn a_run_killed_mid_row_resumes_into_the_same_map() {
     assert!((3..12).contains(&rows_done), "{rows_done} rows at the kill");
 
     let rerun = drumroll()
-        .args(options)
+        .args(&options)
         .arg(&killed)
         .output()
         .expect("runs");
@@ -522,7 +466,7 @@ fn a_run_killed_mid_row_resumes_into_the_same_map() {
         "the work file is removed once the map is written"
     );
     let fresh = drumroll()
-        .args(options)
+        .args(&options)
         .arg(at("fresh.jsonl"))
         .output()
         .expect("runs");

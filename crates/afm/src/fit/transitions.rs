@@ -227,12 +227,12 @@ pub fn detect_transitions(
     } else {
         settings.half_window
     };
-    if n < 4 * w {
+    if n / 4 < w {
         return Err(AfmError::InvalidField {
             file: String::from("measurement"),
             field: String::from("rows"),
             value: n.to_string(),
-            allowed: format!("at least {} rows (4 windows of {w})", 4 * w),
+            allowed: format!("at least {} rows (4 windows of {w})", w.saturating_mul(4)),
         });
     }
     let ratios: Vec<f64> = sorted.iter().map(|p| p.amplitude_nm / a0_nm).collect();

@@ -21,7 +21,8 @@ use serde::Deserialize;
 
 use crate::error::AfmError;
 use crate::fixtures::{
-    builtin_line_text, builtin_sample, line_names, load_sample, parse_json, sample_names,
+    builtin_line_text, builtin_sample, line_names, load_relative, load_sample, parse_json,
+    parse_sample, sample_names,
 };
 use crate::model::sample::Sample;
 use crate::validation::{check, invalid, Interval};
@@ -30,12 +31,13 @@ use crate::validation::{check, invalid, Interval};
 pub const MAX_LINE_NM: f64 = 1e5;
 
 /// A segment's sample as written: a built-in name or a path to a sample file (relative to the
-/// line file's directory), or a sample object inline.
+/// line file's directory), or a sample object inline (kept as JSON until resolved, so that an
+/// error in it names its field, not a failed guess of the variant).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 enum SampleReference {
     Name(String),
-    Inline(Box<Sample>),
+    Inline(serde_json::Value),
 }
 
 /// One segment as written in a line file.
@@ -179,15 +181,7 @@ impl ScanLine {
 
     /// Load a line file from `path` (sample paths in it relative to its directory).
     pub fn load(path: &Path) -> Result<Self, AfmError> {
-        let text = std::fs::read_to_string(path).map_err(|source| AfmError::Io {
-            file: path.display().to_string(),
-            source,
-        })?;
-        Self::parse(
-            &path.display().to_string(),
-            &text,
-            Some(path.parent().unwrap_or_else(|| Path::new(""))),
-        )
+        load_relative(path, Self::parse)
     }
 
     /// The built-in line `name` (`fixtures/lines/`).
@@ -280,10 +274,18 @@ fn resolve_sample(
     base: Option<&Path>,
 ) -> Result<Sample, AfmError> {
     match reference {
-        SampleReference::Inline(sample) => {
-            sample.validate(&format!("{file}: {field}"))?;
-            Ok((**sample).clone())
+        SampleReference::Inline(value) if value.is_object() => {
+            parse_sample(&format!("{file}: {field}"), &value.to_string())
         }
+        SampleReference::Inline(value) => Err(AfmError::InvalidField {
+            file: file.to_string(),
+            field: field.to_string(),
+            value: value.to_string(),
+            allowed: format!(
+                "a built-in sample ({}), a sample file path ending in .json, or a sample object",
+                sample_names().join(", ")
+            ),
+        }),
         SampleReference::Name(name) if sample_names().contains(&name.as_str()) => {
             builtin_sample(name)
         }

@@ -14,7 +14,7 @@ use std::path::Path;
 use serde::Deserialize;
 
 use crate::error::AfmError;
-use crate::fixtures::parse_json;
+use crate::fixtures::{load_relative, parse_json};
 use crate::scan::line::ScanLine;
 use crate::validation::{check, Interval};
 
@@ -119,14 +119,6 @@ impl ScanRaster {
 
     /// Load a raster file from `path` (paths in it relative to its directory).
     pub fn load(path: &Path) -> Result<Self, AfmError> {
-        let text = std::fs::read_to_string(path).map_err(|source| AfmError::Io {
-            file: path.display().to_string(),
-            source,
-        })?;
-        Self::parse(
-            &path.display().to_string(),
-            &text,
-            Some(path.parent().unwrap_or_else(|| Path::new(""))),
-        )
+        load_relative(path, Self::parse)
     }
 }

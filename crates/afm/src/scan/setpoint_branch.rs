@@ -67,13 +67,9 @@ impl SetpointBranch {
         search: &AmplitudeRatioSearch,
         settings: &SteadyOrbitSettings,
     ) -> Result<Self, AfmError> {
-        let a0 = model.free_amplitude_nm();
         let diagram_settings = DiagramSettings {
-            orbit: settings.clone(),
-            z_limit_nm: search.floor_fraction * a0,
-            min_amplitude_ratio: (search.ratio - 0.05).max(0.0),
-            ratio_floor_margin_nm: RATIO_FLOOR_MARGIN * a0,
-            ..DiagramSettings::approach(model)
+            ratio_floor_margin_nm: RATIO_FLOOR_MARGIN * model.free_amplitude_nm(),
+            ..search.diagram_settings(model, settings)
         };
         let diagram = approach_diagram(model, &diagram_settings)?;
         let mut stable_parts = Vec::new();

@@ -43,6 +43,23 @@ impl AmplitudeRatioSearch {
             z_tolerance_nm: 1e-9,
         })
     }
+
+    /// The approach diagram's settings for this search on `model`: from first contact down to
+    /// `A/A0 = ratio - 0.05` (at least 0) or `Z = floor_fraction * A0` (nm), whichever comes
+    /// first, each orbit with `settings`. The branch that [`find_amplitude_ratio`] and the
+    /// scan's setpoint branch (`crate::scan::setpoint_branch`) walk.
+    pub fn diagram_settings(
+        &self,
+        model: &TappingModel,
+        settings: &SteadyOrbitSettings,
+    ) -> DiagramSettings {
+        DiagramSettings {
+            orbit: settings.clone(),
+            z_limit_nm: self.floor_fraction * model.free_amplitude_nm(),
+            min_amplitude_ratio: (self.ratio - 0.05).max(0.0),
+            ..DiagramSettings::approach(model)
+        }
+    }
 }
 
 /// The steady orbit on the approach branch where `A/A0` first falls to `search.ratio`.
@@ -58,14 +75,7 @@ pub fn find_amplitude_ratio(
     search: &AmplitudeRatioSearch,
     settings: &SteadyOrbitSettings,
 ) -> Result<SteadyOrbit, AfmError> {
-    let a0 = model.free_amplitude_nm();
-    let diagram_settings = DiagramSettings {
-        orbit: settings.clone(),
-        z_limit_nm: search.floor_fraction * a0,
-        min_amplitude_ratio: (search.ratio - 0.05).max(0.0),
-        ..DiagramSettings::approach(model)
-    };
-    let branch = approach_diagram(model, &diagram_settings)?;
+    let branch = approach_diagram(model, &search.diagram_settings(model, settings))?;
     let bracket = branch.points.windows(2).find(|pair| {
         pair[0].stable
             && pair[1].stable

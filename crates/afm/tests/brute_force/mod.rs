@@ -129,16 +129,29 @@ pub fn brute_force(model: &TappingModel, x0: &[f64], periods: usize) -> LastPeri
 /// from `state` (the orbit at `z_nm`): its largest Floquet multiplier is about 0.1 on the
 /// cases tested, so the transient from a `Z` change of at most 2e-4 nm decays below 1e-9 nm.
 pub fn grazing_by_bisection(model: &TappingModel, state: &[f64], z_nm: f64) -> f64 {
+    grazing_by_bisection_within(model, state, z_nm, 2e-4, 6)
+}
+
+/// The separation (nm) at which the brute-force orbit's gap minimum nearest the surface
+/// crosses zero, by bisection in Z within `z_nm +- half_width_nm` to 2e-8 nm, each orbit
+/// `periods` periods from `state` (the orbit at `z_nm`); the ends must bracket the grazing.
+pub fn grazing_by_bisection_within(
+    model: &TappingModel,
+    state: &[f64],
+    z_nm: f64,
+    half_width_nm: f64,
+    periods: usize,
+) -> f64 {
     let nearest = |z: f64| {
         let mut at = model.clone();
         at.set_separation(Separation::Constant(z)).unwrap();
-        brute_force(&at, state, 6)
+        brute_force(&at, state, periods)
             .minima
             .into_iter()
             .min_by(|a, b| a.abs().total_cmp(&b.abs()))
             .unwrap()
     };
-    let (mut below, mut above) = (z_nm - 2e-4, z_nm + 2e-4);
+    let (mut below, mut above) = (z_nm - half_width_nm, z_nm + half_width_nm);
     assert!(nearest(below) < 0.0 && nearest(above) > 0.0);
     while above - below > 2e-8 {
         let mid = 0.5 * (below + above);

@@ -42,3 +42,56 @@ pub fn reseal(line: &str) -> String {
         crc32fast::hash(body.as_bytes())
     )
 }
+
+/// The options after `drumroll grid` of a small grid on the Biolever on mica: 4 free
+/// amplitudes (9.5 to 11 nm), Z from 11 down to 8 nm in 13 steps (through first contact and
+/// G2 in every row).
+pub const SMALL_GRID: [&str; 16] = [
+    "--case",
+    "biolever-mica",
+    "--vary",
+    "a0",
+    "--from",
+    "9.5",
+    "--to",
+    "11",
+    "--steps",
+    "4",
+    "--z-from",
+    "11",
+    "--z-to",
+    "8",
+    "--z-steps",
+    "13",
+];
+
+/// The options after `drumroll grid` of a grid that runs for seconds: 12 rows (tip radius 10
+/// to 40 nm) of 200 cells (Z from 12 down to 1 nm) on one thread (about 70 ms a row).
+pub const SLOW_GRID: [&str; 18] = [
+    "--case",
+    "biolever-mica",
+    "--vary",
+    "tip-radius",
+    "--from",
+    "10",
+    "--to",
+    "40",
+    "--steps",
+    "12",
+    "--z-from",
+    "12",
+    "--z-to",
+    "1",
+    "--z-steps",
+    "200",
+    "--threads",
+    "1",
+];
+
+/// The words `grid OPTIONS MORE...` of a `drumroll grid` command.
+pub fn grid_words<'a>(options: &[&'a str], more: &[&'a str]) -> Vec<&'a str> {
+    std::iter::once("grid")
+        .chain(options.iter().copied())
+        .chain(more.iter().copied())
+        .collect()
+}
