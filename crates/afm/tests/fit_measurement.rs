@@ -4,10 +4,10 @@
 //!
 //! The suite runs one seed; the coverage study over 20 seeds is
 //! `cargo test --release -p afm --test fit_measurement -- --ignored --nocapture`.
-use afm::fit::least_squares::{fit_measurement, FitParameter, FitResult, FitSettings};
-use afm::fit::measurement::{Measurement, MeasurementOptions};
 use afm::diagram::bifurcation_diagram::{approach_diagram, DiagramSettings};
 use afm::fit::followed_branch::FollowedBranch;
+use afm::fit::least_squares::{fit_measurement, FitParameter, FitResult, FitSettings};
+use afm::fit::measurement::{Measurement, MeasurementOptions};
 use afm::fit::synthetic::{model_branch, synthetic_approach, to_csv, SyntheticInstrument};
 use afm::map::parameter_axis::ParameterAxis;
 use afm::{builtin_case, Case, TappingModel};
@@ -164,12 +164,12 @@ fn quiet_curve_returns_the_truth() {
         ..SyntheticInstrument::default()
     };
     let quiet = fit_with(&case, &quiet_instrument, 8);
-    for i in 0..4 {
-        let stderr = noisy.parameters[i].stderr.unwrap();
-        let deviation = quiet.parameters[i].value - truth[i];
+    for ((noisy, quiet), truth) in noisy.parameters.iter().zip(&quiet.parameters).zip(truth) {
+        let stderr = noisy.stderr.unwrap();
+        let deviation = quiet.value - truth;
         println!(
             "{}: quiet deviation {:.3e}, noisy stderr {:.3e}, ratio {:.3}",
-            quiet.parameters[i].name,
+            quiet.name,
             deviation,
             stderr,
             deviation / stderr
@@ -177,7 +177,7 @@ fn quiet_curve_returns_the_truth() {
         assert!(
             deviation.abs() < 0.5 * stderr,
             "{}: bias {deviation} vs stderr {stderr}",
-            quiet.parameters[i].name
+            quiet.name
         );
     }
 }

@@ -328,7 +328,10 @@ mod tests {
         let ratio: Reading = |p| p.amplitude_ratio;
         for kink in [6.6, 6.2] {
             let diagram = BifurcationDiagram {
-                points: zs.iter().map(|&z| point(z, kinked_curve(kink, z).0)).collect(),
+                points: zs
+                    .iter()
+                    .map(|&z| point(z, kinked_curve(kink, z).0))
+                    .collect(),
                 special_points: vec![special(kink)],
                 stop: String::new(),
                 completed: true,
@@ -347,7 +350,10 @@ mod tests {
                     assert!((got.value - value).abs() < 0.013, "{z}: {got:?} vs {value}");
                     continue;
                 }
-                assert!((got.value - value).abs() < 1e-12, "{kink} {z}: {got:?} vs {value}");
+                assert!(
+                    (got.value - value).abs() < 1e-12,
+                    "{kink} {z}: {got:?} vs {value}"
+                );
                 // The slope between points (at a point it is the next interval's).
                 if zs.iter().all(|&x| (z - x).abs() > 1e-9) {
                     assert!((got.slope - slope).abs() < 1e-11, "{kink} {z}: {got:?}");
