@@ -111,7 +111,7 @@ fn one_seed_recovers_the_truth_within_three_sigma() {
 
 /// The coverage study: 20 seeds, each parameter within its 2-sigma interval (expected 95%).
 #[test]
-#[ignore = "coverage study over 20 seeds, about a minute; run with --ignored --nocapture"]
+#[ignore = "coverage study over 20 seeds, several minutes; run with --ignored --nocapture"]
 fn coverage_over_twenty_seeds() {
     let case = builtin_case(CASE).unwrap();
     let mut inside = [0usize; 4];
