@@ -85,13 +85,60 @@ impl FitParameter {
     }
 }
 
+/// A quantity Levenberg-Marquardt varies. The calibration `c` is fitted as the model's free
+/// amplitude `A0 = A0_rep / c` together with the reported free amplitude `A0_rep` (both
+/// through their logarithms, `ln c = ln A0_rep - ln A0`), so that the error of the measured
+/// `A0_rep` reaches every parameter through the covariance (MODEL.md section 13.4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Internal {
+    /// `z_offset`, nm.
+    ZOffset,
+    /// The phase offset, degrees.
+    PhaseOffset,
+    /// `ln A0` of the model, `A0` in nm.
+    ModelAmplitude,
+    /// `ln A0_rep`, the free amplitude as the instrument reports it, nm.
+    ReportedAmplitude,
+    /// The logarithm of a case parameter.
+    Case(ParameterAxis),
+}
+
+/// The quantities varied for `parameters`, in order, and the matrix `T` (one row per fitted
+/// parameter) with `theta_user = T theta_internal` (in the logarithms for `c` and the case
+/// parameters).
+fn internal_parameters(parameters: &[FitParameter]) -> (Vec<Internal>, DMatrix<f64>) {
+    let mut internal: Vec<Internal> = parameters
+        .iter()
+        .map(|p| match p {
+            FitParameter::ZOffset => Internal::ZOffset,
+            FitParameter::PhaseOffset => Internal::PhaseOffset,
+            FitParameter::AmplitudeCalibration => Internal::ModelAmplitude,
+            FitParameter::Case(axis) => Internal::Case(*axis),
+        })
+        .collect();
+    let calibration = parameters.contains(&FitParameter::AmplitudeCalibration);
+    if calibration {
+        internal.push(Internal::ReportedAmplitude);
+    }
+    let mut transform = DMatrix::zeros(parameters.len(), internal.len());
+    for (k, p) in parameters.iter().enumerate() {
+        if *p == FitParameter::AmplitudeCalibration {
+            transform[(k, k)] = -1.0;
+            transform[(k, internal.len() - 1)] = 1.0;
+        } else {
+            transform[(k, k)] = 1.0;
+        }
+    }
+    (internal, transform)
+}
+
 /// How a fit is made.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitSettings {
     /// The fitted quantities (at least one, no repeats).
     pub parameters: Vec<FitParameter>,
-    /// Relative step of the forward differences in the logarithm of the model's parameters
-    /// (default 0.01).
+    /// Step of the central differences in the logarithm of the model's free amplitude and case
+    /// parameters (default 0.002).
     pub difference_step: f64,
     /// Largest number of residual evaluations of Levenberg-Marquardt (default 40).
     pub max_evaluations: usize,
@@ -102,7 +149,7 @@ impl FitSettings {
     pub fn new(parameters: Vec<FitParameter>) -> Self {
         Self {
             parameters,
-            difference_step: 0.01,
+            difference_step: 0.002,
             max_evaluations: 40,
         }
     }
@@ -202,9 +249,8 @@ type BranchCache = HashMap<Vec<u64>, Rc<FollowedBranch>>;
 /// The least-squares problem: residuals of amplitude (weighted by its noise) then of phase.
 struct Problem<'a> {
     case: &'a Case,
-    measured_a0: f64,
     points: &'a [MeasuredPoint],
-    parameters: &'a [FitParameter],
+    parameters: Vec<Internal>,
     fixed: Fixed,
     sigma: [f64; 2],
     step: f64,
@@ -218,14 +264,18 @@ struct Problem<'a> {
 #[derive(Debug, Clone, Copy)]
 struct Fixed {
     z_offset: f64,
-    calibration: f64,
+    model_a0: f64,
+    reported_a0: f64,
     phase_offset: f64,
 }
 
 /// The full set of values of a parameter vector.
 struct Values {
     z_offset: f64,
-    calibration: f64,
+    /// The model's free amplitude, nm.
+    model_a0: f64,
+    /// The free amplitude the instrument reports, nm.
+    reported_a0: f64,
     phase_offset: f64,
     case: Vec<(ParameterAxis, f64)>,
 }
@@ -234,16 +284,18 @@ impl Problem<'_> {
     fn values(&self, theta: &DVector<f64>) -> Values {
         let mut values = Values {
             z_offset: self.fixed.z_offset,
-            calibration: self.fixed.calibration,
+            model_a0: self.fixed.model_a0,
+            reported_a0: self.fixed.reported_a0,
             phase_offset: self.fixed.phase_offset,
             case: Vec::new(),
         };
         for (k, p) in self.parameters.iter().enumerate() {
             match p {
-                FitParameter::ZOffset => values.z_offset = theta[k],
-                FitParameter::AmplitudeCalibration => values.calibration = theta[k].exp(),
-                FitParameter::PhaseOffset => values.phase_offset = theta[k],
-                FitParameter::Case(axis) => values.case.push((*axis, theta[k].exp())),
+                Internal::ZOffset => values.z_offset = theta[k],
+                Internal::ModelAmplitude => values.model_a0 = theta[k].exp(),
+                Internal::ReportedAmplitude => values.reported_a0 = theta[k].exp(),
+                Internal::PhaseOffset => values.phase_offset = theta[k],
+                Internal::Case(axis) => values.case.push((*axis, theta[k].exp())),
             }
         }
         values
@@ -251,13 +303,13 @@ impl Problem<'_> {
 
     /// The followed branch of the model at `values` (cached).
     fn branch(&self, values: &Values) -> Result<Rc<FollowedBranch>, AfmError> {
-        let mut key: Vec<u64> = vec![values.calibration.to_bits()];
+        let mut key: Vec<u64> = vec![values.model_a0.to_bits()];
         key.extend(values.case.iter().map(|(_, v)| v.to_bits()));
         if let Some(branch) = self.cache.borrow().get(&key) {
             return Ok(branch.clone());
         }
         let mut case = self.case.clone();
-        case.free_amplitude_nm = self.measured_a0 / values.calibration;
+        case.free_amplitude_nm = values.model_a0;
         for (axis, value) in &values.case {
             case = axis.apply(&case, *value, "fit")?;
         }
@@ -286,7 +338,7 @@ impl Problem<'_> {
             let z = p.z_nm - values.z_offset;
             let ratio = branch.value(z, |d| d.amplitude_ratio).value;
             let phase = branch.value(z, |d| d.phase_deg).value;
-            r[i] = (p.amplitude_nm - self.measured_a0 * ratio) / self.sigma[0];
+            r[i] = (p.amplitude_nm - values.reported_a0 * ratio) / self.sigma[0];
             r[n + i] = (p.phase_deg - phase - values.phase_offset) / self.sigma[1];
         }
         Ok(r)
@@ -295,30 +347,40 @@ impl Problem<'_> {
     fn jacobian_at(&self, theta: &DVector<f64>) -> Result<DMatrix<f64>, AfmError> {
         let n = self.points.len();
         let values = self.values(theta);
-        let base = self.residuals_at(theta)?;
         let branch = self.branch(&values)?;
         let mut jacobian = DMatrix::zeros(2 * n, self.parameters.len());
         for (k, p) in self.parameters.iter().enumerate() {
             match p {
-                FitParameter::ZOffset => {
+                Internal::ZOffset => {
                     for (i, point) in self.points.iter().enumerate() {
                         let z = point.z_nm - values.z_offset;
                         let ratio = branch.value(z, |d| d.amplitude_ratio).slope;
                         let phase = branch.value(z, |d| d.phase_deg).slope;
-                        jacobian[(i, k)] = self.measured_a0 * ratio / self.sigma[0];
+                        jacobian[(i, k)] = values.reported_a0 * ratio / self.sigma[0];
                         jacobian[(n + i, k)] = phase / self.sigma[1];
                     }
                 }
-                FitParameter::PhaseOffset => {
+                Internal::PhaseOffset => {
                     for i in 0..n {
                         jacobian[(n + i, k)] = -1.0 / self.sigma[1];
                     }
                 }
-                _ => {
-                    let mut shifted = theta.clone();
-                    shifted[k] += self.step;
-                    let r = self.residuals_at(&shifted)?;
-                    jacobian.set_column(k, &((r - &base) / self.step));
+                Internal::ReportedAmplitude => {
+                    // d/d(ln A0_rep) of (A_i - A0_rep ratio_i) / sigma, exact.
+                    for (i, point) in self.points.iter().enumerate() {
+                        let z = point.z_nm - values.z_offset;
+                        let ratio = branch.value(z, |d| d.amplitude_ratio).value;
+                        jacobian[(i, k)] = -values.reported_a0 * ratio / self.sigma[0];
+                    }
+                }
+                Internal::ModelAmplitude | Internal::Case(_) => {
+                    // Central differences in the logarithm.
+                    let mut up = theta.clone();
+                    up[k] += self.step;
+                    let mut down = theta.clone();
+                    down[k] -= self.step;
+                    let r = self.residuals_at(&up)? - self.residuals_at(&down)?;
+                    jacobian.set_column(k, &(r / (2.0 * self.step)));
                 }
             }
         }
@@ -402,12 +464,12 @@ pub fn fit_measurement(
     // Starting values from the case's model.
     let initial_problem = Problem {
         case,
-        measured_a0: a0,
         points,
-        parameters: &[],
+        parameters: Vec::new(),
         fixed: Fixed {
             z_offset: 0.0,
-            calibration: 1.0,
+            model_a0: a0,
+            reported_a0: a0,
             phase_offset: 0.0,
         },
         sigma,
@@ -419,7 +481,8 @@ pub fn fit_measurement(
     };
     let start_values = Values {
         z_offset: 0.0,
-        calibration: 1.0,
+        model_a0: a0,
+        reported_a0: a0,
         phase_offset: 0.0,
         case: Vec::new(),
     };
@@ -445,27 +508,30 @@ pub fn fit_measurement(
     let phase_offset = free_phase - start.value(f64::INFINITY, |p| p.phase_deg).value;
     let fixed = Fixed {
         z_offset,
-        calibration: 1.0,
+        model_a0: a0,
+        reported_a0: a0,
         phase_offset,
     };
-    let mut theta = DVector::zeros(parameters.len());
-    let mut initial = Vec::new();
-    for (k, p) in parameters.iter().enumerate() {
-        let value = match p {
-            FitParameter::ZOffset => fixed.z_offset,
-            FitParameter::AmplitudeCalibration => 1.0,
-            FitParameter::PhaseOffset => fixed.phase_offset,
-            FitParameter::Case(axis) => axis.value(case)?,
+    let (internal, transform) = internal_parameters(parameters);
+    let mut theta = DVector::zeros(internal.len());
+    for (k, p) in internal.iter().enumerate() {
+        theta[k] = match p {
+            Internal::ZOffset => fixed.z_offset,
+            Internal::PhaseOffset => fixed.phase_offset,
+            Internal::ModelAmplitude | Internal::ReportedAmplitude => a0.ln(),
+            Internal::Case(axis) => axis.value(case)?.ln(),
         };
-        theta[k] = if p.logarithmic() { value.ln() } else { value };
-        initial.push(value);
     }
+    let initial: Vec<f64> = parameters
+        .iter()
+        .zip((&transform * &theta).iter())
+        .map(|(p, &t)| if p.logarithmic() { t.exp() } else { t })
+        .collect();
     let z_floor = zs.iter().copied().fold(f64::INFINITY, f64::min) - z_offset - 0.15 * a0;
     let problem = Problem {
         case,
-        measured_a0: a0,
         points,
-        parameters,
+        parameters: internal,
         fixed,
         sigma,
         step: settings.difference_step,
@@ -476,7 +542,7 @@ pub fn fit_measurement(
     };
     let patience = settings
         .max_evaluations
-        .div_ceil(parameters.len() + 1)
+        .div_ceil(problem.parameters.len() + 1)
         .max(1);
     let (problem, report) = LevenbergMarquardt::new()
         .with_patience(patience)
@@ -493,49 +559,48 @@ pub fn fit_measurement(
     let jacobian = problem.jacobian_at(&theta)?;
     let n = points.len();
     let p = parameters.len();
+    let q = problem.parameters.len();
     let chi2 = residuals.norm_squared();
-    let dof = (2 * n).saturating_sub(p).max(1);
+    let dof = (2 * n).saturating_sub(q).max(1);
     let reduced_chi2 = chi2 / dof as f64;
     // Covariance: s^2 (J^T J)^{-1} by SVD; directions with singular values below 1e-8 of the
     // largest are undetermined.
     let svd = jacobian.clone().svd(false, true);
     let largest = svd.singular_values.max();
     let v_t = svd.v_t.expect("v_t asked for");
-    let mut covariance = DMatrix::zeros(p, p);
+    let mut internal_covariance = DMatrix::zeros(q, q);
     let mut undetermined = vec![false; p];
     for (j, &s) in svd.singular_values.iter().enumerate() {
         let row = v_t.row(j);
         if s <= 1e-8 * largest {
+            // A fitted parameter with a component on an undetermined direction.
+            let components = &transform * row.transpose();
             for k in 0..p {
-                if row[k].abs() > 1e-3 {
+                if components[k].abs() > 1e-3 {
                     undetermined[k] = true;
                 }
             }
             continue;
         }
-        covariance += row.transpose() * row / (s * s);
+        internal_covariance += row.transpose() * row / (s * s);
     }
-    covariance *= reduced_chi2;
+    let covariance = &transform * internal_covariance * transform.transpose() * reduced_chi2;
+    let user_theta = &transform * &theta;
     let values = problem.values(&theta);
     let mut warnings = Vec::new();
     let mut fitted = Vec::new();
     for (k, parameter) in parameters.iter().enumerate() {
         let raw = covariance[(k, k)].max(0.0).sqrt();
         let value = if parameter.logarithmic() {
-            theta[k].exp()
+            user_theta[k].exp()
         } else {
-            theta[k]
+            user_theta[k]
         };
-        let mut stderr = if parameter.logarithmic() {
+        let stderr = if parameter.logarithmic() {
             value * raw
         } else {
             raw
         };
-        if *parameter == FitParameter::AmplitudeCalibration {
-            // The data fix the true A0 = A0_measured / c: the error of the measured A0 is the
-            // calibration's too.
-            stderr = stderr.hypot(value * measurement.a0_stderr_nm / a0);
-        }
         let relative = stderr / value.abs().max(1e-300);
         let stderr = if undetermined[k] {
             warnings.push(format!(
@@ -588,7 +653,7 @@ pub fn fit_measurement(
                 amplitude_nm: point.amplitude_nm,
                 phase_deg: point.phase_deg,
                 separation_nm: z,
-                model_amplitude_nm: a0 * read(z, |d| d.amplitude_ratio),
+                model_amplitude_nm: values.reported_a0 * read(z, |d| d.amplitude_ratio),
                 model_phase_deg: read(z, |d| d.phase_deg) + values.phase_offset,
                 impacts_per_period: read(z, |d| d.impacts_per_period),
                 peak_force_nn: read(z, |d: &DiagramPoint| d.peak_force_nn),
