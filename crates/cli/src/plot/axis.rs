@@ -1,6 +1,11 @@
 //! Axis ticks: "nice" values (1, 2 or 5 times a power of ten) covering a data range, and their
-//! labels with no more decimals than the step needs; integer-only ticks for counted quantities
-//! such as impacts per period.
+//! labels with no more decimals than the step needs (in scientific notation below a step of
+//! [`SCIENTIFIC_BELOW`], such as the roundoff-sized dissipation of a conservative law);
+//! integer-only ticks for counted quantities such as impacts per period.
+
+/// Tick steps below this are labelled in scientific notation (`-2e-13`) rather than with
+/// their many decimals.
+pub const SCIENTIFIC_BELOW: f64 = 1e-4;
 
 /// The tick values of one axis and the number of decimals their labels need.
 #[derive(Debug, Clone, PartialEq)]
@@ -9,11 +14,27 @@ pub struct Ticks {
     pub values: Vec<f64>,
     /// Decimals printed in each label.
     pub decimals: usize,
+    /// With a step below [`SCIENTIFIC_BELOW`], the common power of ten `p` of the labels (that
+    /// of the largest tick): each label is `value / 10^p` with `decimals` decimals, then
+    /// `e{p}`.
+    pub exponent: Option<i32>,
 }
 
 impl Ticks {
     /// The label of tick `value` (never `-0`).
     pub fn label(&self, value: f64) -> String {
+        if let Some(p) = self.exponent {
+            let mantissa = format!("{:.*}", self.decimals, value / 10f64.powi(p));
+            return if mantissa
+                .trim_start_matches('-')
+                .chars()
+                .all(|c| c == '0' || c == '.')
+            {
+                String::from("0")
+            } else {
+                format!("{mantissa}e{p}")
+            };
+        }
         let text = format!("{value:.*}", self.decimals);
         if text.starts_with('-') && text[1..].chars().all(|c| c == '0' || c == '.') {
             text[1..].to_string()
@@ -47,6 +68,7 @@ pub fn ticks(lo: f64, hi: f64, target: usize, integer: bool) -> Ticks {
         return Ticks {
             values: vec![lo],
             decimals: 0,
+            exponent: None,
         };
     }
     let mut step = nice_step(span / target.max(1) as f64);
@@ -56,12 +78,21 @@ pub fn ticks(lo: f64, hi: f64, target: usize, integer: bool) -> Ticks {
     let first = (lo / step).ceil() as i64;
     let last = (hi / step).floor() as i64;
     let values = (first..=last).map(|k| k as f64 * step).collect();
-    let decimals = if integer {
-        0
-    } else {
-        (-(step.log10() + 1e-9).floor()).max(0.0) as usize
+    let step_power = (step.log10() + 1e-9).floor() as i32;
+    let exponent = (!integer && step < SCIENTIFIC_BELOW).then(|| {
+        let largest = lo.abs().max(hi.abs());
+        (largest.log10() + 1e-9).floor() as i32
+    });
+    let decimals = match exponent {
+        _ if integer => 0,
+        Some(p) => (p - step_power).max(0) as usize,
+        None => (-step_power).max(0) as usize,
     };
-    Ticks { values, decimals }
+    Ticks {
+        values,
+        decimals,
+        exponent,
+    }
 }
 
 #[cfg(test)]
@@ -95,5 +126,19 @@ mod tests {
             vec![-150.0, -100.0, -50.0, 0.0, 50.0, 100.0, 150.0]
         );
         assert_eq!(t.decimals, 0);
+    }
+
+    #[test]
+    fn tiny_steps_are_labelled_in_scientific_notation() {
+        // A conservative law's dissipation: roundoff between -1.3e-12 and 0 eV.
+        let t = ticks(-1.3e-12, 0.05e-12, 6, false);
+        assert_eq!(t.exponent, Some(-12));
+        let labels: Vec<String> = t.values.iter().map(|&v| t.label(v)).collect();
+        assert_eq!(
+            labels,
+            ["-1.2e-12", "-1.0e-12", "-0.8e-12", "-0.6e-12", "-0.4e-12", "-0.2e-12", "0"]
+        );
+        // Ordinary steps keep their decimals.
+        assert_eq!(ticks(0.27, 1.03, 6, false).exponent, None);
     }
 }
