@@ -486,3 +486,44 @@ fn where_attractive_and_repulsive_orbits_coexist_trace_and_retrace_differ_as_the
         "{first_trace} {first_retrace}"
     );
 }
+
+#[test]
+fn the_time_domain_loop_follows_the_same_regimes_over_the_polymer_blend() {
+    // The ideal feedback's coexisting regimes (the test above) checked by an independent
+    // mechanism: the PI loop integrates the cantilever through the line in the time domain
+    // (no branches, no settling rules), at 3000 nm/s (about 100 cycles per pixel of 50 nm).
+    // On the last pixel of each segment of each pass it has settled: Z within 0.01 nm of the
+    // ideal feedback's, so it too engages attractive, turns repulsive over the weak polymer
+    // and stays repulsive on the way back.
+    let case = builtin_case("silicon-air-polymer").unwrap();
+    let line = ScanLine::builtin("polymer-blend").unwrap();
+    let settings = ScanSettings {
+        directions: ScanDirections::Both,
+        ..ScanSettings::new(0.8, 6)
+    };
+    let mut pi = PiSettings::for_case(&case).unwrap();
+    pi.scan_rate_nm_per_s = 3000.0;
+    let ideal = ideal_scan(&case, &line, &settings).unwrap();
+    let timed = pi_scan(&case, &line, &settings, &pi).unwrap();
+    assert_eq!(timed.len(), ideal.len());
+    for (a, b) in ideal.iter().zip(&timed) {
+        assert_eq!((a.index, a.direction), (b.index, b.direction));
+        let last_of_segment = match a.direction {
+            ScanDirection::Trace => a.index % 2 == 1,
+            ScanDirection::Retrace => a.index % 2 == 0,
+        };
+        if last_of_segment {
+            assert!(
+                (a.z_nm - b.z_nm).abs() < 0.01 && (a.phase_deg - b.phase_deg).abs() < 0.1,
+                "{:?} {}: ideal Z {} phase {}, PI Z {} phase {}",
+                a.direction,
+                a.index,
+                a.z_nm,
+                a.phase_deg,
+                b.z_nm,
+                b.phase_deg
+            );
+        }
+    }
+    assert!(timed[1].phase_deg > 90.0 && timed[11].phase_deg < 90.0);
+}
