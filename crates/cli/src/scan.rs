@@ -136,7 +136,7 @@ pub struct ScanArgs {
     )]
     pub lockin_time_constant: f64,
     /// The harmonics n = 1..N of u per pixel, N in [1, 20].
-    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = crate::approach::DEFAULT_HARMONICS, allow_negative_numbers = true)]
     pub harmonics: i64,
     /// Print one JSON object `{"inputs", "line", "pixels"}` instead of CSV.
     #[arg(long)]

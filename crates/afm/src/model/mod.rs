@@ -570,16 +570,7 @@ impl TappingModel {
             .zip(rates.chunks_exact_mut(n))
             .enumerate()
         {
-            // The gap's change along this column: the sum of the modal displacements (+1 on
-            // the parameter column, `dd/dZ = 1`).
-            let mut gap_change = if parameter_column && c + 1 == columns {
-                1.0
-            } else {
-                0.0
-            };
-            for i in 0..count {
-                gap_change += v[2 * i];
-            }
+            let gap_change = tangent_gap_change(v, count, parameter_column && c + 1 == columns);
             for (i, m) in modes.iter().enumerate() {
                 rate[2 * i] = v[2 * i + 1];
                 rate[2 * i + 1] = m.omega_squared_over_stiffness * slope * gap_change
@@ -720,6 +711,18 @@ impl TappingModel {
     fn in_contact(mode: Mode) -> bool {
         mode & CONTACT != 0
     }
+}
+
+/// The gap's change `dd` along a tangent column `v` of the state `[q_1, q_1', ..., q_N, q_N',
+/// ...]`: the sum of the `count` modal displacements `v[2i]`, plus `dd/dZ = 1` on the
+/// parameter column (`parameter`).
+#[inline(always)]
+pub(crate) fn tangent_gap_change(v: &[f64], count: usize, parameter: bool) -> f64 {
+    let mut change = if parameter { 1.0 } else { 0.0 };
+    for i in 0..count {
+        change += v[2 * i];
+    }
+    change
 }
 
 fn check_separation(separation: &Separation) -> Result<(), AfmError> {

@@ -5,7 +5,7 @@
 
 use hybrid::Mode;
 
-use super::{TappingModel, CONTACT};
+use super::{tangent_gap_change, TappingModel, CONTACT};
 use crate::contact::standard_linear_solid::StandardLinearSolid;
 
 /// The slopes that couple the sample's state to the cantilever at one `(t, x)`.
@@ -131,14 +131,7 @@ impl TappingModel {
             .zip(rates.chunks_exact_mut(n))
             .enumerate()
         {
-            let mut gap_change = if parameter_column && c + 1 == columns {
-                1.0
-            } else {
-                0.0
-            };
-            for i in 0..count {
-                gap_change += v[2 * i];
-            }
+            let gap_change = tangent_gap_change(v, count, parameter_column && c + 1 == columns);
             let state_change = v[2 * count];
             let coupling = slopes.force_gap * gap_change + slopes.force_state * state_change;
             for (i, m) in self.modes.iter().enumerate() {
