@@ -61,4 +61,17 @@ impl DmtContact {
             rate_slope: 0.0,
         }
     }
+
+    /// The interaction energy at gap `d` (nm), nN nm, zero at infinite gap (`F = -dU/dd`,
+    /// MODEL.md section 10): `-A / d` outside contact, and inside
+    /// `-A / a0 + (2/5) c s^{5/2} - F_ad s` with `s = a0 - d` (continuous at `d = a0`).
+    pub fn potential_nn_nm(&self, gap_nm: f64) -> f64 {
+        let a0 = self.intermolecular_distance_nm;
+        if gap_nm >= a0 {
+            return -self.adhesion_scale() / gap_nm;
+        }
+        let s = a0 - gap_nm;
+        -self.adhesion_scale() / a0 + 0.4 * self.hertz_coefficient() * s * s * s.sqrt()
+            - self.adhesion_force_nn() * s
+    }
 }

@@ -56,4 +56,10 @@ impl DoubleLayer {
             rate_slope: 0.0,
         }
     }
+
+    /// The energy `U_dl(d) = int_d^inf F_dl dd' = lambda_D F_dl(d)`, nN nm (MODEL.md
+    /// section 10).
+    pub fn potential_nn_nm(&self, gap_nm: f64) -> f64 {
+        self.debye_length_nm * self.force(gap_nm)
+    }
 }

@@ -82,4 +82,21 @@ impl FilmContact {
             rate_slope: 0.0,
         }
     }
+
+    /// The elastic energy stored at gap `d` (nm), `U = int_d^0 F dd'` in nN nm (MODEL.md
+    /// section 10): `c sum_k b_k s^{(5+k)/2} / ((5+k)/2)`, term by term from
+    /// [`FilmContact::force_slopes`]'s series.
+    pub fn potential_nn_nm(&self, gap_nm: f64) -> f64 {
+        let c = 4.0 / 3.0 * self.effective_modulus_gpa * self.tip_radius_nm.sqrt();
+        let s = (-gap_nm).max(0.0);
+        let root = s.sqrt();
+        let ratio = self.tip_radius_nm.sqrt() / self.thickness_nm;
+        let mut energy = 0.0;
+        let mut weight = 1.0;
+        for (k, a) in self.correction.coefficients().into_iter().enumerate() {
+            energy += a * weight * s * s * root / ((5 + k) as f64 / 2.0);
+            weight *= ratio * root;
+        }
+        c * energy
+    }
 }

@@ -72,4 +72,27 @@ impl HertzShape {
             rate_slope: 0.0,
         }
     }
+
+    /// The elastic energy stored at gap `d` (nm), `U = int_d^0 F dd'` in nN nm (zero for
+    /// `d >= 0`; `F = -dU/dd`, MODEL.md section 10): `(2/5) c s^{5/2}` for the sphere,
+    /// `c s^3 / 3` for the cone, `c s^2 / 2` for the punch, with each shape's `c` of
+    /// [`HertzShape::force_slopes`].
+    pub fn potential_nn_nm(&self, gap_nm: f64) -> f64 {
+        let indentation = (-gap_nm).max(0.0);
+        let e = self.effective_modulus_gpa;
+        match self.tip {
+            HertzTip::Sphere { radius_nm } => {
+                let c = 4.0 / 3.0 * e * radius_nm.sqrt();
+                0.4 * c * indentation * indentation * indentation.sqrt()
+            }
+            HertzTip::Cone { half_angle_deg } => {
+                let c = 2.0 / PI * e * half_angle_deg.to_radians().tan();
+                c * indentation * indentation * indentation / 3.0
+            }
+            HertzTip::FlatPunch { radius_nm } => {
+                let c = 2.0 * e * radius_nm;
+                0.5 * c * indentation * indentation
+            }
+        }
+    }
 }

@@ -68,4 +68,15 @@ impl HydrationForce {
             rate_slope: 0.0,
         }
     }
+
+    /// The energy `U_h(d) = int_d^inf F_h dd'`, nN nm (MODEL.md section 10):
+    /// `A exp(-d/lambda) [(1/lambda - k^2 lambda) cos(k d) - 2 k sin(k d)] / (1/lambda^2 + k^2)`.
+    pub fn potential_nn_nm(&self, gap_nm: f64) -> f64 {
+        let k = 2.0 * PI / self.layer_spacing_nm;
+        let lambda = self.decay_length_nm;
+        let decay = self.amplitude_nn * (-gap_nm / lambda).exp();
+        let (sin, cos) = (k * gap_nm).sin_cos();
+        decay * ((1.0 / lambda - k * k * lambda) * cos - 2.0 * k * sin)
+            / (1.0 / (lambda * lambda) + k * k)
+    }
 }

@@ -157,6 +157,22 @@ impl ContactLaw {
         }
     }
 
+    /// The energy `U(d)` (nN nm, zero far from the sample) of a conservative law, whose force
+    /// depends on the gap alone, `F = -dU/dd` (MODEL.md section 10): Hertz (every shape), DMT
+    /// and the film. `None` for a law that dissipates or carries a state (Kelvin-Voigt, the
+    /// standard linear solid, JKR and the meniscus with their hysteresis).
+    pub fn potential_nn_nm(&self, gap_nm: f64) -> Option<f64> {
+        match self {
+            Self::Hertz(shape) => Some(shape.potential_nn_nm(gap_nm)),
+            Self::Dmt(dmt) => Some(dmt.potential_nn_nm(gap_nm)),
+            Self::Film(film) => Some(film.potential_nn_nm(gap_nm)),
+            Self::KelvinVoigt(_)
+            | Self::StandardLinearSolid(_)
+            | Self::Jkr(_)
+            | Self::Capillary(_) => None,
+        }
+    }
+
     /// Whether the force inside contact grows with a half-integer power of the indentation
     /// `d_c - d` from the contact surface (sphere Hertz, DMT, Kelvin-Voigt, film), so the
     /// solution is smooth in the square root of the time from a crossing; `false` for the cone
@@ -280,6 +296,24 @@ impl TipSampleForce {
             total += additive(hydration.force_slopes(at));
         }
         total
+    }
+
+    /// The energy `U(d)` (nN nm, zero far from the sample) of a conservative tip-sample force,
+    /// `F = -dU/dd` (MODEL.md section 10): [`ContactLaw::potential_nn_nm`] plus the double
+    /// layer's and the hydration force's energies, which inside contact, where their force is
+    /// held at `F(d_c)`, grow as `U(d_c) + F(d_c) (d_c - d)`. `None` when the law has no energy.
+    pub fn potential_nn_nm(&self, gap_nm: f64) -> Option<f64> {
+        let mut energy = self.law.potential_nn_nm(gap_nm)?;
+        let contact_gap = self.contact_gap_nm();
+        let at = gap_nm.max(contact_gap);
+        let held = contact_gap - gap_nm.min(contact_gap);
+        if let Some(layer) = &self.double_layer {
+            energy += layer.potential_nn_nm(at) + layer.force(contact_gap) * held;
+        }
+        if let Some(hydration) = &self.hydration {
+            energy += hydration.potential_nn_nm(at) + hydration.force(contact_gap) * held;
+        }
+        Some(energy)
     }
 
     /// The force (nN) at gap `d` and rate `d'` with the region taken from the gap itself

@@ -124,8 +124,9 @@ pub struct ModeEnergy {
     pub drive_work_ev: f64,
     /// The loss in the mode's damping `D_i = (k_i / (w_i Q_i)) int q_i'^2 dt`, eV.
     pub damping_loss_ev: f64,
-    /// The mode's share of the tip-sample dissipation `-int F_ts q_i' dt`, eV (the shares sum
-    /// to `dissipated_ev`).
+    /// The mode's share of the tip-sample dissipation `-int F_ts q_i' dt`, eV, by quadrature
+    /// (the shares sum to `dissipated_ev + base_work_ev`, for a conservative law to the
+    /// quadrature's accuracy).
     pub dissipated_share_ev: f64,
     /// The change of the mode's energy `m_i q_i'^2 / 2 + k_i q_i^2 / 2` from the window's
     /// start to its end, eV (zero on a periodic orbit to Newton's tolerance).
@@ -177,7 +178,8 @@ pub struct OrbitObservables {
     /// The energy dissipated in the sample per drive period,
     /// `E_ts = -(1/k) int F_ts (w' + y_base') dt` over the window (`w = sum_i q_i` the tip
     /// deflection, `y_base` an acoustic drive's base motion, else 0), eV (MODEL.md sections 10
-    /// and 14): zero for a conservative law, positive for a dissipative one.
+    /// and 14): zero for a conservative law (computed from its energy `U(d)`, exact), positive
+    /// for a dissipative one.
     pub dissipated_ev: f64,
     /// The contact force's work on the moving base per drive period,
     /// `(1/k) int F_ts y_base' dt` over the window, eV (MODEL.md section 14; 0 but under an
@@ -602,11 +604,7 @@ impl PeriodObserver {
             mean_force_nn: self.impulse / (k * self.period),
             contact_time_periods,
             impulse_nn_us: self.impulse / k,
-            dissipated_ev: mode_energy
-                .iter()
-                .map(|mode| mode.dissipated_share_ev)
-                .sum::<f64>()
-                - per_period * self.base_work,
+            dissipated_ev: self.dissipated_ev(model, &mode_energy),
             base_work_ev: per_period * self.base_work,
             second_drive: self.second_fourier.map(|(_, [a, b])| SecondDriveResponse {
                 amplitude_nm: scale * a.hypot(b),
@@ -617,6 +615,31 @@ impl PeriodObserver {
             mean_indentation_nm,
             energy_balance_residual,
             mode_energy,
+        }
+    }
+
+    /// The energy dissipated in the sample per drive period, `E_ts = -int F_ts (w' + y_base')
+    /// dt`, eV (MODEL.md section 10). For a force with an energy `U(d)` (a conservative law),
+    /// exactly `U(d_end) - U(d_start) + Z' int F_ts dt`, as `w' + y_base' = d' - Z'`: zero
+    /// over a closed orbit, with no quadrature error. Otherwise the modes' shares (quadrature
+    /// on the dense output) less the base's work.
+    fn dissipated_ev(&self, model: &TappingModel, mode_energy: &[ModeEnergy]) -> f64 {
+        let per_period = NN_NM_IN_EV / self.window_periods as f64;
+        let force = model.contact_force();
+        match (
+            force.potential_nn_nm(self.gap_at_start),
+            force.potential_nn_nm(self.gap_at_end),
+        ) {
+            (Some(start), Some(end)) => {
+                per_period * (end - start + model.separation().rate() * self.impulse)
+            }
+            _ => {
+                mode_energy
+                    .iter()
+                    .map(|mode| mode.dissipated_share_ev)
+                    .sum::<f64>()
+                    - per_period * self.base_work
+            }
         }
     }
 
