@@ -6,7 +6,10 @@
 //! contact.
 //!
 //! Where they differ, the fast check runs the transient start's Newton from the same iterate,
-//! so its orbit equals the full check's to rounding: 1e-12 (nm, nm/us).
+//! so its orbit equals the full check's to rounding: 1e-12 (nm, nm/us). The fast check's
+//! linearisation test (a transient that moves as the found orbit's monodromy predicts) must
+//! not stop a transient that heads for another orbit: from the retract orbit of the bistable
+//! window, the check finds the approach orbit.
 
 use afm::orbit::steady_orbit::{coexisting_orbit, COEXISTING_DISTANCE};
 use afm::{
