@@ -222,7 +222,7 @@ fn follows_linearisation(
         .map(|m| m.norm())
         .fold(0.0, f64::max);
     let n = orbit.state.len();
-    if !(spectral_radius < 1.0) || monodromy.shape() != (n, n) {
+    if spectral_radius.is_nan() || spectral_radius >= 1.0 || monodromy.shape() != (n, n) {
         return false;
     }
     let allowed = LINEAR_FRACTION * (1.0 - spectral_radius);
