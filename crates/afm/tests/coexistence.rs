@@ -6,7 +6,10 @@
 //! contact.
 //!
 //! Where they differ, the fast check runs the transient start's Newton from the same iterate,
-//! so its orbit equals the full check's to rounding: 1e-12 (nm, nm/us).
+//! so its orbit equals the full check's to rounding: 1e-12 (nm, nm/us). The fast check's
+//! linearisation test (a transient that moves as the found orbit's monodromy predicts) must
+//! not stop a transient that heads for another orbit: from the retract orbit of the bistable
+//! window, the check finds the approach orbit.
 
 use afm::orbit::steady_orbit::{coexisting_orbit, COEXISTING_DISTANCE};
 use afm::{
@@ -63,4 +66,38 @@ fn inside_the_bistable_window_both_checks_agree() {
     for z in [19.9959, 19.9962, 19.997, 19.9975, 19.9981] {
         compare(&model, z, "maclever-mica");
     }
+}
+
+#[test]
+fn the_retract_orbit_of_the_bistable_window_has_the_approach_orbit_beside_it() {
+    // Below the window the approach reaches the retract branch's orbit; followed up into the
+    // window (at 19.997 nm) it coexists with the approach branch's, which the transient from
+    // the free state reaches. The check from the retract orbit must find that one (the
+    // linearisation test must not take the transient for the retract orbit's), equal to the
+    // full check's and to the approach start's own orbit to Newton's tolerance.
+    let model =
+        TappingModel::from_case(&builtin_case("maclever-mica").expect("case")).expect("model");
+    let settings = SteadyOrbitSettings::default();
+    let below = steady_orbit(&model, 19.995, OrbitStart::Approach, &settings).expect("below");
+    let mut retract = below;
+    for z in [19.996, 19.997] {
+        retract = steady_orbit(&model, z, OrbitStart::Near(&retract.state), &settings)
+            .expect("retract orbit");
+    }
+    let approach = steady_orbit(&model, 19.997, OrbitStart::Approach, &settings).expect("approach");
+    assert!(retract.converged && retract.stable && approach.converged && approach.stable);
+    let apart = state_distance(&retract.state, &approach.state);
+    assert!(
+        apart > 1e3 * COEXISTING_DISTANCE,
+        "the two branches' orbits are {apart:e} apart"
+    );
+    let found = coexisting_orbit(&model, &retract, OrbitStart::Transient, &settings)
+        .expect("the transient start's orbit beside the retract orbit");
+    assert!(
+        state_distance(&found.state, &approach.state) <= 1e-9,
+        "the coexisting orbit is not the approach orbit: {:e}",
+        state_distance(&found.state, &approach.state)
+    );
+    // And from the approach orbit, the transient start finds nothing else.
+    assert!(coexisting_orbit(&model, &approach, OrbitStart::Transient, &settings).is_none());
 }

@@ -82,6 +82,7 @@ mod tests {
             state: cubics.iter().map(value).collect(),
             multipliers: Vec::new(),
             stable: true,
+            monodromy: None,
             tangent: Some(cubics.iter().map(slope).collect()),
             whole_orbit: OrbitObservables::default(),
             periods: Vec::new(),

@@ -270,6 +270,7 @@ pub fn steady_orbit_in(
             state: first.state.clone(),
             stable: true,
             multipliers: first_multipliers,
+            monodromy: Some(first.sensitivities.monodromy),
             tangent: first_tangent,
             whole_orbit: first.observables.clone(),
             periods: vec![first.observables],

@@ -42,7 +42,8 @@ const MAX_WALK_STEP: f64 = 0.25;
 /// by transients (a fold or a period doubling lies within this distance).
 const MIN_WALK_STEP: f64 = 1e-3;
 
-/// The factor by which a step grows after a successful one, up to [`MAX_WALK_STEP`].
+/// The factor by which a step grows after a successful one, up to [`MAX_WALK_STEP`]; a
+/// remainder of the walk within the grown step is walked in one step.
 const STEP_GROWTH: f64 = 2.0;
 
 /// Newton's tolerance on a walk step's residual `|P(x) - x|`, in units of `A0`: the walk's
@@ -98,7 +99,13 @@ pub(crate) fn walk_approach(
     let mut before: Option<WalkPoint> = None;
     let mut step = INITIAL_WALK_STEP * amplitude;
     while last.z_nm > z_nm {
-        let z_next = (last.z_nm - step).max(z_nm);
+        // A remainder within the step the walk would grow to is taken at once, rather than
+        // as this step and a shorter one after it.
+        let z_next = if last.z_nm - z_nm <= (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude) {
+            z_nm
+        } else {
+            last.z_nm - step
+        };
         let mut at_next = model.clone();
         at_next.set_separation(Separation::Constant(z_next))?;
         let prediction = predict(z_next, &last, before.as_ref());

@@ -2,7 +2,7 @@
 //! slope along the branch, and its observables over the whole orbit and per drive period
 //! (MODEL.md sections 4 and 5).
 
-use nalgebra::Complex;
+use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
 use super::state_distance;
@@ -33,6 +33,12 @@ pub struct SteadyOrbit {
     pub multipliers: Vec<Complex<f64>>,
     /// Whether every multiplier lies inside the unit circle (the orbit attracts).
     pub stable: bool,
+    /// The monodromy matrix `dP/dx` (dimensionless, `2N x 2N` in the state's order) whose
+    /// eigenvalues are [`SteadyOrbit::multipliers`], for a period-1 orbit found by Newton
+    /// (MODEL.md section 4); `None` for an orbit of period `k T`, `k > 1`. The coexistence
+    /// check ([`crate::orbit::steady_orbit::coexisting_orbit`]) compares transients with it.
+    #[serde(skip)]
+    pub monodromy: Option<DMatrix<f64>>,
     /// `dx/dZ`: how the orbit's state at `t = 0` moves with the separation along its branch
     /// (nm per nm and nm/us per nm), `-(M - I)^{-1} dP/dZ` from the monodromy `M` and the
     /// parameter derivative `dP/dZ` of the same period map (of `P^k`; the implicit-function

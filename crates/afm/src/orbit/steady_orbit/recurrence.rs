@@ -198,6 +198,7 @@ fn finish(
         state: attempt.state,
         stable: is_stable(&attempt.multipliers),
         multipliers: attempt.multipliers,
+        monodromy: None,
         tangent: attempt.tangent,
         whole_orbit,
         periods,
