@@ -295,7 +295,7 @@ pub fn detect_transitions(
                     0.5 * (signals.z[g] + signals.z[g + 1]),
                     (signals.z[g] - signals.z[g + 1]) / 12f64.sqrt(),
                 ),
-                TransitionKind::Kink => kink_profile(&signals, range.clone(), g, w),
+                TransitionKind::Kink => kink_profile(&signals, g, w),
             };
             let (ratio, phase) = smooth_value(&signals, range, z_nm, [sigma_ratio, sigma_phase]);
             Transition {
@@ -323,44 +323,72 @@ pub fn detect_transitions(
     })
 }
 
+/// The rounding widths over which a kink's onset is profiled, as fractions of its window's `Z`
+/// span: denser than [`KINK_ROUNDING`] so that the profile of `chi^2` over the onset is smooth
+/// (a rounded hinge starting at `c` and a sharper one a little below it fit a rounded kink
+/// about equally well; the profile must show that spread; MODEL.md section 13.2).
+pub const KINK_PROFILE_ROUNDING: [f64; 13] = [
+    0.0, 0.01, 0.02, 0.035, 0.05, 0.075, 0.1, 0.125, 0.15, 0.2, 0.25, 0.3, 0.4,
+];
+
+/// Rows kept on each side of a profiled onset inside its window (the kink model has 5
+/// coefficients per signal).
+const PROFILE_MARGIN: usize = 6;
+
 /// The kink's onset `Z` and its 1-sigma uncertainty: the alternative's `chi^2`, minimised over
-/// the rounding width ([`KINK_ROUNDING`]), profiled over the onset `c` on a grid across the
-/// middle of the window; the onset is the minimum, the uncertainty the half width of the
-/// interval where `chi^2 <= min + 1` (profile likelihood).
-fn kink_profile(
-    signals: &Signals,
-    range: std::ops::Range<usize>,
-    g: usize,
-    w: usize,
-) -> (f64, f64) {
-    let z = &signals.z;
-    let high = z[(g + 1).saturating_sub(w / 2).max(range.start)];
-    let low = z[(g + w / 2).min(range.end - 1)];
-    let steps = 200;
-    let profile: Vec<(f64, f64)> = (0..=steps)
-        .map(|s| {
-            let c = high + (low - high) * s as f64 / steps as f64;
-            let chi2 = KINK_ROUNDING
-                .iter()
-                .map(|&epsilon| statistic(signals, range.clone(), c, Extra::Hinge(epsilon)).1)
-                .fold(f64::INFINITY, f64::min);
-            (c, chi2)
-        })
-        .collect();
-    let (best, minimum) = profile
-        .iter()
-        .copied()
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .expect("non-empty profile");
-    let inside: Vec<f64> = profile
-        .iter()
-        .filter(|(_, chi2)| *chi2 <= minimum + 1.0)
-        .map(|(c, _)| *c)
-        .collect();
-    let top = inside.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let bottom = inside.iter().copied().fold(f64::INFINITY, f64::min);
-    let grid = (high - low).abs() / steps as f64;
-    (best, (0.5 * (top - bottom)).max(grid))
+/// the rounding width ([`KINK_PROFILE_ROUNDING`]), profiled over the onset `c` on a 200-step
+/// grid across the window (all but [`PROFILE_MARGIN`] rows at each end); if the minimum falls
+/// in the outer quarter of that range the window is re-centred on it and the profile repeated
+/// (at most 4 times), so that the scan's candidate, which maximises the statistic rather than
+/// locating the onset, never truncates the profile. The onset is the minimum, the uncertainty
+/// the half width of the set where `chi^2 <= min + 1` (profile likelihood).
+fn kink_profile(signals: &Signals, g: usize, w: usize) -> (f64, f64) {
+    let n = signals.z.len();
+    let mut centre = g;
+    let mut result = (signals.z[g], f64::INFINITY);
+    for _ in 0..4 {
+        let start = (centre + 1).saturating_sub(w).min(n - 2 * w);
+        let range = start..start + 2 * w;
+        let z = &signals.z;
+        let high = z[range.start + PROFILE_MARGIN];
+        let low = z[range.end - 1 - PROFILE_MARGIN];
+        let steps = 200;
+        let profile: Vec<(f64, f64)> = (0..=steps)
+            .map(|s| {
+                let c = high + (low - high) * s as f64 / steps as f64;
+                let chi2 = KINK_PROFILE_ROUNDING
+                    .iter()
+                    .map(|&epsilon| statistic(signals, range.clone(), c, Extra::Hinge(epsilon)).1)
+                    .fold(f64::INFINITY, f64::min);
+                (c, chi2)
+            })
+            .collect();
+        let (best_index, minimum) = profile
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (k, p.1))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("non-empty profile");
+        let best = profile[best_index].0;
+        let inside: Vec<f64> = profile
+            .iter()
+            .filter(|(_, chi2)| *chi2 <= minimum + 1.0)
+            .map(|(c, _)| *c)
+            .collect();
+        let top = inside.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let bottom = inside.iter().copied().fold(f64::INFINITY, f64::min);
+        let grid = (high - low).abs() / steps as f64;
+        result = (best, (0.5 * (top - bottom)).max(grid));
+        let central = (steps / 4..=3 * steps / 4).contains(&best_index);
+        // The row just above the estimate becomes the new centre.
+        let next = z.partition_point(|&zi| zi >= best).saturating_sub(1);
+        let edge_of_data = (next + 1 < w && start == 0) || (next + w >= n && start == n - 2 * w);
+        if central || next == centre || edge_of_data {
+            break;
+        }
+        centre = next.max(w - 1).min(n - w - 1);
+    }
+    result
 }
 
 /// `A/A0` and phase of the window's null (quadratic) fit on the upper side at `z`.
