@@ -74,6 +74,20 @@ fn maclever_mica_g2_is_found_within_three_sigma_in_18_of_20_seeds() {
     }
 }
 
+/// The Biolever on the soft sample: G2 (A/A0 = 0.93, 1.2 nm below G1) and the weak G3 kink
+/// (A/A0 = 0.48, whose slope change builds up over about 0.5 nm and which only the long scan
+/// window resolves) each found within 3 of its reported sigmas in at least 4 of 5 seeds (the
+/// full study over 20 seeds is the ignored `detection_studies`: 19/20 and 18/20).
+#[test]
+fn biolever_soft_g2_and_weak_g3_are_found_within_three_sigma() {
+    let counts = detection_counts("biolever-soft", 0..5);
+    println!("{counts:?}");
+    assert_eq!(counts.len(), 2, "{counts:?}");
+    for (label, count) in counts {
+        assert!(count >= 4, "{label}: {count} of 5");
+    }
+}
+
 /// Smooth noisy curves: the model's branch between G2 + 1 nm and G1 - 1 nm (no transition
 /// there), 30 seeds: at most 1 (3%; the level is 1%) may show a spurious transition at the default level.
 #[test]

@@ -13,10 +13,13 @@
 //! smooth curve exceeds its `T`. A transition is reported where that bound is below the significance level.
 
 use nalgebra::{DMatrix, DVector};
+use rand::rngs::StdRng;
+use rand::SeedableRng;
 use serde::Serialize;
 
 use crate::error::AfmError;
 use crate::fit::measurement::{noise_sigma, MeasuredPoint};
+use crate::fit::synthetic::gaussian;
 
 /// The rounding widths tried when a kink is located, as fractions of the window's `Z` span: the
 /// kink term is a hinge whose slope change builds up linearly over the width `epsilon` below
@@ -106,6 +109,9 @@ pub struct Transition {
     pub significance: f64,
     /// The statistic `T` (drop of `chi^2` from the smooth null).
     pub statistic: f64,
+    /// Rows on each side of the window that found it (the short scan window, or the long one
+    /// for a kink only the long window resolves).
+    pub half_window: usize,
 }
 
 /// The result of a detection.
@@ -152,52 +158,60 @@ enum Extra {
     Step,
 }
 
-/// The design matrix over the window's `z` centred at `c`: `1, u, u^2` (u scaled to the
-/// window) and, if any, the `extra` term (a hinge also frees the curvature below `c`:
-/// `(c - Z)_+^2`).
-fn design(z: &[f64], c: f64, extra: Option<Extra>) -> DMatrix<f64> {
+/// The design matrix over the window's `z` centred at `c`: the null polynomial `1, u, ...,
+/// u^degree` (u scaled to the window) and, if any, the `extra` term (a hinge also frees the
+/// curvature below `c`: `(c - Z)_+^2`).
+fn design(z: &[f64], c: f64, degree: usize, extra: Option<Extra>) -> DMatrix<f64> {
     let scale = (z[0] - z[z.len() - 1]).abs().max(1e-300);
-    let columns = match extra {
-        None => 3,
-        Some(Extra::Step) => 4,
-        Some(Extra::Hinge(_)) => 5,
-    };
+    let columns = degree
+        + 1
+        + match extra {
+            None => 0,
+            Some(Extra::Step) => 1,
+            Some(Extra::Hinge(_)) => 2,
+        };
     DMatrix::from_fn(z.len(), columns, |i, j| {
         let u = (z[i] - c) / scale;
-        match j {
-            0 => 1.0,
-            1 => u,
-            2 => u * u,
-            4 => u.min(0.0).powi(2),
-            _ => match extra {
-                Some(Extra::Hinge(epsilon)) => {
-                    let s = -u;
-                    if s <= 0.0 {
-                        0.0
-                    } else if s < epsilon {
-                        s * s / (2.0 * epsilon)
-                    } else {
-                        s - 0.5 * epsilon
-                    }
+        if j <= degree {
+            return u.powi(j as i32);
+        }
+        if j == degree + 2 {
+            return u.min(0.0).powi(2);
+        }
+        match extra {
+            Some(Extra::Hinge(epsilon)) => {
+                let s = -u;
+                if s <= 0.0 {
+                    0.0
+                } else if s < epsilon {
+                    s * s / (2.0 * epsilon)
+                } else {
+                    s - 0.5 * epsilon
                 }
-                _ => {
-                    if u < 0.0 {
-                        1.0
-                    } else {
-                        0.0
-                    }
+            }
+            _ => {
+                if u < 0.0 {
+                    1.0
+                } else {
+                    0.0
                 }
-            },
+            }
         }
     })
 }
 
-/// The drop of `chi^2` (both signals) from the quadratic null to the null plus `kind` at `c`
+/// The drop of `chi^2` (both signals) from the null polynomial of `degree` to the null plus `kind` at `c`
 /// over the window's rows, and the alternative's `chi^2`.
-fn statistic(signals: &Signals, range: std::ops::Range<usize>, c: f64, extra: Extra) -> (f64, f64) {
+fn statistic(
+    signals: &Signals,
+    range: std::ops::Range<usize>,
+    c: f64,
+    degree: usize,
+    extra: Extra,
+) -> (f64, f64) {
     let z = &signals.z[range.clone()];
-    let null = design(z, c, None);
-    let alternative = design(z, c, Some(extra));
+    let null = design(z, c, degree, None);
+    let alternative = design(z, c, degree, Some(extra));
     let (mut drop, mut chi2) = (0.0, 0.0);
     for values in &signals.values {
         let y = DVector::from_column_slice(&values[range.clone()]);
@@ -207,6 +221,48 @@ fn statistic(signals: &Signals, range: std::ops::Range<usize>, c: f64, extra: Ex
         chi2 += r1;
     }
     (drop, chi2)
+}
+
+/// A scan's window: rows on each side of a candidate and the degree of the null polynomial.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Scale {
+    half_window: usize,
+    degree: usize,
+}
+
+/// The long scan window's half width in short ones: a weak kink whose slope change builds up
+/// over more than the short window is found at this scale, against a quartic null (MODEL.md
+/// section 13.2).
+pub const LONG_WINDOW_FACTOR: usize = 3;
+
+/// The statistic at candidate gap `g` (between rows `g` and `g + 1`) on `scale`: the larger of
+/// the kink's (maximised over [`KINK_ROUNDING`]) and the jump's, its kind and its single-test
+/// tail probability.
+fn candidate_score(signals: &Signals, g: usize, scale: Scale) -> (f64, TransitionKind, f64) {
+    let w = scale.half_window;
+    let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
+    let range = g + 1 - w..g + w + 1;
+    let kink = KINK_ROUNDING
+        .iter()
+        .map(|&epsilon| {
+            statistic(
+                signals,
+                range.clone(),
+                c,
+                scale.degree,
+                Extra::Hinge(epsilon),
+            )
+            .0
+        })
+        .fold(f64::NEG_INFINITY, f64::max);
+    let (jump, _) = statistic(signals, range, c, scale.degree, Extra::Step);
+    let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
+    let jump_tail = (-0.5 * jump).exp();
+    if jump_tail < kink_tail {
+        (jump, TransitionKind::Jump, jump_tail)
+    } else {
+        (kink, TransitionKind::Kink, kink_tail)
+    }
 }
 
 /// Detect transitions on a curve sorted by decreasing `Z` (an approach) or increasing `Z`.
@@ -246,56 +302,67 @@ pub fn detect_transitions(
             phases.iter().map(|p| p / sigma_phase).collect(),
         ],
     };
+    // The scales: the short window with the quadratic null, and, where the curve is long
+    // enough, the long one with the quartic null (MODEL.md section 13.2).
+    let mut scales = vec![Scale {
+        half_window: w,
+        degree: 2,
+    }];
+    let long = LONG_WINDOW_FACTOR * w;
+    if n / 4 >= long {
+        scales.push(Scale {
+            half_window: long,
+            degree: 4,
+        });
+    }
     // Candidate g lies between rows g and g + 1, window rows g + 1 - w ..= g + w.
-    let candidates: Vec<usize> = (w - 1..n - w).collect();
-    let tests = (KINK_ROUNDING.len() + 1) * candidates.len();
-    let threshold = 2.0 * (tests as f64 / settings.significance).ln();
-    // Per candidate: the larger alternative's statistic, its kind and its single-test tail
-    // probability (kink: chi^2 with 4 degrees of freedom, the hinge and the free curvature for
-    // each signal; jump: chi^2 with 2).
-    let scores: Vec<(f64, TransitionKind, f64)> = candidates
+    let per_scale: Vec<Vec<usize>> = scales
         .iter()
-        .map(|&g| {
-            let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
-            let range = g + 1 - w..g + w + 1;
-            let kink = KINK_ROUNDING
+        .map(|scale| (scale.half_window - 1..n - scale.half_window).collect())
+        .collect();
+    let tests = (KINK_ROUNDING.len() + 1) * per_scale.iter().map(Vec::len).sum::<usize>();
+    let threshold = 2.0 * (tests as f64 / settings.significance).ln();
+    let mut chosen: Vec<(usize, Scale, f64, TransitionKind, f64)> = Vec::new();
+    for (scale, candidates) in scales.iter().zip(&per_scale) {
+        // Per candidate: the larger alternative's statistic, its kind and its single-test tail
+        // probability (kink: chi^2 with 4 degrees of freedom, the hinge and the free curvature
+        // for each signal; jump: chi^2 with 2).
+        let scores: Vec<(f64, TransitionKind, f64)> = candidates
+            .iter()
+            .map(|&g| candidate_score(&signals, g, *scale))
+            .collect();
+        // Above the threshold, strongest first; a candidate whose window holds a stronger
+        // chosen one of its scale (within 2 w rows) is that one's shadow, and a longer scale
+        // adds only what lies 2 of its windows away from every transition already found.
+        let mut order: Vec<usize> = (0..candidates.len())
+            .filter(|&k| tests as f64 * scores[k].2 < settings.significance)
+            .collect();
+        order.sort_by(|&a, &b| scores[a].2.total_cmp(&scores[b].2));
+        let before = chosen.len();
+        for k in order {
+            let g = candidates[k];
+            if chosen[..before]
                 .iter()
-                .map(|&epsilon| statistic(&signals, range.clone(), c, Extra::Hinge(epsilon)).0)
-                .fold(f64::NEG_INFINITY, f64::max);
-            let (jump, _) = statistic(&signals, range, c, Extra::Step);
-            let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
-            let jump_tail = (-0.5 * jump).exp();
-            if jump_tail < kink_tail {
-                (jump, TransitionKind::Jump, jump_tail)
-            } else {
-                (kink, TransitionKind::Kink, kink_tail)
+                .all(|c| c.0.abs_diff(g) > 2 * scale.half_window)
+                && chosen[before..]
+                    .iter()
+                    .all(|c| c.0.abs_diff(g) > 2 * scale.half_window)
+            {
+                chosen.push((g, *scale, scores[k].0, scores[k].1, scores[k].2));
             }
-        })
-        .collect();
-    // Local maxima above the threshold, strongest first; a candidate whose window holds a
-    // stronger chosen one (within 2 w rows) is that one's shadow.
-    let mut order: Vec<usize> = (0..candidates.len())
-        .filter(|&k| tests as f64 * scores[k].2 < settings.significance)
-        .collect();
-    order.sort_by(|&a, &b| scores[a].2.total_cmp(&scores[b].2));
-    let mut chosen: Vec<usize> = Vec::new();
-    for k in order {
-        if chosen.iter().all(|&c| c.abs_diff(k) > 2 * w) {
-            chosen.push(k);
         }
     }
     let mut transitions: Vec<Transition> = chosen
         .into_iter()
-        .map(|k| {
-            let g = candidates[k];
-            let (score, kind, tail) = scores[k];
+        .map(|(g, scale, score, kind, tail)| {
+            let w = scale.half_window;
             let range = g + 1 - w..g + w + 1;
             let (z_nm, z_uncertainty_nm) = match kind {
                 TransitionKind::Jump => (
                     0.5 * (signals.z[g] + signals.z[g + 1]),
                     (signals.z[g] - signals.z[g + 1]) / 12f64.sqrt(),
                 ),
-                TransitionKind::Kink => kink_profile(&signals, g, w),
+                TransitionKind::Kink => kink_profile(&signals, g, scale),
             };
             let (ratio, phase) = smooth_value(&signals, range, z_nm, [sigma_ratio, sigma_phase]);
             Transition {
@@ -306,6 +373,7 @@ pub fn detect_transitions(
                 kind,
                 significance: (tests as f64 * tail).min(1.0),
                 statistic: score,
+                half_window: w,
             }
         })
         .collect();
@@ -342,10 +410,12 @@ const PROFILE_MARGIN: usize = 6;
 /// (at most 4 times), so that the scan's candidate, which maximises the statistic rather than
 /// locating the onset, never truncates the profile. The onset is the minimum, the uncertainty
 /// the half width of the set where `chi^2 <= min + 1` (profile likelihood).
-fn kink_profile(signals: &Signals, g: usize, w: usize) -> (f64, f64) {
+fn kink_profile(signals: &Signals, g: usize, scale: Scale) -> (f64, f64) {
+    let (w, degree) = (scale.half_window, scale.degree);
     let n = signals.z.len();
     let mut centre = g;
     let mut result = (signals.z[g], f64::INFINITY);
+    let mut window = 0..0;
     for _ in 0..4 {
         let start = (centre + 1).saturating_sub(w).min(n - 2 * w);
         let range = start..start + 2 * w;
@@ -358,7 +428,9 @@ fn kink_profile(signals: &Signals, g: usize, w: usize) -> (f64, f64) {
                 let c = high + (low - high) * s as f64 / steps as f64;
                 let chi2 = KINK_PROFILE_ROUNDING
                     .iter()
-                    .map(|&epsilon| statistic(signals, range.clone(), c, Extra::Hinge(epsilon)).1)
+                    .map(|&epsilon| {
+                        statistic(signals, range.clone(), c, degree, Extra::Hinge(epsilon)).1
+                    })
                     .fold(f64::INFINITY, f64::min);
                 (c, chi2)
             })
@@ -379,6 +451,7 @@ fn kink_profile(signals: &Signals, g: usize, w: usize) -> (f64, f64) {
         let bottom = inside.iter().copied().fold(f64::INFINITY, f64::min);
         let grid = (high - low).abs() / steps as f64;
         result = (best, (0.5 * (top - bottom)).max(grid));
+        window = range.clone();
         let central = (steps / 4..=3 * steps / 4).contains(&best_index);
         // The row just above the estimate becomes the new centre.
         let next = z.partition_point(|&zi| zi >= best).saturating_sub(1);
@@ -388,7 +461,108 @@ fn kink_profile(signals: &Signals, g: usize, w: usize) -> (f64, f64) {
         }
         centre = next.max(w - 1).min(n - w - 1);
     }
-    result
+    let spread = bootstrap_spread(signals, window, result.0, degree, g as u64);
+    (result.0, result.1.max(spread))
+}
+
+/// Replicates of the parametric bootstrap of a kink's onset.
+pub const BOOTSTRAP_REPLICATES: usize = 60;
+
+/// The parametric bootstrap of a kink's onset (MODEL.md section 13.2): the kink model fitted at
+/// the onset `c` (rounding minimising `chi^2`) is taken as the truth, white Gaussian noise of
+/// the estimated levels is added [`BOOTSTRAP_REPLICATES`] times (seeded by `seed`, so a
+/// detection is reproducible), and each replicate's onset is located by the same profile (on a
+/// 100-step grid, [`KINK_ROUNDING`]); the result is the standard deviation of those onsets
+/// about `c`, nm. It holds what the `Delta chi^2 = 1` interval misses when the profile is
+/// flat or has several minima (a rounded onset trades against a sharper hinge below it).
+fn bootstrap_spread(
+    signals: &Signals,
+    range: std::ops::Range<usize>,
+    c: f64,
+    degree: usize,
+    seed: u64,
+) -> f64 {
+    let z = &signals.z[range.clone()];
+    let len = z.len();
+    // The fitted kink model at c.
+    let best_epsilon = KINK_PROFILE_ROUNDING
+        .iter()
+        .copied()
+        .min_by(|&a, &b| {
+            statistic(signals, range.clone(), c, degree, Extra::Hinge(a))
+                .1
+                .total_cmp(&statistic(signals, range.clone(), c, degree, Extra::Hinge(b)).1)
+        })
+        .unwrap_or(0.0);
+    let fitted_design = design(z, c, degree, Some(Extra::Hinge(best_epsilon)));
+    let fitted_svd = fitted_design.clone().svd(true, true);
+    let fitted: Vec<DVector<f64>> = signals
+        .values
+        .iter()
+        .map(|values| {
+            let y = DVector::from_column_slice(&values[range.clone()]);
+            match fitted_svd.solve(&y, 1e-12) {
+                Ok(coefficients) => &fitted_design * coefficients,
+                Err(_) => y,
+            }
+        })
+        .collect();
+    // Orthonormal bases of every (onset, rounding) alternative: the residual of y is
+    // |y|^2 - |U^T y|^2.
+    let (high, low) = (z[PROFILE_MARGIN], z[len - 1 - PROFILE_MARGIN]);
+    let steps = 100;
+    let grid: Vec<f64> = (0..=steps)
+        .map(|s| high + (low - high) * s as f64 / steps as f64)
+        .collect();
+    let bases: Vec<Vec<DMatrix<f64>>> = grid
+        .iter()
+        .map(|&onset| {
+            KINK_ROUNDING
+                .iter()
+                .map(|&epsilon| {
+                    orthonormal_basis(&design(z, onset, degree, Some(Extra::Hinge(epsilon))))
+                })
+                .collect()
+        })
+        .collect();
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut sum2 = 0.0;
+    for _ in 0..BOOTSTRAP_REPLICATES {
+        let replicate: Vec<DVector<f64>> = fitted
+            .iter()
+            .map(|f| f.map(|v| v + gaussian(&mut rng)))
+            .collect();
+        let mut best = (f64::NEG_INFINITY, c);
+        for (onset, row) in grid.iter().zip(&bases) {
+            // The largest explained sum of squares is the smallest residual.
+            let explained = row
+                .iter()
+                .map(|u| {
+                    replicate
+                        .iter()
+                        .map(|y| (u.transpose() * y).norm_squared())
+                        .sum::<f64>()
+                })
+                .fold(f64::NEG_INFINITY, f64::max);
+            if explained > best.0 {
+                best = (explained, *onset);
+            }
+        }
+        sum2 += (best.1 - c).powi(2);
+    }
+    (sum2 / BOOTSTRAP_REPLICATES as f64).sqrt()
+}
+
+/// An orthonormal basis of the column space of `design` (left singular vectors of the
+/// singular values above `1e-10` of the largest).
+fn orthonormal_basis(design: &DMatrix<f64>) -> DMatrix<f64> {
+    let svd = design.clone().svd(true, false);
+    let u = svd.u.expect("left singular vectors requested");
+    let largest = svd.singular_values.max();
+    let kept: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&k| svd.singular_values[k] > 1e-10 * largest)
+        .collect();
+    DMatrix::from_fn(u.nrows(), kept.len(), |i, j| u[(i, kept[j])])
 }
 
 /// `A/A0` and phase of the window's null (quadratic) fit on the upper side at `z`.
@@ -407,7 +581,7 @@ fn smooth_value(
             signals.values[1][i] * sigma[1],
         );
     }
-    let d = design(&zs, z, None);
+    let d = design(&zs, z, 2, None);
     let mut out = [0.0; 2];
     for (k, values) in signals.values.iter().enumerate() {
         let y = DVector::from_iterator(rows.len(), rows.iter().map(|&i| values[i]));
