@@ -138,15 +138,6 @@ struct Signals {
     values: [Vec<f64>; 2],
 }
 
-/// The residual sum of squares of the least-squares fit of `y` by the columns of `design`.
-fn rss(design: &DMatrix<f64>, y: &DVector<f64>) -> f64 {
-    let svd = design.clone().svd(true, true);
-    match svd.solve(y, 1e-12) {
-        Ok(coefficients) => (design * coefficients - y).norm_squared(),
-        Err(_) => f64::INFINITY,
-    }
-}
-
 /// The term added to the smooth null at `c`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Extra {
@@ -200,27 +191,32 @@ fn design(z: &[f64], c: f64, degree: usize, extra: Option<Extra>) -> DMatrix<f64
     })
 }
 
-/// The drop of `chi^2` (both signals) from the null polynomial of `degree` to the null plus `kind` at `c`
-/// over the window's rows, and the alternative's `chi^2`.
-fn statistic(
+/// The sum of squares of `y` explained by the orthonormal `basis`: `|basis^T y|^2` (the
+/// residual of the least-squares fit is `|y|^2` minus it).
+fn explained(basis: &DMatrix<f64>, y: &DVector<f64>) -> f64 {
+    (basis.transpose() * y).norm_squared()
+}
+
+/// The window's rows of both signals.
+fn window_values(signals: &Signals, range: std::ops::Range<usize>) -> [DVector<f64>; 2] {
+    [0, 1].map(|k| DVector::from_column_slice(&signals.values[k][range.clone()]))
+}
+
+/// The `chi^2` (both signals) of the null polynomial of `degree` plus the kink term `extra` at
+/// `c` over the window's rows.
+fn alternative_chi2(
     signals: &Signals,
     range: std::ops::Range<usize>,
     c: f64,
     degree: usize,
     extra: Extra,
-) -> (f64, f64) {
+) -> f64 {
     let z = &signals.z[range.clone()];
-    let null = design(z, c, degree, None);
-    let alternative = design(z, c, degree, Some(extra));
-    let (mut drop, mut chi2) = (0.0, 0.0);
-    for values in &signals.values {
-        let y = DVector::from_column_slice(&values[range.clone()]);
-        let r0 = rss(&null, &y);
-        let r1 = rss(&alternative, &y);
-        drop += r0 - r1;
-        chi2 += r1;
-    }
-    (drop, chi2)
+    let basis = orthonormal_basis(&design(z, c, degree, Some(extra)));
+    window_values(signals, range)
+        .iter()
+        .map(|y| (y.norm_squared() - explained(&basis, y)).max(0.0))
+        .sum()
 }
 
 /// A scan's window: rows on each side of a candidate and the degree of the null polynomial.
@@ -242,20 +238,19 @@ fn candidate_score(signals: &Signals, g: usize, scale: Scale) -> (f64, Transitio
     let w = scale.half_window;
     let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
     let range = g + 1 - w..g + w + 1;
+    let z = &signals.z[range.clone()];
+    let ys = window_values(signals, range);
+    let null = orthonormal_basis(&design(z, c, scale.degree, None));
+    let null_explained: f64 = ys.iter().map(|y| explained(&null, y)).sum();
+    let drop = |extra: Extra| {
+        let basis = orthonormal_basis(&design(z, c, scale.degree, Some(extra)));
+        ys.iter().map(|y| explained(&basis, y)).sum::<f64>() - null_explained
+    };
     let kink = KINK_ROUNDING
         .iter()
-        .map(|&epsilon| {
-            statistic(
-                signals,
-                range.clone(),
-                c,
-                scale.degree,
-                Extra::Hinge(epsilon),
-            )
-            .0
-        })
+        .map(|&epsilon| drop(Extra::Hinge(epsilon)))
         .fold(f64::NEG_INFINITY, f64::max);
-    let (jump, _) = statistic(signals, range, c, scale.degree, Extra::Step);
+    let jump = drop(Extra::Step);
     let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
     let jump_tail = (-0.5 * jump).exp();
     if jump_tail < kink_tail {
@@ -429,7 +424,7 @@ fn kink_profile(signals: &Signals, g: usize, scale: Scale) -> (f64, f64) {
                 let chi2 = KINK_PROFILE_ROUNDING
                     .iter()
                     .map(|&epsilon| {
-                        statistic(signals, range.clone(), c, degree, Extra::Hinge(epsilon)).1
+                        alternative_chi2(signals, range.clone(), c, degree, Extra::Hinge(epsilon))
                     })
                     .fold(f64::INFINITY, f64::min);
                 (c, chi2)
@@ -489,9 +484,9 @@ fn bootstrap_spread(
         .iter()
         .copied()
         .min_by(|&a, &b| {
-            statistic(signals, range.clone(), c, degree, Extra::Hinge(a))
-                .1
-                .total_cmp(&statistic(signals, range.clone(), c, degree, Extra::Hinge(b)).1)
+            alternative_chi2(signals, range.clone(), c, degree, Extra::Hinge(a)).total_cmp(
+                &alternative_chi2(signals, range.clone(), c, degree, Extra::Hinge(b)),
+            )
         })
         .unwrap_or(0.0);
     let fitted_design = design(z, c, degree, Some(Extra::Hinge(best_epsilon)));
