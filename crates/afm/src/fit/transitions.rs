@@ -4,13 +4,17 @@
 //! false-alarm rate.
 //!
 //! At every gap between consecutive rows a window of `w` rows on each side is fitted by a
-//! quadratic in `Z` (the smooth null), and by the quadratic plus a kink term
-//! `(c - Z)_+^{3/2}` (the shape of a grazing with Hertz contact) or plus a step `H(c - Z)`,
-//! for `A/A0` and phase together, each weighted by its noise (from second differences). The
-//! drop `T` of `chi^2` from the null is `chi^2` with 4 (kink: hinge and curvature below `c`
-//! per signal) or 2 (jump) degrees of freedom on a smooth curve with white Gaussian noise, and
-//! over `M` tests the Bonferroni bound `M P(T)` bounds the probability that any test on a
-//! smooth curve exceeds its `T`. A transition is reported where that bound is below the significance level.
+//! quadratic in `Z` (the smooth null), and by the quadratic plus a rounded hinge and a free
+//! curvature below the onset `c` (the shape of a grazing with Hertz contact: a jump of
+//! curvature turning into a change of slope) or plus a step `H(c - Z)`, for `A/A0` and phase
+//! together, each weighted by its noise (from second differences); a long window of
+//! [`LONG_WINDOW_FACTOR`] `w` rows against a quartic null adds the weak kinks whose slope
+//! change builds up over more than the short window. The drop `T` of `chi^2` from the null is
+//! `chi^2` with 4 (kink) or 2 (jump) degrees of freedom on a smooth curve with white Gaussian
+//! noise, and over `M` tests the Bonferroni bound `M P(T)` bounds the probability that any
+//! test on a smooth curve exceeds its `T`. A transition is reported where that bound is below
+//! the significance level. A kink's onset is the minimum of its profile likelihood, its
+//! uncertainty the larger of the profile's and a parametric bootstrap's.
 
 use nalgebra::{DMatrix, DVector};
 use rand::rngs::StdRng;
@@ -121,9 +125,10 @@ pub struct Detection {
     pub a0_nm: f64,
     /// The noise estimates.
     pub noise: CurveNoise,
-    /// Rows on each side of a window.
+    /// Rows on each side of the short window (the long one has [`LONG_WINDOW_FACTOR`] times
+    /// as many).
     pub half_window: usize,
-    /// Tests made (`M`).
+    /// Tests made (`M`, both windows).
     pub tests: usize,
     /// The threshold on a jump's `T`, `2 ln(M / significance)` (a kink's is higher: its tail
     /// is `exp(-T/2) (1 + T/2)`).
