@@ -202,9 +202,15 @@ fn explained(basis: &DMatrix<f64>, y: &DVector<f64>) -> f64 {
     (basis.transpose() * y).norm_squared()
 }
 
-/// The window's rows of both signals.
+/// The window's rows of both signals, less their mean over the window (every model holds the
+/// constant, so residuals are unchanged, and `|y|^2 - |U^T y|^2` loses no digits to a large
+/// offset).
 fn window_values(signals: &Signals, range: std::ops::Range<usize>) -> [DVector<f64>; 2] {
-    [0, 1].map(|k| DVector::from_column_slice(&signals.values[k][range.clone()]))
+    [0, 1].map(|k| {
+        let y = DVector::from_column_slice(&signals.values[k][range.clone()]);
+        let mean = y.mean();
+        y.add_scalar(-mean)
+    })
 }
 
 /// The `chi^2` (both signals) of the null polynomial of `degree` plus the kink term `extra` at
@@ -496,15 +502,11 @@ fn bootstrap_spread(
         .unwrap_or(0.0);
     let fitted_design = design(z, c, degree, Some(Extra::Hinge(best_epsilon)));
     let fitted_svd = fitted_design.clone().svd(true, true);
-    let fitted: Vec<DVector<f64>> = signals
-        .values
-        .iter()
-        .map(|values| {
-            let y = DVector::from_column_slice(&values[range.clone()]);
-            match fitted_svd.solve(&y, 1e-12) {
-                Ok(coefficients) => &fitted_design * coefficients,
-                Err(_) => y,
-            }
+    let fitted: Vec<DVector<f64>> = window_values(signals, range.clone())
+        .into_iter()
+        .map(|y| match fitted_svd.solve(&y, 1e-12) {
+            Ok(coefficients) => &fitted_design * coefficients,
+            Err(_) => y,
         })
         .collect();
     // Orthonormal bases of every (onset, rounding) alternative: the residual of y is
