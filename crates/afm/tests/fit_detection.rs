@@ -7,9 +7,8 @@
 use afm::fit::followed_branch::FollowedBranch;
 use afm::fit::measurement::MeasuredPoint;
 use afm::fit::synthetic::{model_branch, synthetic_approach, SyntheticInstrument};
-use afm::fit::transitions::{
-    detect_transitions, DetectionSettings, KINK_ROUNDING, LONG_WINDOW_FACTOR,
-};
+use afm::fit::transitions::{detect_transitions, DetectionSettings, LONG_WINDOW_FACTOR};
+use afm::fit::window_models::KINK_ROUNDING;
 use afm::{builtin_case, TappingModel};
 
 fn branch_of(case: &str) -> (FollowedBranch, f64) {
