@@ -50,8 +50,9 @@ impl Default for SyntheticInstrument {
     }
 }
 
-/// A standard normal deviate by Box-Muller from two uniform deviates.
-fn gaussian(rng: &mut StdRng) -> f64 {
+/// A standard normal deviate (mean 0, deviation 1) by Box-Muller from two uniform deviates of
+/// `rng`.
+pub fn gaussian(rng: &mut StdRng) -> f64 {
     let u1: f64 = 1.0 - rng.random::<f64>();
     let u2: f64 = rng.random::<f64>();
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()

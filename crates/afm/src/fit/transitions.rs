@@ -4,24 +4,27 @@
 //! false-alarm rate.
 //!
 //! At every gap between consecutive rows a window of `w` rows on each side is fitted by a
-//! quadratic in `Z` (the smooth null), and by the quadratic plus a kink term
-//! `(c - Z)_+^{3/2}` (the shape of a grazing with Hertz contact) or plus a step `H(c - Z)`,
-//! for `A/A0` and phase together, each weighted by its noise (from second differences). The
-//! drop `T` of `chi^2` from the null is `chi^2` with 4 (kink: hinge and curvature below `c`
-//! per signal) or 2 (jump) degrees of freedom on a smooth curve with white Gaussian noise, and
-//! over `M` tests the Bonferroni bound `M P(T)` bounds the probability that any test on a
-//! smooth curve exceeds its `T`. A transition is reported where that bound is below the significance level.
+//! quadratic in `Z` (the smooth null), and by the quadratic plus a rounded hinge and a free
+//! curvature below the onset `c` (the shape of a grazing with Hertz contact: a jump of
+//! curvature turning into a change of slope) or plus a step `H(c - Z)`, for `A/A0` and phase
+//! together, each weighted by its noise (from second differences); a long window of
+//! [`LONG_WINDOW_FACTOR`] `w` rows against a quartic null adds the weak kinks whose slope
+//! change builds up over more than the short window. The drop `T` of `chi^2` from the null is
+//! `chi^2` with 4 (kink) or 2 (jump) degrees of freedom on a smooth curve with white Gaussian
+//! noise, and over `M` tests the Bonferroni bound `M P(T)` bounds the probability that any
+//! test on a smooth curve exceeds its `T`. A transition is reported where that bound is below
+//! the significance level. A kink's onset is the minimum of its profile likelihood, its
+//! uncertainty the larger of the profile's and a parametric bootstrap's.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use serde::Serialize;
 
 use crate::error::AfmError;
+use crate::fit::kink_onset::kink_onset;
 use crate::fit::measurement::{noise_sigma, MeasuredPoint};
-
-/// The rounding widths tried when a kink is located, as fractions of the window's `Z` span: the
-/// kink term is a hinge whose slope change builds up linearly over the width `epsilon` below
-/// the onset `c` (a grazing's new impact grows from zero depth; MODEL.md section 13.2).
-pub const KINK_ROUNDING: [f64; 7] = [0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3];
+use crate::fit::window_models::{
+    design, explained, orthonormal_basis, window_values, Extra, Scale, Signals, KINK_ROUNDING,
+};
 
 /// How transitions are searched for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,6 +109,9 @@ pub struct Transition {
     pub significance: f64,
     /// The statistic `T` (drop of `chi^2` from the smooth null).
     pub statistic: f64,
+    /// Rows on each side of the window that found it (the short scan window, or the long one
+    /// for a kink only the long window resolves).
+    pub half_window: usize,
 }
 
 /// The result of a detection.
@@ -115,9 +121,10 @@ pub struct Detection {
     pub a0_nm: f64,
     /// The noise estimates.
     pub noise: CurveNoise,
-    /// Rows on each side of a window.
+    /// Rows on each side of the short window (the long one has [`LONG_WINDOW_FACTOR`] times
+    /// as many).
     pub half_window: usize,
-    /// Tests made (`M`).
+    /// Tests made (`M`, both windows).
     pub tests: usize,
     /// The threshold on a jump's `T`, `2 ln(M / significance)` (a kink's is higher: its tail
     /// is `exp(-T/2) (1 + T/2)`).
@@ -126,87 +133,38 @@ pub struct Detection {
     pub transitions: Vec<Transition>,
 }
 
-/// The two signals of a window, scaled by their noise: `A/A0 / sigma_r` and `phase / sigma_phi`.
-struct Signals {
-    z: Vec<f64>,
-    values: [Vec<f64>; 2],
-}
+/// The long scan window's half width in short ones: a weak kink whose slope change builds up
+/// over more than the short window is found at this scale, against a quartic null (MODEL.md
+/// section 13.2).
+pub const LONG_WINDOW_FACTOR: usize = 3;
 
-/// The residual sum of squares of the least-squares fit of `y` by the columns of `design`.
-fn rss(design: &DMatrix<f64>, y: &DVector<f64>) -> f64 {
-    let svd = design.clone().svd(true, true);
-    match svd.solve(y, 1e-12) {
-        Ok(coefficients) => (design * coefficients - y).norm_squared(),
-        Err(_) => f64::INFINITY,
-    }
-}
-
-/// The term added to the smooth null at `c`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Extra {
-    /// The rounded hinge of width `epsilon` (a fraction of the window's span): with
-    /// `s = (c - Z) / span`, `0` above `c`, `s^2 / (2 epsilon)` for `0 < s < epsilon`, then
-    /// `s - epsilon / 2` (a sharp hinge for `epsilon = 0`).
-    Hinge(f64),
-    /// The step `H(c - Z)`.
-    Step,
-}
-
-/// The design matrix over the window's `z` centred at `c`: `1, u, u^2` (u scaled to the
-/// window) and, if any, the `extra` term (a hinge also frees the curvature below `c`:
-/// `(c - Z)_+^2`).
-fn design(z: &[f64], c: f64, extra: Option<Extra>) -> DMatrix<f64> {
-    let scale = (z[0] - z[z.len() - 1]).abs().max(1e-300);
-    let columns = match extra {
-        None => 3,
-        Some(Extra::Step) => 4,
-        Some(Extra::Hinge(_)) => 5,
-    };
-    DMatrix::from_fn(z.len(), columns, |i, j| {
-        let u = (z[i] - c) / scale;
-        match j {
-            0 => 1.0,
-            1 => u,
-            2 => u * u,
-            4 => u.min(0.0).powi(2),
-            _ => match extra {
-                Some(Extra::Hinge(epsilon)) => {
-                    let s = -u;
-                    if s <= 0.0 {
-                        0.0
-                    } else if s < epsilon {
-                        s * s / (2.0 * epsilon)
-                    } else {
-                        s - 0.5 * epsilon
-                    }
-                }
-                _ => {
-                    if u < 0.0 {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                }
-            },
-        }
-    })
-}
-
-/// The drop of `chi^2` (both signals) from the quadratic null to the null plus `kind` at `c`
-/// over the window's rows, and the alternative's `chi^2`.
-fn statistic(signals: &Signals, range: std::ops::Range<usize>, c: f64, extra: Extra) -> (f64, f64) {
+/// The statistic at candidate gap `g` (between rows `g` and `g + 1`) on `scale`: the larger of
+/// the kink's (maximised over [`KINK_ROUNDING`]) and the jump's, its kind and its single-test
+/// tail probability.
+fn candidate_score(signals: &Signals, g: usize, scale: Scale) -> (f64, TransitionKind, f64) {
+    let w = scale.half_window;
+    let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
+    let range = g + 1 - w..g + w + 1;
     let z = &signals.z[range.clone()];
-    let null = design(z, c, None);
-    let alternative = design(z, c, Some(extra));
-    let (mut drop, mut chi2) = (0.0, 0.0);
-    for values in &signals.values {
-        let y = DVector::from_column_slice(&values[range.clone()]);
-        let r0 = rss(&null, &y);
-        let r1 = rss(&alternative, &y);
-        drop += r0 - r1;
-        chi2 += r1;
+    let ys = window_values(signals, range);
+    let null = orthonormal_basis(&design(z, c, scale.degree, None));
+    let null_explained: f64 = ys.iter().map(|y| explained(&null, y)).sum();
+    let drop = |extra: Extra| {
+        let basis = orthonormal_basis(&design(z, c, scale.degree, Some(extra)));
+        ys.iter().map(|y| explained(&basis, y)).sum::<f64>() - null_explained
+    };
+    let kink = KINK_ROUNDING
+        .iter()
+        .map(|&epsilon| drop(Extra::Hinge(epsilon)))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let jump = drop(Extra::Step);
+    let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
+    let jump_tail = (-0.5 * jump).exp();
+    if jump_tail < kink_tail {
+        (jump, TransitionKind::Jump, jump_tail)
+    } else {
+        (kink, TransitionKind::Kink, kink_tail)
     }
-    (drop, chi2)
 }
 
 /// Detect transitions on a curve sorted by decreasing `Z` (an approach) or increasing `Z`.
@@ -246,56 +204,67 @@ pub fn detect_transitions(
             phases.iter().map(|p| p / sigma_phase).collect(),
         ],
     };
+    // The scales: the short window with the quadratic null, and, where the curve is long
+    // enough, the long one with the quartic null (MODEL.md section 13.2).
+    let mut scales = vec![Scale {
+        half_window: w,
+        degree: 2,
+    }];
+    let long = LONG_WINDOW_FACTOR * w;
+    if n / 4 >= long {
+        scales.push(Scale {
+            half_window: long,
+            degree: 4,
+        });
+    }
     // Candidate g lies between rows g and g + 1, window rows g + 1 - w ..= g + w.
-    let candidates: Vec<usize> = (w - 1..n - w).collect();
-    let tests = (KINK_ROUNDING.len() + 1) * candidates.len();
-    let threshold = 2.0 * (tests as f64 / settings.significance).ln();
-    // Per candidate: the larger alternative's statistic, its kind and its single-test tail
-    // probability (kink: chi^2 with 4 degrees of freedom, the hinge and the free curvature for
-    // each signal; jump: chi^2 with 2).
-    let scores: Vec<(f64, TransitionKind, f64)> = candidates
+    let per_scale: Vec<Vec<usize>> = scales
         .iter()
-        .map(|&g| {
-            let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
-            let range = g + 1 - w..g + w + 1;
-            let kink = KINK_ROUNDING
+        .map(|scale| (scale.half_window - 1..n - scale.half_window).collect())
+        .collect();
+    let tests = (KINK_ROUNDING.len() + 1) * per_scale.iter().map(Vec::len).sum::<usize>();
+    let threshold = 2.0 * (tests as f64 / settings.significance).ln();
+    let mut chosen: Vec<(usize, Scale, f64, TransitionKind, f64)> = Vec::new();
+    for (scale, candidates) in scales.iter().zip(&per_scale) {
+        // Per candidate: the larger alternative's statistic, its kind and its single-test tail
+        // probability (kink: chi^2 with 4 degrees of freedom, the hinge and the free curvature
+        // for each signal; jump: chi^2 with 2).
+        let scores: Vec<(f64, TransitionKind, f64)> = candidates
+            .iter()
+            .map(|&g| candidate_score(&signals, g, *scale))
+            .collect();
+        // Above the threshold, strongest first; a candidate whose window holds a stronger
+        // chosen one of its scale (within 2 w rows) is that one's shadow, and a longer scale
+        // adds only what lies 2 of its windows away from every transition already found.
+        let mut order: Vec<usize> = (0..candidates.len())
+            .filter(|&k| tests as f64 * scores[k].2 < settings.significance)
+            .collect();
+        order.sort_by(|&a, &b| scores[a].2.total_cmp(&scores[b].2));
+        let before = chosen.len();
+        for k in order {
+            let g = candidates[k];
+            if chosen[..before]
                 .iter()
-                .map(|&epsilon| statistic(&signals, range.clone(), c, Extra::Hinge(epsilon)).0)
-                .fold(f64::NEG_INFINITY, f64::max);
-            let (jump, _) = statistic(&signals, range, c, Extra::Step);
-            let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
-            let jump_tail = (-0.5 * jump).exp();
-            if jump_tail < kink_tail {
-                (jump, TransitionKind::Jump, jump_tail)
-            } else {
-                (kink, TransitionKind::Kink, kink_tail)
+                .all(|c| c.0.abs_diff(g) > 2 * scale.half_window)
+                && chosen[before..]
+                    .iter()
+                    .all(|c| c.0.abs_diff(g) > 2 * scale.half_window)
+            {
+                chosen.push((g, *scale, scores[k].0, scores[k].1, scores[k].2));
             }
-        })
-        .collect();
-    // Local maxima above the threshold, strongest first; a candidate whose window holds a
-    // stronger chosen one (within 2 w rows) is that one's shadow.
-    let mut order: Vec<usize> = (0..candidates.len())
-        .filter(|&k| tests as f64 * scores[k].2 < settings.significance)
-        .collect();
-    order.sort_by(|&a, &b| scores[a].2.total_cmp(&scores[b].2));
-    let mut chosen: Vec<usize> = Vec::new();
-    for k in order {
-        if chosen.iter().all(|&c| c.abs_diff(k) > 2 * w) {
-            chosen.push(k);
         }
     }
     let mut transitions: Vec<Transition> = chosen
         .into_iter()
-        .map(|k| {
-            let g = candidates[k];
-            let (score, kind, tail) = scores[k];
+        .map(|(g, scale, score, kind, tail)| {
+            let w = scale.half_window;
             let range = g + 1 - w..g + w + 1;
             let (z_nm, z_uncertainty_nm) = match kind {
                 TransitionKind::Jump => (
                     0.5 * (signals.z[g] + signals.z[g + 1]),
                     (signals.z[g] - signals.z[g + 1]) / 12f64.sqrt(),
                 ),
-                TransitionKind::Kink => kink_profile(&signals, range.clone(), g, w),
+                TransitionKind::Kink => kink_onset(&signals, g, scale),
             };
             let (ratio, phase) = smooth_value(&signals, range, z_nm, [sigma_ratio, sigma_phase]);
             Transition {
@@ -306,6 +275,7 @@ pub fn detect_transitions(
                 kind,
                 significance: (tests as f64 * tail).min(1.0),
                 statistic: score,
+                half_window: w,
             }
         })
         .collect();
@@ -321,46 +291,6 @@ pub fn detect_transitions(
         threshold,
         transitions,
     })
-}
-
-/// The kink's onset `Z` and its 1-sigma uncertainty: the alternative's `chi^2`, minimised over
-/// the rounding width ([`KINK_ROUNDING`]), profiled over the onset `c` on a grid across the
-/// middle of the window; the onset is the minimum, the uncertainty the half width of the
-/// interval where `chi^2 <= min + 1` (profile likelihood).
-fn kink_profile(
-    signals: &Signals,
-    range: std::ops::Range<usize>,
-    g: usize,
-    w: usize,
-) -> (f64, f64) {
-    let z = &signals.z;
-    let high = z[(g + 1).saturating_sub(w / 2).max(range.start)];
-    let low = z[(g + w / 2).min(range.end - 1)];
-    let steps = 200;
-    let profile: Vec<(f64, f64)> = (0..=steps)
-        .map(|s| {
-            let c = high + (low - high) * s as f64 / steps as f64;
-            let chi2 = KINK_ROUNDING
-                .iter()
-                .map(|&epsilon| statistic(signals, range.clone(), c, Extra::Hinge(epsilon)).1)
-                .fold(f64::INFINITY, f64::min);
-            (c, chi2)
-        })
-        .collect();
-    let (best, minimum) = profile
-        .iter()
-        .copied()
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .expect("non-empty profile");
-    let inside: Vec<f64> = profile
-        .iter()
-        .filter(|(_, chi2)| *chi2 <= minimum + 1.0)
-        .map(|(c, _)| *c)
-        .collect();
-    let top = inside.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let bottom = inside.iter().copied().fold(f64::INFINITY, f64::min);
-    let grid = (high - low).abs() / steps as f64;
-    (best, (0.5 * (top - bottom)).max(grid))
 }
 
 /// `A/A0` and phase of the window's null (quadratic) fit on the upper side at `z`.
@@ -379,7 +309,7 @@ fn smooth_value(
             signals.values[1][i] * sigma[1],
         );
     }
-    let d = design(&zs, z, None);
+    let d = design(&zs, z, 2, None);
     let mut out = [0.0; 2];
     for (k, values) in signals.values.iter().enumerate() {
         let y = DVector::from_iterator(rows.len(), rows.iter().map(|&i| values[i]));
