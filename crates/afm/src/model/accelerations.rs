@@ -381,6 +381,47 @@ impl SwitchingStructure for TappingModel {
                 .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
     }
 
+    /// Under an acoustic drive the gap `Z(t) + Y cos(w t) + sum_i q_i` is affine in the state
+    /// (gradient 1 on every `q_i`) with the time part `Z(t) + Y cos(w t)` (MODEL.md section 14),
+    /// and so are `h_0 = d - d_c`, a hysteretic law's `h_1 = d - d_r` and a clipped
+    /// Kelvin-Voigt law's `h_1 = -d - tau d'`; not a relaxing standard linear solid's
+    /// `h_0 = d + rho^{2/3}`.
+    fn switching_is_affine_in_state(&self, _k: usize) -> bool {
+        self.force
+            .law
+            .standard_linear_solid()
+            .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
+    }
+
+    /// The time part of `h_k` along the clock: `Z(t(s)) + Y cos(w t(s))` (nm) for `h_0` and a
+    /// hysteretic law's `h_1`, `-(Z + Y cos(w t)) - tau (Z' - w Y sin(w t))` for a clipped
+    /// Kelvin-Voigt law's `h_1`; its coefficients `1..` from the drive phase's series (module
+    /// `contact_series`).
+    fn switching_time_series(&self, k: usize, clock: &ClockPolynomial, coefficients: &mut [f64]) {
+        let order = coefficients.len().saturating_sub(1).min(contact_series::MAX_ORDER);
+        let mut cos = [0.0; contact_series::MAX_ORDER + 1];
+        let mut sin = [0.0; contact_series::MAX_ORDER + 1];
+        let (amplitude, w) = self
+            .base
+            .as_ref()
+            .map_or((0.0, 0.0), |base| (base.amplitude_nm, base.angular_frequency));
+        if amplitude != 0.0 {
+            contact_series::phase_series(w, clock, order, &mut cos, &mut sin);
+        }
+        let separation = contact_series::separation_coefficients(&self.separation, clock);
+        let (on_gap, on_rate) = if k == GAP_SURFACE || self.force.release_gap_nm().is_some() {
+            (1.0, 0.0)
+        } else {
+            (-1.0, -self.force.law.release_time_us().unwrap_or(0.0))
+        };
+        for (j, c) in coefficients.iter_mut().enumerate().take(order + 1).skip(1) {
+            let gap = separation.get(j).copied().unwrap_or(0.0) + amplitude * cos[j];
+            // `Z'` is constant: the rate's coefficients from 1 on are the base's.
+            let rate = -w * amplitude * sin[j];
+            *c = on_gap * gap + on_rate * rate;
+        }
+    }
+
     /// In free flight, a bound on the gap's curvature `|d''| = |Z'' + sum_i q_i''|` over
     /// `[t0, t0 + dt]` (any `dt`), nm/us^2; `Z'' = 0` for both separation laws. Each mode is its
     /// steady drive response `p_i = alpha_i cos(w t) + beta_i sin(w t)` plus a homogeneous part

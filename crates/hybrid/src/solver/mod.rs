@@ -235,6 +235,11 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// Whether every switching function is affine (gradients and drifts in the buffers), so
     /// that a Runge-Kutta step may be proven settled on its interpolant.
     affine_switching: bool,
+    /// Whether every switching function is affine in the state (gradients in the buffers;
+    /// affine in time too, or with the time part's series from the system,
+    /// [`crate::SwitchingStructure::switching_time_series`]), so that its polynomial along a
+    /// Taylor step's series is known.
+    series_switching: bool,
     /// The crossing of the mode's half-power surface that the last Taylor step's series
     /// predicts (its first zero up to [`RELEASE_LOOKAHEAD`] reaches past the step).
     predicted_crossing: Option<f64>,
@@ -309,7 +314,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         buffers.flow_dxdp.fill(0.0);
         let accelerations = system.accelerations();
         let affine_switching = (0..surfaces).all(|k| accelerations.switching_is_affine(k));
-        if affine_switching {
+        let series_switching = affine_switching
+            || (0..surfaces).all(|k| {
+                accelerations.switching_is_affine(k)
+                    || accelerations.switching_is_affine_in_state(k)
+            });
+        if series_switching {
             for k in 0..surfaces {
                 let partials = system.switching_gradient(
                     k,
@@ -345,6 +355,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             full_dense: false,
             proven_clear: false,
             affine_switching,
+            series_switching,
             predicted_crossing: None,
             ridge: None,
             last_series_step: 0.0,
