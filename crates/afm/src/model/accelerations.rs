@@ -398,13 +398,15 @@ impl SwitchingStructure for TappingModel {
     /// Kelvin-Voigt law's `h_1`; its coefficients `1..` from the drive phase's series (module
     /// `contact_series`).
     fn switching_time_series(&self, k: usize, clock: &ClockPolynomial, coefficients: &mut [f64]) {
-        let order = coefficients.len().saturating_sub(1).min(contact_series::MAX_ORDER);
+        let order = coefficients
+            .len()
+            .saturating_sub(1)
+            .min(contact_series::MAX_ORDER);
         let mut cos = [0.0; contact_series::MAX_ORDER + 1];
         let mut sin = [0.0; contact_series::MAX_ORDER + 1];
-        let (amplitude, w) = self
-            .base
-            .as_ref()
-            .map_or((0.0, 0.0), |base| (base.amplitude_nm, base.angular_frequency));
+        let (amplitude, w) = self.base.as_ref().map_or((0.0, 0.0), |base| {
+            (base.amplitude_nm, base.angular_frequency)
+        });
         if amplitude != 0.0 {
             contact_series::phase_series(w, clock, order, &mut cos, &mut sin);
         }

@@ -135,7 +135,10 @@ pub(crate) fn phase_series(
 /// The separation `Z(t(s))`'s coefficients `0..=2` (`Z` constant or a linear ramp in `t`, `t`
 /// quadratic in `s`: the higher ones vanish).
 #[inline]
-pub(crate) fn separation_coefficients(separation: &Separation, clock: &ClockPolynomial) -> [f64; 3] {
+pub(crate) fn separation_coefficients(
+    separation: &Separation,
+    clock: &ClockPolynomial,
+) -> [f64; 3] {
     let rate = separation.rate();
     [
         separation.at(clock.start),
