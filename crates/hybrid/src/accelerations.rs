@@ -71,7 +71,12 @@ impl<'a> Accelerations<'a> {
 
     /// [`SwitchingStructure::switching_time_series`] for surface `k` into `coefficients[1..]`
     /// (zeros without a switching structure).
-    pub fn switching_time_series(&self, k: usize, clock: &ClockPolynomial, coefficients: &mut [f64]) {
+    pub fn switching_time_series(
+        &self,
+        k: usize,
+        clock: &ClockPolynomial,
+        coefficients: &mut [f64],
+    ) {
         match self.switching {
             Some(switching) => switching.switching_time_series(k, clock, coefficients),
             None => coefficients.iter_mut().skip(1).for_each(|c| *c = 0.0),

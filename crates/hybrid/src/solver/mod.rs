@@ -57,7 +57,11 @@
 //!   it holds no extremum the samples could find, and at most one crossing per surface, which the
 //!   signs at its ends show and which is located on the interpolant as usual. Inside a Hertz
 //!   contact every step but the one holding the deepest indentation is monotone. The bound is
-//!   rigorous for the interpolant, which is what sampling inspects too.
+//!   rigorous for the interpolant, which is what sampling inspects too. Where an `h_k` is affine
+//!   in the state only, with a time part whose series the system gives
+//!   ([`crate::SwitchingStructure::switching_is_affine_in_state`], a gap with a base motion in
+//!   it), the same holds over Taylor steps (the state's series weighted by the gradient plus the
+//!   time part's series) but not over Runge-Kutta steps, which are then sampled.
 //!
 //! # Step-size control
 //!

@@ -281,11 +281,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         } else {
             let order = taylor.state.order().min(TAYLOR_ORDER);
             let mut time_part = [0.0; TAYLOR_ORDER + 1];
-            self.accelerations.switching_time_series(
-                k,
-                &taylor.clock,
-                &mut time_part[..=order],
-            );
+            self.accelerations
+                .switching_time_series(k, &taylor.clock, &mut time_part[..=order]);
             for (p, b) in power.iter_mut().zip(&time_part).skip(1) {
                 *p += b;
             }
