@@ -14,6 +14,10 @@ use crate::model::contact_series::{self, SeriesDrive, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
 
+/// The most grid times at which [`ExactFlow::exact_flow_grid`] computes a bimodal drive's second
+/// phase once for every mode (the solver's grids have 8).
+const SHARED_SECOND_PHASES: usize = 33;
+
 /// Offered only when no force acts outside contact ([`HybridSystem::accelerations`]): then
 /// every mode outside contact (`FREE_FLIGHT`, and a clipped Kelvin-Voigt law's free mode on
 /// the clipped side of its release surface) is the force-free Eq. 1.
@@ -56,13 +60,39 @@ impl ExactFlow for TappingModel {
             Some(c) => self.grid_rotations[c],
             None => phase::sin_cos(w * spacing),
         };
+        // A bimodal drive's second phase at the grid's times (shared by the modes), index 0 at
+        // `t0`.
+        let mut second_phases = [(0.0, 0.0); SHARED_SECOND_PHASES];
+        let shared = match &self.second {
+            Some(second) if count < SHARED_SECOND_PHASES => {
+                let w_b = second.angular_frequency;
+                second_phases[0] = phase::sin_cos(w_b * t0);
+                for (j, slot) in second_phases[1..=count].iter_mut().enumerate() {
+                    *slot = phase::sin_cos(w_b * (t0 + (j + 1) as f64 * spacing));
+                }
+                true
+            }
+            _ => false,
+        };
+        let second_at = |i: usize, j: usize| {
+            if shared {
+                let (sin, cos) = second_phases[j];
+                self.second_steady_state_at_phase(i, sin, cos)
+            } else {
+                self.second_steady_state(i, t0 + j as f64 * spacing)
+            }
+        };
         for (i, m) in self.modes.iter().enumerate() {
             let phi = match kept {
                 Some(c) => m.grid_transitions[c],
                 None => m.oscillator.homogeneous_transition(spacing),
             };
             let start = m.oscillator.steady_state_at_phase(sin0, cos0);
-            let second = self.second_steady_state(i, t0);
+            let second = if shared {
+                second_at(i, 0)
+            } else {
+                self.second_steady_state(i, t0)
+            };
             let mut y = [
                 x0[2 * i] - start[0] - second[0],
                 x0[2 * i + 1] - start[1] - second[1],
@@ -78,7 +108,11 @@ impl ExactFlow for TappingModel {
                     cos * cos_step - sin * sin_step,
                 );
                 let steady = m.oscillator.steady_state_at_phase(sin, cos);
-                let second = self.second_steady_state(i, t0 + (j + 1) as f64 * spacing);
+                let second = if shared {
+                    second_at(i, j + 1)
+                } else {
+                    self.second_steady_state(i, t0 + (j + 1) as f64 * spacing)
+                };
                 states[j * n + 2 * i] = steady[0] + second[0] + y[0];
                 states[j * n + 2 * i + 1] = steady[1] + second[1] + y[1];
             }
@@ -113,6 +147,13 @@ impl ExactFlow for TappingModel {
         let start_phase = phase::sin_cos(self.drive.angular_frequency * t0);
         let end_phase = phase::sin_cos(self.drive.angular_frequency * (t0 + dt));
         let standard = dt == self.exact_step_limit;
+        // A bimodal drive's second phase at both ends, shared by the modes.
+        let second_phases = self.second.as_ref().map(|second| {
+            (
+                phase::sin_cos(second.angular_frequency * t0),
+                phase::sin_cos(second.angular_frequency * (t0 + dt)),
+            )
+        });
         for (i, m) in self.modes.iter().enumerate() {
             let phi = if standard {
                 m.step_transition
@@ -121,8 +162,13 @@ impl ExactFlow for TappingModel {
             };
             // A bimodal drive's second response is a further particular solution: the flow of
             // `x0 - s_b(t0)` under the first drive, plus `s_b(t0 + dt)`.
-            let start = self.second_steady_state(i, t0);
-            let end = self.second_steady_state(i, t0 + dt);
+            let (start, end) = match second_phases {
+                Some(((sin0, cos0), (sin1, cos1))) => (
+                    self.second_steady_state_at_phase(i, sin0, cos0),
+                    self.second_steady_state_at_phase(i, sin1, cos1),
+                ),
+                None => ([0.0, 0.0], [0.0, 0.0]),
+            };
             let state = m.oscillator.flow_with_transition(
                 start_phase,
                 end_phase,
@@ -154,6 +200,16 @@ impl ExactFlow for TappingModel {
 }
 
 impl TappingModel {
+    /// Mode `i`'s steady response to a bimodal drive's second drive at a time whose second
+    /// phase `w_b t` has sine `sin` and cosine `cos`, `[q, q']` (nm, nm/us); zero for another
+    /// drive.
+    #[inline]
+    fn second_steady_state_at_phase(&self, i: usize, sin: f64, cos: f64) -> [f64; 2] {
+        self.second.as_ref().map_or([0.0, 0.0], |second| {
+            second.oscillators[i].steady_state_at_phase(sin, cos)
+        })
+    }
+
     /// Mode `i`'s steady response to a bimodal drive's second drive at `t`, `[q, q']` (nm,
     /// nm/us); zero for another drive.
     #[inline]
