@@ -62,6 +62,27 @@ impl<'a> Accelerations<'a> {
             .is_some_and(|switching| switching.switching_is_affine(k))
     }
 
+    /// [`SwitchingStructure::switching_is_affine_in_state`] for surface `k`; `false` when
+    /// unknown.
+    pub fn switching_is_affine_in_state(&self, k: usize) -> bool {
+        self.switching
+            .is_some_and(|switching| switching.switching_is_affine_in_state(k))
+    }
+
+    /// [`SwitchingStructure::switching_time_series`] for surface `k` into `coefficients[1..]`
+    /// (zeros without a switching structure).
+    pub fn switching_time_series(
+        &self,
+        k: usize,
+        clock: &ClockPolynomial,
+        coefficients: &mut [f64],
+    ) {
+        match self.switching {
+            Some(switching) => switching.switching_time_series(k, clock, coefficients),
+            None => coefficients.iter_mut().skip(1).for_each(|c| *c = 0.0),
+        }
+    }
+
     /// [`SwitchingStructure::half_power_surface`] of mode `mode`; `None` when unknown.
     pub fn half_power_surface(&self, mode: Mode) -> Option<usize> {
         self.switching
@@ -220,6 +241,32 @@ pub trait SwitchingStructure {
     fn switching_is_affine(&self, k: usize) -> bool {
         let _ = k;
         false
+    }
+
+    /// Whether `h_k` is affine in the state but not in time, `h_k(t, x) = g . x + b_k(t)` with
+    /// `g` constant (as [`crate::HybridSystem::switching_gradient`] gives it, read once per
+    /// solver) and a time part whose Taylor series [`SwitchingStructure::switching_time_series`]
+    /// gives (a gap with a base motion `Y cos(w t)` in it). The default is `false`.
+    ///
+    /// Along a Taylor step's series such an `h_k` is still a polynomial in the step's clock
+    /// offset, so the solver takes Taylor steps next to it as a half-power surface (its zeros
+    /// ahead found on that polynomial) and may prove a Taylor step settled on it, as for an
+    /// affine one; a Runge-Kutta step's interpolant of it is no polynomial and is sampled.
+    fn switching_is_affine_in_state(&self, k: usize) -> bool {
+        let _ = k;
+        false
+    }
+
+    /// For an `h_k` affine in the state ([`SwitchingStructure::switching_is_affine_in_state`]),
+    /// the Taylor coefficients `1..coefficients.len()` of its time part `b_k(t(s))` in the clock
+    /// offset `s` of `clock` (`t(s) = start + rate s + curvature s^2`), written into
+    /// `coefficients[1..]` (`coefficients[0]` is the caller's). Called only where
+    /// `switching_is_affine_in_state(k)`; the default writes zeros (a constant time part).
+    fn switching_time_series(&self, k: usize, clock: &ClockPolynomial, coefficients: &mut [f64]) {
+        let _ = (k, clock);
+        for c in coefficients.iter_mut().skip(1) {
+            *c = 0.0;
+        }
     }
 
     /// A rigorous upper bound of `|d^2 h_k / dt^2|` along the flow of mode `mode` from

@@ -14,6 +14,10 @@ use crate::model::contact_series::{self, SeriesDrive, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
 
+/// The most grid times at which [`ExactFlow::exact_flow_grid`] computes a bimodal drive's second
+/// phase once for every mode (the solver's grids have 8).
+const SHARED_SECOND_PHASES: usize = 33;
+
 /// Offered only when no force acts outside contact ([`HybridSystem::accelerations`]): then
 /// every mode outside contact (`FREE_FLIGHT`, and a clipped Kelvin-Voigt law's free mode on
 /// the clipped side of its release surface) is the force-free Eq. 1.
@@ -56,13 +60,39 @@ impl ExactFlow for TappingModel {
             Some(c) => self.grid_rotations[c],
             None => phase::sin_cos(w * spacing),
         };
+        // A bimodal drive's second phase at the grid's times (shared by the modes), index 0 at
+        // `t0`.
+        let mut second_phases = [(0.0, 0.0); SHARED_SECOND_PHASES];
+        let shared = match &self.second {
+            Some(second) if count < SHARED_SECOND_PHASES => {
+                let w_b = second.angular_frequency;
+                second_phases[0] = phase::sin_cos(w_b * t0);
+                for (j, slot) in second_phases[1..=count].iter_mut().enumerate() {
+                    *slot = phase::sin_cos(w_b * (t0 + (j + 1) as f64 * spacing));
+                }
+                true
+            }
+            _ => false,
+        };
+        let second_at = |i: usize, j: usize| {
+            if shared {
+                let (sin, cos) = second_phases[j];
+                self.second_steady_state_at_phase(i, sin, cos)
+            } else {
+                self.second_steady_state(i, t0 + j as f64 * spacing)
+            }
+        };
         for (i, m) in self.modes.iter().enumerate() {
             let phi = match kept {
                 Some(c) => m.grid_transitions[c],
                 None => m.oscillator.homogeneous_transition(spacing),
             };
             let start = m.oscillator.steady_state_at_phase(sin0, cos0);
-            let second = self.second_steady_state(i, t0);
+            let second = if shared {
+                second_at(i, 0)
+            } else {
+                self.second_steady_state(i, t0)
+            };
             let mut y = [
                 x0[2 * i] - start[0] - second[0],
                 x0[2 * i + 1] - start[1] - second[1],
@@ -78,7 +108,11 @@ impl ExactFlow for TappingModel {
                     cos * cos_step - sin * sin_step,
                 );
                 let steady = m.oscillator.steady_state_at_phase(sin, cos);
-                let second = self.second_steady_state(i, t0 + (j + 1) as f64 * spacing);
+                let second = if shared {
+                    second_at(i, j + 1)
+                } else {
+                    self.second_steady_state(i, t0 + (j + 1) as f64 * spacing)
+                };
                 states[j * n + 2 * i] = steady[0] + second[0] + y[0];
                 states[j * n + 2 * i + 1] = steady[1] + second[1] + y[1];
             }
@@ -113,6 +147,13 @@ impl ExactFlow for TappingModel {
         let start_phase = phase::sin_cos(self.drive.angular_frequency * t0);
         let end_phase = phase::sin_cos(self.drive.angular_frequency * (t0 + dt));
         let standard = dt == self.exact_step_limit;
+        // A bimodal drive's second phase at both ends, shared by the modes.
+        let second_phases = self.second.as_ref().map(|second| {
+            (
+                phase::sin_cos(second.angular_frequency * t0),
+                phase::sin_cos(second.angular_frequency * (t0 + dt)),
+            )
+        });
         for (i, m) in self.modes.iter().enumerate() {
             let phi = if standard {
                 m.step_transition
@@ -121,8 +162,13 @@ impl ExactFlow for TappingModel {
             };
             // A bimodal drive's second response is a further particular solution: the flow of
             // `x0 - s_b(t0)` under the first drive, plus `s_b(t0 + dt)`.
-            let start = self.second_steady_state(i, t0);
-            let end = self.second_steady_state(i, t0 + dt);
+            let (start, end) = match second_phases {
+                Some(((sin0, cos0), (sin1, cos1))) => (
+                    self.second_steady_state_at_phase(i, sin0, cos0),
+                    self.second_steady_state_at_phase(i, sin1, cos1),
+                ),
+                None => ([0.0, 0.0], [0.0, 0.0]),
+            };
             let state = m.oscillator.flow_with_transition(
                 start_phase,
                 end_phase,
@@ -154,6 +200,16 @@ impl ExactFlow for TappingModel {
 }
 
 impl TappingModel {
+    /// Mode `i`'s steady response to a bimodal drive's second drive at a time whose second
+    /// phase `w_b t` has sine `sin` and cosine `cos`, `[q, q']` (nm, nm/us); zero for another
+    /// drive.
+    #[inline]
+    fn second_steady_state_at_phase(&self, i: usize, sin: f64, cos: f64) -> [f64; 2] {
+        self.second.as_ref().map_or([0.0, 0.0], |second| {
+            second.oscillators[i].steady_state_at_phase(sin, cos)
+        })
+    }
+
     /// Mode `i`'s steady response to a bimodal drive's second drive at `t`, `[q, q']` (nm,
     /// nm/us); zero for another drive.
     #[inline]
@@ -379,6 +435,49 @@ impl SwitchingStructure for TappingModel {
                 .law
                 .standard_linear_solid()
                 .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
+    }
+
+    /// Under an acoustic drive the gap `Z(t) + Y cos(w t) + sum_i q_i` is affine in the state
+    /// (gradient 1 on every `q_i`) with the time part `Z(t) + Y cos(w t)` (MODEL.md section 14),
+    /// and so are `h_0 = d - d_c`, a hysteretic law's `h_1 = d - d_r` and a clipped
+    /// Kelvin-Voigt law's `h_1 = -d - tau d'`; not a relaxing standard linear solid's
+    /// `h_0 = d + rho^{2/3}`.
+    fn switching_is_affine_in_state(&self, _k: usize) -> bool {
+        self.force
+            .law
+            .standard_linear_solid()
+            .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
+    }
+
+    /// The time part of `h_k` along the clock: `Z(t(s)) + Y cos(w t(s))` (nm) for `h_0` and a
+    /// hysteretic law's `h_1`, `-(Z + Y cos(w t)) - tau (Z' - w Y sin(w t))` for a clipped
+    /// Kelvin-Voigt law's `h_1`; its coefficients `1..` from the drive phase's series (module
+    /// `contact_series`).
+    fn switching_time_series(&self, k: usize, clock: &ClockPolynomial, coefficients: &mut [f64]) {
+        let order = coefficients
+            .len()
+            .saturating_sub(1)
+            .min(contact_series::MAX_ORDER);
+        let mut cos = [0.0; contact_series::MAX_ORDER + 1];
+        let mut sin = [0.0; contact_series::MAX_ORDER + 1];
+        let (amplitude, w) = self.base.as_ref().map_or((0.0, 0.0), |base| {
+            (base.amplitude_nm, base.angular_frequency)
+        });
+        if amplitude != 0.0 {
+            contact_series::phase_series(w, clock, order, &mut cos, &mut sin);
+        }
+        let separation = contact_series::separation_coefficients(&self.separation, clock);
+        let (on_gap, on_rate) = if k == GAP_SURFACE || self.force.release_gap_nm().is_some() {
+            (1.0, 0.0)
+        } else {
+            (-1.0, -self.force.law.release_time_us().unwrap_or(0.0))
+        };
+        for (j, c) in coefficients.iter_mut().enumerate().take(order + 1).skip(1) {
+            let gap = separation.get(j).copied().unwrap_or(0.0) + amplitude * cos[j];
+            // `Z'` is constant: the rate's coefficients from 1 on are the base's.
+            let rate = -w * amplitude * sin[j];
+            *c = on_gap * gap + on_rate * rate;
+        }
     }
 
     /// In free flight, a bound on the gap's curvature `|d''| = |Z'' + sum_i q_i''|` over

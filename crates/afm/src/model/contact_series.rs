@@ -109,7 +109,7 @@ pub(crate) struct SeriesDrive {
 
 /// Coefficients `0..=p` of `cos(w t(s))` and `sin(w t(s))` into `cos` and `sin`, by the
 /// recurrence `(cos)' = -w tau sin`, `(sin)' = w tau cos` (as in [`contact_state_series`]).
-fn phase_series(
+pub(crate) fn phase_series(
     frequency: f64,
     clock: &ClockPolynomial,
     p: usize,
@@ -135,7 +135,10 @@ fn phase_series(
 /// The separation `Z(t(s))`'s coefficients `0..=2` (`Z` constant or a linear ramp in `t`, `t`
 /// quadratic in `s`: the higher ones vanish).
 #[inline]
-fn separation_coefficients(separation: &Separation, clock: &ClockPolynomial) -> [f64; 3] {
+pub(crate) fn separation_coefficients(
+    separation: &Separation,
+    clock: &ClockPolynomial,
+) -> [f64; 3] {
     let rate = separation.rate();
     [
         separation.at(clock.start),

@@ -92,22 +92,74 @@ impl FreeFlightMode {
     }
 }
 
+/// A bimodal drive's second steady response in free flight (MODEL.md section 14): each mode's
+/// `s_i(t) = alpha_bi cos(w_b t) + beta_bi sin(w_b t)`, a further particular solution added to
+/// the first drive's free flight (shared with [`crate::model::free_flight_energy`]).
+#[derive(Debug, Clone)]
+pub(crate) struct SecondFlight {
+    /// `w_b`, rad/us.
+    pub(crate) angular_frequency: f64,
+    /// `F_1b / F_1`.
+    pub(crate) relative_force: f64,
+    /// Each mode's `[alpha_bi, beta_bi]`, nm.
+    pub(crate) steady: Vec<[f64; 2]>,
+}
+
+impl SecondFlight {
+    /// The second response of `model`'s bimodal drive; `None` for another drive.
+    pub(crate) fn of(model: &TappingModel) -> Option<Self> {
+        model.second_drive().map(|second| Self {
+            angular_frequency: second.angular_frequency,
+            relative_force: second.relative_force,
+            steady: second
+                .oscillators
+                .iter()
+                .map(|oscillator| oscillator.steady_coefficients())
+                .collect(),
+        })
+    }
+
+    /// Mode `i`'s `[s_i(t), s_i'(t)]` (nm, nm/us).
+    pub(crate) fn state(&self, i: usize, t: f64) -> [f64; 2] {
+        let [alpha, beta] = self.steady[i];
+        let w = self.angular_frequency;
+        let (sin, cos) = (w * t).sin_cos();
+        [alpha * cos + beta * sin, w * (beta * cos - alpha * sin)]
+    }
+
+    /// Mode `i`'s homogeneous coefficients (as [`FreeFlightMode::homogeneous`]) of the flight
+    /// from `q`, `q'` at `a` under both drives: the first drive's from `q - s_i(a)`,
+    /// `q' - s_i'(a)`.
+    pub(crate) fn homogeneous(
+        &self,
+        mode: &FreeFlightMode,
+        i: usize,
+        w: f64,
+        a: f64,
+        q: f64,
+        velocity: f64,
+    ) -> [Complex<f64>; 2] {
+        let [s, ds] = self.state(i, a);
+        mode.homogeneous(w, a, q - s, velocity - ds)
+    }
+}
+
 /// The closed-form Fourier integrals of `u` over free flight of a [`TappingModel`].
 #[derive(Debug, Clone)]
 pub struct FreeFlightFourier {
     /// Drive angular frequency `w`, rad/us.
     angular_frequency: f64,
     modes: Vec<FreeFlightMode>,
+    /// A bimodal drive's second response.
+    second: Option<SecondFlight>,
 }
 
 impl FreeFlightFourier {
-    /// The closed form for `model`'s free flight; `None` when a mode is within 0.1% of critical
-    /// damping (`Q_i` near 1/2), or under a bimodal drive (two drive frequencies, MODEL.md
-    /// section 14), where the caller should integrate numerically instead.
+    /// The closed form for `model`'s free flight (under a bimodal drive with the second drive's
+    /// steady response added, MODEL.md section 14); `None` when a mode is within 0.1% of
+    /// critical damping (`Q_i` near 1/2), where the caller should integrate numerically
+    /// instead.
     pub fn new(model: &TappingModel) -> Option<Self> {
-        if model.second_drive().is_some() {
-            return None;
-        }
         let drive = model.drive();
         let modes = model
             .cantilever()
@@ -118,6 +170,7 @@ impl FreeFlightFourier {
         Some(Self {
             angular_frequency: drive.angular_frequency,
             modes,
+            second: SecondFlight::of(model),
         })
     }
 
@@ -133,7 +186,11 @@ impl FreeFlightFourier {
     /// e^{iwt})` integrates as `(alpha - i beta)/2 int e^{i(1-k)wt} dt + (alpha + i beta)/2 int
     /// e^{-i(1+k)wt} dt` and the homogeneous part as `c e^{-ikwa} (e^{(lambda - ikw) L} - 1) /
     /// (lambda - ikw)`.
+    /// Under a bimodal drive, [`FreeFlightFourier::integrate_frequency`] at `k w`.
     pub fn integrate_harmonic(&self, k: usize, a: f64, x_a: &[f64], b: f64) -> [f64; 2] {
+        if self.second.is_some() {
+            return self.integrate_frequency(k as f64 * self.angular_frequency, a, x_a, b);
+        }
         let w = self.angular_frequency;
         let kw = k as f64 * w;
         let length = b - a;
@@ -155,6 +212,63 @@ impl FreeFlightFourier {
             let mut homogeneous = Complex::new(0.0, 0.0);
             for (c, l) in coefficients.into_iter().zip(mode.roots) {
                 let z = l + minus_ikw;
+                homogeneous += c * ((z * length).exp() - 1.0) / z;
+            }
+            total += (steady + rotation_a * homogeneous) * mode.optical_sensitivity;
+        }
+        [total.re, -total.im]
+    }
+}
+
+impl FreeFlightFourier {
+    /// A bimodal drive's second lock-in integrals `[int_a^b u cos(w_b t) dt, int_a^b u sin(w_b
+    /// t) dt]` (nm us) over free flight from `x_a` at `a` to `b` (MODEL.md section 14); `None`
+    /// for another drive.
+    pub fn integrate_second(&self, a: f64, x_a: &[f64], b: f64) -> Option<[f64; 2]> {
+        let second = self.second.as_ref()?;
+        Some(self.integrate_frequency(second.angular_frequency, a, x_a, b))
+    }
+
+    /// `[int_a^b u cos(nu t) dt, int_a^b u sin(nu t) dt]` (nm us) under a bimodal drive: `q_i`
+    /// is the first drive's steady part `p_i`, the second's `s_i` and the homogeneous part
+    /// `y_i` (from `q_i - p_i - s_i` at `a`), each integrated against `e^{-i nu t}` as in
+    /// the module docs (`s_i` like `p_i` at `w_b`).
+    fn integrate_frequency(&self, nu: f64, a: f64, x_a: &[f64], b: f64) -> [f64; 2] {
+        let w = self.angular_frequency;
+        let length = b - a;
+        let (sin_a, cos_a) = (nu * a).sin_cos();
+        let rotation_a = Complex::new(cos_a, -sin_a);
+        let co_rotating = exponential_integral(w - nu, a, length);
+        let counter_rotating = exponential_integral(-w - nu, a, length);
+        let (second_co, second_counter) = self.second.as_ref().map_or(
+            (Complex::new(0.0, 0.0), Complex::new(0.0, 0.0)),
+            |second| {
+                let wb = second.angular_frequency;
+                (
+                    exponential_integral(wb - nu, a, length),
+                    exponential_integral(-wb - nu, a, length),
+                )
+            },
+        );
+        let minus_inu = Complex::new(0.0, -nu);
+        let mut total = Complex::new(0.0, 0.0);
+        for (i, mode) in self.modes.iter().enumerate() {
+            let [alpha, beta] = mode.steady;
+            let mut steady = Complex::new(alpha, -beta) * 0.5 * co_rotating
+                + Complex::new(alpha, beta) * 0.5 * counter_rotating;
+            let (q, velocity) = (x_a[2 * i], x_a[2 * i + 1]);
+            let coefficients = match &self.second {
+                Some(second) => {
+                    let [alpha_b, beta_b] = second.steady[i];
+                    steady += Complex::new(alpha_b, -beta_b) * 0.5 * second_co
+                        + Complex::new(alpha_b, beta_b) * 0.5 * second_counter;
+                    second.homogeneous(mode, i, w, a, q, velocity)
+                }
+                None => mode.homogeneous(w, a, q, velocity),
+            };
+            let mut homogeneous = Complex::new(0.0, 0.0);
+            for (c, l) in coefficients.into_iter().zip(mode.roots) {
+                let z = l + minus_inu;
                 homogeneous += c * ((z * length).exp() - 1.0) / z;
             }
             total += (steady + rotation_a * homogeneous) * mode.optical_sensitivity;

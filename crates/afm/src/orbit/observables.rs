@@ -457,6 +457,13 @@ impl PeriodObserver {
                 coefficient[0] += cosine;
                 coefficient[1] += sine;
             }
+            if let (Some((_, coefficients)), Some([cosine, sine])) = (
+                &mut self.second_fourier,
+                free_flight.integrate_second(start, &self.free_state, end),
+            ) {
+                coefficients[0] += cosine;
+                coefficients[1] += sine;
+            }
             if let Some(energy) = &self.free_flight_energy {
                 energy.accumulate(start, &self.free_state, end, &mut self.mode_integrals);
             }

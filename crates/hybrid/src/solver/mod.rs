@@ -57,7 +57,11 @@
 //!   it holds no extremum the samples could find, and at most one crossing per surface, which the
 //!   signs at its ends show and which is located on the interpolant as usual. Inside a Hertz
 //!   contact every step but the one holding the deepest indentation is monotone. The bound is
-//!   rigorous for the interpolant, which is what sampling inspects too.
+//!   rigorous for the interpolant, which is what sampling inspects too. Where an `h_k` is affine
+//!   in the state only, with a time part whose series the system gives
+//!   ([`crate::SwitchingStructure::switching_is_affine_in_state`], a gap with a base motion in
+//!   it), the same holds over Taylor steps (the state's series weighted by the gradient plus the
+//!   time part's series) but not over Runge-Kutta steps, which are then sampled.
 //!
 //! # Step-size control
 //!
@@ -235,6 +239,11 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// Whether every switching function is affine (gradients and drifts in the buffers), so
     /// that a Runge-Kutta step may be proven settled on its interpolant.
     affine_switching: bool,
+    /// Whether every switching function is affine in the state (gradients in the buffers;
+    /// affine in time too, or with the time part's series from the system,
+    /// [`crate::SwitchingStructure::switching_time_series`]), so that its polynomial along a
+    /// Taylor step's series is known.
+    series_switching: bool,
     /// The crossing of the mode's half-power surface that the last Taylor step's series
     /// predicts (its first zero up to [`RELEASE_LOOKAHEAD`] reaches past the step).
     predicted_crossing: Option<f64>,
@@ -309,7 +318,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         buffers.flow_dxdp.fill(0.0);
         let accelerations = system.accelerations();
         let affine_switching = (0..surfaces).all(|k| accelerations.switching_is_affine(k));
-        if affine_switching {
+        let series_switching = affine_switching
+            || (0..surfaces).all(|k| {
+                accelerations.switching_is_affine(k)
+                    || accelerations.switching_is_affine_in_state(k)
+            });
+        if series_switching {
             for k in 0..surfaces {
                 let partials = system.switching_gradient(
                     k,
@@ -345,6 +359,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             full_dense: false,
             proven_clear: false,
             affine_switching,
+            series_switching,
             predicted_crossing: None,
             ridge: None,
             last_series_step: 0.0,

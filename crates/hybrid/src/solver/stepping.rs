@@ -107,10 +107,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             height: self.settings.extremum_height,
             bounds: &bounds[..self.surfaces],
         });
-        // A Runge-Kutta step with affine switching functions may be proven settled on its
-        // interpolant, whatever the height.
-        let polynomial =
-            self.affine_switching && matches!(self.kind, StepKind::RungeKutta | StepKind::Taylor);
+        // A Runge-Kutta step with affine switching functions, or a Taylor step with switching
+        // functions affine in the state, may be proven settled on its interpolant, whatever the
+        // height.
+        let polynomial = match self.kind {
+            StepKind::RungeKutta => self.affine_switching,
+            StepKind::Taylor => self.series_switching,
+            _ => false,
+        };
         let clear = (self.settings.extremum_height.is_finite() || polynomial || bounded) && {
             self.buffers.samples.sample_ends(
                 self.system,

@@ -35,7 +35,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             return Ok(None);
         }
         let half_power = accelerations.half_power_surface(mode);
-        if half_power.is_some() && !self.affine_switching {
+        if half_power.is_some() && !self.series_switching {
             return Ok(None);
         }
         self.check_attempts()?;
@@ -257,8 +257,11 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         surface_ahead(&power, upto, side_sign(self.mode, k))
     }
 
-    /// The polynomial in the clock offset `s` of the affine surface `k` along the last Taylor
-    /// series: `h_k(t0) + g . (x(s) - x(0)) + b (t(s) - t0)`, with `h_k(t0) = start_value`.
+    /// The polynomial in the clock offset `s` of the surface `k`, affine in the state, along
+    /// the last Taylor series: `h_k(t0) + g . (x(s) - x(0)) + b (t(s) - t0)` for an affine
+    /// one, with `h_k(t0) = start_value`; for a time part `b_k(t)` that is not affine, its
+    /// series from the system ([`crate::SwitchingStructure::switching_time_series`]) in place of
+    /// `b (t(s) - t0)`.
     pub(super) fn series_surface_polynomial(
         &self,
         k: usize,
@@ -271,10 +274,20 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             &self.buffers.affine_gradients[k * n..(k + 1) * n],
             &mut power,
         );
-        let drift = self.buffers.affine_drifts[k];
+        if self.affine_switching {
+            let drift = self.buffers.affine_drifts[k];
+            power[1] += drift * taylor.clock.rate;
+            power[2] += drift * taylor.clock.curvature;
+        } else {
+            let order = taylor.state.order().min(TAYLOR_ORDER);
+            let mut time_part = [0.0; TAYLOR_ORDER + 1];
+            self.accelerations
+                .switching_time_series(k, &taylor.clock, &mut time_part[..=order]);
+            for (p, b) in power.iter_mut().zip(&time_part).skip(1) {
+                *p += b;
+            }
+        }
         power[0] = start_value;
-        power[1] += drift * taylor.clock.rate;
-        power[2] += drift * taylor.clock.curvature;
         power
     }
 }
