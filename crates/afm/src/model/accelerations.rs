@@ -14,10 +14,6 @@ use crate::model::contact_series::{self, SeriesDrive, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
 
-/// Whether attached JKR steps by its Taylor series (work in progress: its tangents are being
-/// checked against finite differences).
-const JKR_SERIES: bool = false;
-
 /// Offered only when no force acts outside contact ([`HybridSystem::accelerations`]): then
 /// every mode outside contact (`FREE_FLIGHT`, and a clipped Kelvin-Voigt law's free mode on
 /// the clipped side of its release surface) is the force-free Eq. 1.
@@ -228,7 +224,7 @@ impl TappingModel {
         ) {
             // Attached, on both sides of d = 0 (MODEL.md section 9, JKR); detached the tip
             // flies freely (the exact flow).
-            return (JKR_SERIES && Self::is_attached(mode)).then_some(SeriesForce::Jkr { law });
+            return Self::is_attached(mode).then_some(SeriesForce::Jkr { law });
         }
         let (ContactLaw::Dmt(dmt), None, None) = (
             self.force.law,

@@ -284,6 +284,12 @@ pub(crate) fn contact_state_series(
     if series.order() > MAX_ORDER || series.dim() != 2 * modes.len() {
         return false;
     }
+    // JKR's slope `dF/dd` is infinite at pull-off, where a square-root clock is centred: its
+    // tangents' series would sum a pole at the step's end. Those steps take the Runge-Kutta
+    // path, with its exact limit at the crossing.
+    if matches!(force, SeriesForce::Jkr { .. }) && clock.curvature != 0.0 {
+        return false;
+    }
     let separation = shifted_separation(separation, clock, force);
     // The common mode counts as constants, so that the loops over modes unroll.
     let mut run = |modes| state_recurrence(modes, force, drive, &separation, clock, series);
