@@ -229,7 +229,14 @@ fn indentation_coefficient(separation: &[f64; 3], row: &[f64], k: usize) -> f64 
 /// k b = delta` (module docs); `false` where `d delta/db = 4 b_0^3/R - k` is not positive (at
 /// or past pull-off) or the root is not finite.
 #[inline]
-fn update_jkr_root(law: &JkrContact, b: &mut [f64], p: &mut [f64], c: &mut [f64], delta: &[f64], m: usize) -> bool {
+fn update_jkr_root(
+    law: &JkrContact,
+    b: &mut [f64],
+    p: &mut [f64],
+    c: &mut [f64],
+    delta: &[f64],
+    m: usize,
+) -> bool {
     let r = law.tip_radius_nm;
     if m == 0 {
         let b0 = law.contact_root(delta[0]);
