@@ -116,7 +116,10 @@ fn attached_heights(model: &TappingModel, x0: &[f64], steps: usize) -> Vec<f64> 
             if attached {
                 previous_gaps.push(gap);
                 let m = previous_gaps.len();
-                if m >= 3 && previous_gaps[m - 2] >= previous_gaps[m - 3] && previous_gaps[m - 2] > gap {
+                if m >= 3
+                    && previous_gaps[m - 2] >= previous_gaps[m - 3]
+                    && previous_gaps[m - 2] > gap
+                {
                     // Parabola through the last three samples: its vertex height.
                     let (g0, g1, g2) = (previous_gaps[m - 3], previous_gaps[m - 2], gap);
                     let curvature = g0 - 2.0 * g1 + g2;
@@ -174,9 +177,15 @@ fn approach_locates_the_pull_off_grazing() {
     let mut at_point = model.clone();
     at_point.set_parameter(point.z_nm);
     let d_po = Jkr::of(&model).pull_off_gap();
-    assert!(at_point.gap(0.0, &point.state) > d_po, "the orbit starts free");
+    assert!(
+        at_point.gap(0.0, &point.state) > d_po,
+        "the orbit starts free"
+    );
     let heights = attached_heights(&at_point, &point.state, 200_000);
-    let nearest = heights.iter().map(|h| h.abs()).fold(f64::INFINITY, f64::min);
+    let nearest = heights
+        .iter()
+        .map(|h| h.abs())
+        .fold(f64::INFINITY, f64::min);
     println!("pull-off at Z = {} nm: heights {heights:?}", point.z_nm);
     assert!(nearest < 1e-6, "nearest height {nearest} nm");
     // A branch point above the grazing (on the approach's side) releases transversally.
@@ -189,7 +198,16 @@ fn approach_locates_the_pull_off_grazing() {
     let mut at_neighbour = model.clone();
     at_neighbour.set_parameter(neighbour.z_nm);
     let heights = attached_heights(&at_neighbour, &neighbour.state, 200_000);
-    let nearest_neighbour = heights.iter().map(|h| h.abs()).fold(f64::INFINITY, f64::min);
-    println!("neighbour at Z = {} nm: heights {heights:?}", neighbour.z_nm);
-    assert!(nearest_neighbour > 1e-5, "neighbour height {nearest_neighbour} nm");
+    let nearest_neighbour = heights
+        .iter()
+        .map(|h| h.abs())
+        .fold(f64::INFINITY, f64::min);
+    println!(
+        "neighbour at Z = {} nm: heights {heights:?}",
+        neighbour.z_nm
+    );
+    assert!(
+        nearest_neighbour > 1e-5,
+        "neighbour height {nearest_neighbour} nm"
+    );
 }
