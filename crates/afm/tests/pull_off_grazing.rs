@@ -192,8 +192,7 @@ fn approach_locates_the_pull_off_grazing() {
     let neighbour = diagram
         .points
         .iter()
-        .filter(|p| p.z_nm > point.z_nm + 1e-3 && p.z_nm < point.z_nm + 0.2)
-        .last()
+        .rfind(|p| p.z_nm > point.z_nm + 1e-3 && p.z_nm < point.z_nm + 0.2)
         .expect("a branch point above the grazing");
     let mut at_neighbour = model.clone();
     at_neighbour.set_parameter(neighbour.z_nm);
