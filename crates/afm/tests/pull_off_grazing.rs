@@ -163,7 +163,7 @@ fn attached_heights(model: &TappingModel, x0: &[f64], steps: usize) -> Vec<f64> 
 /// touches the pull-off surface: the nearest height to it is below 1e-6 nm, while the
 /// diagram's own points 1e-3 nm and more above the grazing (the same branch) release with
 /// virtual heights above 1e-5 nm (so the check tells the grazing from its neighbours).
-/// Measured: the grazing orbit's height 3e-12 nm; the neighbour 1.4e-3 nm above, 2.4e-5 nm.
+/// Measured: the grazing orbit's height 2e-13 nm; the neighbour 1.4e-3 nm above, 2.4e-5 nm.
 #[test]
 fn approach_locates_the_pull_off_grazing() {
     let model = TappingModel::from_case(&builtin_case("biolever-sticky").unwrap()).unwrap();
