@@ -2,8 +2,9 @@
 //! (`DiagramSettings::approach`) of the Biolever and the MAClever on the soft sample with a DMT
 //! law (H = 5e-22 J, a0 = 0.165 nm), a clipped Kelvin-Voigt law (eta = 100 Pa s), a standard
 //! linear solid (E0 = 1 GPa, Einf = 0.4 GPa, tau = 5 us), Hertz with the hydration force
-//! (10 MPa, 0.25 nm, 0.3 nm) and JKR (W = 0.5 mJ/m^2, the `adhesive-soft` sample), against the
-//! Hertz diagram of the same case. Target: each within 3 times the Hertz time.
+//! (10 MPa, 0.25 nm, 0.3 nm) and JKR (W = 0.5 mJ/m^2, the `adhesive-soft` sample; W = 2 mJ/m^2,
+//! `sticky-soft`, whose approach meets the pull-off grazing), against the Hertz diagram of the
+//! same case. Target: each within 3 times the Hertz time.
 //!
 //! Run with `cargo bench -p afm --bench contact_laws`; `-- --repetitions N` (default 5) sets
 //! the repetitions of each diagram, whose median thread CPU time is reported.
@@ -89,6 +90,10 @@ fn main() {
         (
             "jkr",
             Some(r#"{"law": "jkr", "work_of_adhesion_mj_per_m2": 0.5}"#),
+        ),
+        (
+            "jkr-sticky",
+            Some(r#"{"law": "jkr", "work_of_adhesion_mj_per_m2": 2.0}"#),
         ),
     ];
     for (cantilever, a0) in [("biolever", 10.0), ("maclever", 20.0)] {

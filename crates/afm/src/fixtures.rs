@@ -47,6 +47,7 @@ const SAMPLES: &[Embedded] = &[
     embedded!("samples", "soft-viscoelastic"),
     embedded!("samples", "mica-hydration"),
     embedded!("samples", "adhesive-soft"),
+    embedded!("samples", "sticky-soft"),
     embedded!("samples", "polymer-strong-vdw"),
     embedded!("samples", "polymer-weak-vdw"),
     embedded!("samples", "mica-humid"),
@@ -65,6 +66,7 @@ const CASES: &[Embedded] = &[
     embedded!("cases", "biolever-mica-acoustic"),
     embedded!("cases", "biolever-mica-bimodal"),
     embedded!("cases", "biolever-adhesive"),
+    embedded!("cases", "biolever-sticky"),
     embedded!("cases", "silicon-air-polymer"),
     embedded!("cases", "rectangular-air-mica-humid"),
 ];

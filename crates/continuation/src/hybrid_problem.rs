@@ -37,6 +37,14 @@ pub trait Parametrised: HybridSystem + Clone {
     fn contact_surface(&self) -> usize {
         0
     }
+    /// A release surface `r` and the mode bits `held` of a contact that forms on the contact
+    /// surface and ends only at the `Up` crossing of `r` (a hysteretic contact: for the AFM,
+    /// JKR's pull-off gap, MODEL.md section 9): the maxima of `h_r` in modes with a bit of
+    /// `held` set, and the releases, make the orbit structure's
+    /// [`OrbitStructure::release_maxima`]. Default `None`: no release surface.
+    fn release_surface(&self) -> Option<(usize, hybrid::Mode)> {
+        None
+    }
 }
 
 /// The period map `x -> x(periods * T)` from `t0 = 0` of a [`Parametrised`] hybrid system.
@@ -209,9 +217,23 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
     /// state `x`: `a = d^2h/dt^2` by a forward difference of `dh/dt` along the flow
     /// (continuous through the reset up to `O(v)`, which vanishes at grazing).
     fn virtual_minimum(&self, system: &S, k: usize, t: f64, v: f64, x: &[f64]) -> f64 {
+        self.virtual_extremum(system, k, system.mode_of(t, x), t, v, x)
+    }
+
+    /// `-v^2 / (2 |a|)` for surface `k` crossed at time `t` with rate `v` from state `x`, with
+    /// `a = d^2h/dt^2` of mode `mode`'s flow by a forward difference of `dh/dt`: minus the
+    /// height of the parabola's extremum beyond the surface.
+    fn virtual_extremum(
+        &self,
+        system: &S,
+        k: usize,
+        mode: hybrid::Mode,
+        t: f64,
+        v: f64,
+        x: &[f64],
+    ) -> f64 {
         let mut buffers = self.buffers.borrow_mut();
         let Buffers { field, shifted } = &mut *buffers;
-        let mode = system.mode_of(t, x);
         system.vector_field(mode, t, x, field);
         let scale = system.period();
         let delta = 1e-7 * scale;
@@ -267,7 +289,37 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
             impacts: 0,
             permanent_contact: false,
             duration,
+            release_maxima: Vec::new(),
         };
+        if let Some((r, held)) = system.release_surface() {
+            for extremum in flow
+                .extrema
+                .iter()
+                .filter(|e| e.surface == r && e.kind == ExtremumKind::Maximum && e.mode & held != 0)
+            {
+                structure
+                    .release_maxima
+                    .push((extremum.t - self.start_time, extremum.value));
+            }
+            for event in flow
+                .events
+                .iter()
+                .filter(|e| e.surface == r && e.direction == Direction::Up && e.mode & held != 0)
+            {
+                let value = -self.virtual_extremum(
+                    &system,
+                    r,
+                    event.mode,
+                    event.t,
+                    event.rate,
+                    &event.state,
+                );
+                structure
+                    .release_maxima
+                    .push((event.t - self.start_time, value));
+            }
+            structure.release_maxima.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
         for extremum in flow.extrema.iter().filter(|e| e.surface == k) {
             let entry = (extremum.t - self.start_time, extremum.value);
             match extremum.kind {

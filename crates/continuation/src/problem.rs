@@ -37,6 +37,15 @@ pub struct OrbitStructure {
     /// Duration of the period map (system time units): the times above lie in
     /// `[0, duration)` and are compared modulo it.
     pub duration: f64,
+    /// `(time since the period start, value)` of every local maximum of a release surface's
+    /// switching function `h_r` while the contact is held (MODEL.md Sec. 8, `pull-off`; empty
+    /// for a system without one, [`crate::Parametrised::release_surface`]): negative while the
+    /// orbit stays attached through it. At a release (the `Up` crossing of `h_r` while held)
+    /// the problem reports the *virtual* maximum `v^2 / (2 |a|)` of the held flow continued
+    /// through the surface (`v = dh_r/dt` at the crossing, `a = d^2h_r/dt^2` there), positive
+    /// and tending to 0 as the release becomes tangential: the value is 0 at the grazing of the
+    /// release surface.
+    pub release_maxima: Vec<(f64, f64)>,
 }
 
 /// One evaluation of the period map `P(x; p)` and its derivatives.

@@ -27,6 +27,10 @@ pub enum SpecialPointKind {
     /// A local maximum of a trajectory in contact throughout rises above zero: free flight
     /// appears, the reverse of [`SpecialPointKind::PermanentContact`].
     LiftOff,
+    /// A maximum of a release surface's switching function while the contact is held touches
+    /// zero: the grazing of the release surface (for the AFM, JKR's pull-off gap), where an
+    /// orbit that stays attached through the maximum meets one that releases there.
+    PullOff,
     /// The impact count decreases with no extremum crossing zero.
     ImpactVanish,
     /// The impact count increases with no extremum crossing zero.
@@ -36,7 +40,7 @@ pub enum SpecialPointKind {
 impl SpecialPointKind {
     /// The label of a point of this kind with `impacts_after` impacts per period after it:
     /// `G<n>`, `fold`, `period-doubling`, `neimark-sacker`, `merge`, `split`,
-    /// `permanent-contact`, `lift-off`, `impact-vanish`, `impact-appear`.
+    /// `permanent-contact`, `lift-off`, `pull-off`, `impact-vanish`, `impact-appear`.
     pub fn label(self, impacts_after: usize) -> String {
         match self {
             SpecialPointKind::Fold => "fold".into(),
@@ -47,6 +51,7 @@ impl SpecialPointKind {
             SpecialPointKind::Split => "split".into(),
             SpecialPointKind::PermanentContact => "permanent-contact".into(),
             SpecialPointKind::LiftOff => "lift-off".into(),
+            SpecialPointKind::PullOff => "pull-off".into(),
             SpecialPointKind::ImpactVanish => "impact-vanish".into(),
             SpecialPointKind::ImpactAppear => "impact-appear".into(),
         }
@@ -57,7 +62,7 @@ impl SpecialPointKind {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpecialPoint {
     /// `G1`, `G2`, ..., `fold`, `period-doubling`, `neimark-sacker`, `merge`, `split`,
-    /// `permanent-contact`, `lift-off`, `impact-vanish`, `impact-appear`
+    /// `permanent-contact`, `lift-off`, `pull-off`, `impact-vanish`, `impact-appear`
     /// ([`SpecialPointKind::label`]).
     pub label: String,
     /// The kind of point.

@@ -9,7 +9,9 @@
 //!   located sign change counts only with a complex pair on the unit circle);
 //! * structure (MODEL.md Sec. 5): the value of each local minimum of the contact switching
 //!   function (zero at grazing), of each local maximum (zero when two contacts merge), and the
-//!   impact count per period. Extrema of two orbits are matched by their time in the period.
+//!   impact count per period; with a release surface (a hysteretic contact), each maximum of
+//!   its switching function while the contact is held (zero at the grazing of that surface,
+//!   `pull-off`). Extrema of two orbits are matched by their time in the period.
 //!
 //! (Kuznetsov, *Elements of Applied Bifurcation Theory*, Sec. 10.2, for the bialternate test.)
 
@@ -84,6 +86,10 @@ pub(crate) enum ExtremumKind {
     Minimum,
     /// A local maximum of `h` (between two contacts when negative).
     Maximum,
+    /// A local maximum of a release surface's `h_r` while the contact is held, or the virtual
+    /// maximum at a release ([`OrbitStructure::release_maxima`]): 0 at the grazing of the
+    /// release surface (`pull-off`).
+    ReleaseMaximum,
 }
 
 /// A structure test between two branch points: an extremum followed from one to the other
@@ -153,6 +159,11 @@ pub(crate) fn structure_changes(a: &OrbitStructure, b: &OrbitStructure) -> Vec<S
     for (kind, la, lb) in [
         (ExtremumKind::Minimum, &a.minima, &b.minima),
         (ExtremumKind::Maximum, &a.maxima, &b.maxima),
+        (
+            ExtremumKind::ReleaseMaximum,
+            &a.release_maxima,
+            &b.release_maxima,
+        ),
     ] {
         for (i, j) in matched(la, lb, duration) {
             let (t_a, value_a) = la[i];
@@ -195,6 +206,7 @@ impl StructureTest {
                 let list = match kind {
                     ExtremumKind::Minimum => &structure.minima,
                     ExtremumKind::Maximum => &structure.maxima,
+                    ExtremumKind::ReleaseMaximum => &structure.release_maxima,
                 };
                 list.iter()
                     .min_by(|x, y| {
@@ -260,6 +272,7 @@ mod tests {
             impacts: 0,
             duration: 1.0,
             permanent_contact: false,
+            release_maxima: vec![],
         };
         let b = OrbitStructure {
             minima: vec![(0.01, -0.01), (0.5, 0.3)],
@@ -267,6 +280,7 @@ mod tests {
             impacts: 1,
             duration: 1.0,
             permanent_contact: false,
+            release_maxima: vec![],
         };
         let tests = structure_changes(&a, &b);
         assert_eq!(tests.len(), 1, "{tests:?}");
@@ -277,6 +291,7 @@ mod tests {
             impacts: 0,
             duration: 1.0,
             permanent_contact: false,
+            release_maxima: vec![],
         };
         assert_eq!(tests[0].value(0.5, &mid), 0.002);
         assert!((tests[0].linear_root() - 0.5).abs() < 1e-15);

@@ -47,6 +47,7 @@ impl PeriodicProblem for Quadratic {
                 impacts,
                 duration: 1.0,
                 permanent_contact: false,
+                release_maxima: vec![],
             },
         })
     }

@@ -1,7 +1,7 @@
 //! What the solver reports about switching surfaces: events (crossings and impacts) and the
 //! smooth extrema of the switching functions found inside steps.
 
-use crate::system::Direction;
+use crate::system::{Direction, Mode};
 
 /// A crossing of (or an impact on) a switching surface `h_k = 0`.
 ///
@@ -23,6 +23,9 @@ pub struct Event {
     pub reset: bool,
     /// State just after the event (after any reset).
     pub state: Vec<f64>,
+    /// The mode just before the event (a system's discrete state, such as an attachment bit
+    /// that no surface's sign holds, tells what the crossing meant).
+    pub mode: Mode,
 }
 
 /// Whether an extremum of a switching function is a minimum or a maximum.
@@ -48,4 +51,6 @@ pub struct Extremum {
     /// `h_k` at the extremum (switching-function units); a minimum of the gap with value 0 is
     /// a grazing contact (MODEL.md Sec. 5).
     pub value: f64,
+    /// The mode of the step the extremum lies in.
+    pub mode: Mode,
 }

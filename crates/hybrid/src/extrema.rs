@@ -286,6 +286,7 @@ impl Samples {
                         surface: k,
                         kind,
                         value,
+                        mode,
                     });
                 }
             }

@@ -55,7 +55,7 @@ impl JkrContact {
     }
 
     /// `k = sqrt(2 pi W / E*)`, nm^{1/2}.
-    fn adhesion_root(&self) -> f64 {
+    pub fn adhesion_root(&self) -> f64 {
         self.adhesion_root
     }
 
@@ -102,8 +102,8 @@ impl JkrContact {
     }
 
     /// `b = sqrt(a)` (nm^{1/2}) at indentation `delta` (nm): the Newton iteration of
-    /// [`Self::contact_radius_nm`].
-    fn contact_root(&self, indentation_nm: f64) -> f64 {
+    /// [`Self::contact_radius_nm`] (`b_c` past pull-off).
+    pub fn contact_root(&self, indentation_nm: f64) -> f64 {
         let r = self.tip_radius_nm;
         let k = self.adhesion_root;
         let critical = self.critical_root;

@@ -337,7 +337,7 @@ pub fn diagram_until(
         let grazing_at_end = diagram
             .special_points
             .last()
-            .is_some_and(|p| p.label.starts_with('G') && (p.z_nm - last.z_nm).abs() < 1e-6);
+            .is_some_and(|p| is_grazing(&p.label) && (p.z_nm - last.z_nm).abs() < 1e-6);
         // On a retract, an attached branch ends where the orbit can no longer stay attached.
         if !grazing_at_end && sign > 0.0 && last.impacts_per_orbit > 0 {
             system.set_parameter(last.z_nm);
@@ -370,15 +370,19 @@ pub fn diagram_until(
     let grazings: Vec<f64> = diagram
         .special_points
         .iter()
-        .filter(|p| p.label.starts_with('G'))
+        .filter(|p| is_grazing(&p.label))
         .map(|p| p.z_nm)
         .collect();
     diagram.special_points.retain(|p| {
-        p.converged
-            || p.label.starts_with('G')
-            || !grazings.iter().any(|z| (z - p.z_nm).abs() < 1e-6)
+        p.converged || is_grazing(&p.label) || !grazings.iter().any(|z| (z - p.z_nm).abs() < 1e-6)
     });
     Ok(diagram)
+}
+
+/// Whether `label` names a grazing where a hysteretic law's branch breaks: `G<n>` of the
+/// contact surface or `pull-off`, the grazing of the pull-off surface (MODEL.md section 8).
+fn is_grazing(label: &str) -> bool {
+    label.starts_with('G') || label == "pull-off"
 }
 
 /// The most steps of [`settle_on_period_one`]'s walk past a branch break.

@@ -235,8 +235,8 @@ impl TappingModel {
     /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
     /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
     /// outside it (van der Waals, when `H > 0`), the Hertz sphere with a hydration force (in
-    /// contact plus `F_h(0)`, outside `F_h(d)`); `None` for every other law, mode, or with a
-    /// double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
+    /// contact plus `F_h(0)`, outside `F_h(d)`), JKR while attached (its series in `sqrt(a)`);
+    /// `None` for every other law, mode, or with a double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
     pub(crate) fn series_force(&self, mode: Mode) -> Option<SeriesForce> {
         if self.plain_hertz {
             return Self::in_contact(mode).then_some(SeriesForce::Hertz {
@@ -273,6 +273,15 @@ impl TappingModel {
                 }
             });
         }
+        if let (ContactLaw::Jkr(law), None, None) = (
+            self.force.law,
+            self.force.double_layer,
+            self.force.hydration,
+        ) {
+            // Attached, on both sides of d = 0 (MODEL.md section 9, JKR); detached the tip
+            // flies freely (the exact flow).
+            return Self::is_attached(mode).then_some(SeriesForce::Jkr { law });
+        }
         let (ContactLaw::Dmt(dmt), None, None) = (
             self.force.law,
             self.force.double_layer,
@@ -294,8 +303,9 @@ impl TappingModel {
     }
 }
 
-/// Offered for the plain Hertz sphere (its contact) and DMT (its contact and, with `H > 0`,
-/// its free flight) ([`HybridSystem::accelerations`]): the series of module `contact_series`.
+/// Offered for the plain Hertz sphere (its contact), DMT (its contact and, with `H > 0`, its
+/// free flight), the hydration force and attached JKR ([`HybridSystem::accelerations`]): the
+/// series of module `contact_series`.
 /// Every other law integrates by the adaptive Runge-Kutta path.
 impl TaylorExpansion for TappingModel {
     /// Where [`TappingModel::series_force`] has a force, 40: the Taylor series come from the

@@ -15,15 +15,16 @@ mod period_maps;
 mod recurrence;
 
 use continuation::{floquet_multipliers, is_stable, NewtonSettings, Parametrised};
-use hybrid::{HybridSystem, Settings};
+use hybrid::{HybridSystem, Mode, Settings};
 
 pub use coexistence::{coexisting_orbit, COEXISTING_DISTANCE};
 pub use orbit::{PeriodBreakdown, SteadyOrbit};
 pub use period_maps::SteadyOrbitWorkspace;
 
+use crate::contact::law::ContactLaw;
 use crate::error::AfmError;
 use crate::model::separation::Separation;
-use crate::model::TappingModel;
+use crate::model::{TappingModel, ATTACHED, PULL_OFF_SURFACE};
 use crate::validation::invalid;
 use approach_walk::{walk_approach, WalkEnd};
 use newton::shoot_observed;
@@ -46,6 +47,13 @@ impl Parametrised for TappingModel {
 
     fn period(&self) -> f64 {
         self.period_us()
+    }
+
+    /// JKR's pull-off surface while attached (MODEL.md section 9, JKR): its maxima make the
+    /// `pull-off` grazing (section 8). `None` for every other law.
+    fn release_surface(&self) -> Option<(usize, Mode)> {
+        matches!(self.contact_force().law, ContactLaw::Jkr(_))
+            .then_some((PULL_OFF_SURFACE, ATTACHED))
     }
 }
 

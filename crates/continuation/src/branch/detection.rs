@@ -65,6 +65,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                     ..
                 } => SpecialPointKind::Grazing,
                 StructureTest::Extremum {
+                    kind: ExtremumKind::ReleaseMaximum,
+                    ..
+                } => SpecialPointKind::PullOff,
+                StructureTest::Extremum {
                     kind: ExtremumKind::Maximum,
                     value_a,
                     ..
@@ -217,6 +221,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                     | SpecialPointKind::Split
                     | SpecialPointKind::PermanentContact
                     | SpecialPointKind::LiftOff
+                    | SpecialPointKind::PullOff
             )
         {
             impacts_before = segment.get(0).map.structure.impacts;

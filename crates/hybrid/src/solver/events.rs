@@ -210,6 +210,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             grazing: rate.abs() < self.settings.grazing_rate,
             reset,
             state: self.buffers.z[..n].to_vec(),
+            mode,
         })
     }
 
