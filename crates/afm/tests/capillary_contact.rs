@@ -6,6 +6,8 @@
 //! cantilever's free field; the loop's exact area `F_m d_r` as the dissipated energy; and the
 //! vanishing meniscus against the Hertz sphere's grazing points.
 
+mod hertz_limit;
+
 use afm::{
     approach_diagram, builtin_cantilever, builtin_case, diagram, steady_orbit, DiagramSettings,
     OrbitStart, Sample, Separation, SteadyOrbitSettings, TappingModel,
@@ -275,22 +277,7 @@ fn vanishing_meniscus_reproduces_hertz_grazing() {
         r#", "contact": {"law": "capillary", "relative_humidity": 0.4, "surface_tension_mn_per_m": 1e-12}"#,
     ));
     let dry = build(sample(""));
-    let a = approach_diagram(&wet, &DiagramSettings::approach(&wet)).unwrap();
-    let b = approach_diagram(&dry, &DiagramSettings::approach(&dry)).unwrap();
-    let grazing = |d: &afm::BifurcationDiagram| -> Vec<(String, f64)> {
-        d.special_points
-            .iter()
-            .filter(|p| p.label.starts_with('G'))
-            .map(|p| (p.label.clone(), p.z_nm))
-            .collect()
-    };
-    let (ga, gb) = (grazing(&a), grazing(&b));
-    assert!(gb.len() >= 3, "{gb:?}");
-    assert_eq!(ga.len(), gb.len(), "{ga:?} vs {gb:?}");
-    for ((la, za), (lb, zb)) in ga.iter().zip(&gb) {
-        assert_eq!(la, lb);
-        assert!((za - zb).abs() < 1e-9, "{la}: {za} vs {zb}");
-    }
+    hertz_limit::assert_hertz_grazing(&wet, &dry, 3, 1e-9);
 }
 
 /// The case's approach and retract diagrams (MODEL.md section 9, "Capillary meniscus"): each

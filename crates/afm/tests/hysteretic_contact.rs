@@ -5,6 +5,8 @@
 //! cantilever's free field; the exact hysteresis loop area as the dissipated energy; and
 //! `W = 0` against the Hertz sphere's grazing points.
 
+mod hertz_limit;
+
 use std::f64::consts::PI;
 
 use afm::{
@@ -267,22 +269,7 @@ fn zero_adhesion_reproduces_hertz_grazing() {
         0.0,
     );
     let hertz = model_with(None, 0.0);
-    let a = approach_diagram(&jkr, &DiagramSettings::approach(&jkr)).unwrap();
-    let b = approach_diagram(&hertz, &DiagramSettings::approach(&hertz)).unwrap();
-    let grazing = |d: &afm::BifurcationDiagram| -> Vec<(String, f64)> {
-        d.special_points
-            .iter()
-            .filter(|p| p.label.starts_with('G'))
-            .map(|p| (p.label.clone(), p.z_nm))
-            .collect()
-    };
-    let (ga, gb) = (grazing(&a), grazing(&b));
-    assert!(gb.len() >= 2);
-    assert_eq!(ga.len(), gb.len());
-    for ((la, za), (lb, zb)) in ga.iter().zip(&gb) {
-        assert_eq!(la, lb);
-        assert!((za - zb).abs() < 1e-9, "{la}: {za} vs {zb}");
-    }
+    hertz_limit::assert_hertz_grazing(&jkr, &hertz, 2, 1e-9);
 }
 
 /// The Biolever's approach on the adhesive sample: G1 located to 1e-9 nm at the free orbit's
