@@ -100,47 +100,51 @@ impl JkrContact {
     }
 
     /// `b = sqrt(a)` (nm^{1/2}) at indentation `delta` (nm): the root `b >= b_c` of `b^4/R - k b
-    /// = delta` (MODEL.md section 9, JKR), in closed form. In `x = b / b_c` and `u = 4 delta /
-    /// (k b_c)` (`u = -3` at pull-off) the quartic is `x^4 - 4 x = u`; Ferrari's resolvent cubic
-    /// `y^3 + u y - 2 = 0` has one positive root, by Cardano `y = A + B` with `A = (1 + sqrt(1 +
-    /// u^3/27))^{1/3}`, `B = -u / (3 A)`, evaluated as `y = 2 / (A^2 - A B + B^2)` (no
-    /// cancellation for large `u`), and the larger root of `x^2 - s x + y + ... = 0` (`s =
-    /// sqrt(2 y)`) is `x = (s + sqrt(8/s - s^2)) / 2`. One Newton step on the quartic polishes
-    /// the rounding (kept where it lowers the residual). `b_c` past pull-off (`delta <= delta_c`); `(R delta)^{1/4}` (Hertz) for `W =
-    /// 0`.
+    /// = delta` (MODEL.md section 9, JKR), `b_c (1 + e)` with `e` from
+    /// [`Self::pull_off_offset`]. `b_c` past pull-off (`delta <= delta_c`); `(R delta)^{1/4}`
+    /// (Hertz) for `W = 0`.
     pub fn contact_root(&self, indentation_nm: f64) -> f64 {
-        let r = self.tip_radius_nm;
-        let k = self.adhesion_root;
-        let critical = self.critical_root;
-        if k == 0.0 {
-            return (r * indentation_nm.max(0.0)).sqrt().sqrt();
+        if self.adhesion_root == 0.0 {
+            return (self.tip_radius_nm * indentation_nm.max(0.0)).sqrt().sqrt();
         }
-        if indentation_nm <= -self.pull_off_gap_nm() {
-            return critical;
+        self.critical_root * (1.0 + self.pull_off_offset(indentation_nm))
+    }
+
+    /// The stable root's offset from pull-off, `e = b / b_c - 1 >= 0` (dimensionless), at
+    /// indentation `delta` (nm), in closed form. In `x = b / b_c = 1 + e` and `v = 4 (delta -
+    /// delta_c) / (k b_c)` (`delta - delta_c = delta + d_po` is exact next to pull-off) the
+    /// quartic is `x^4 - 4 x + 3 = e^2 (e^2 + 4 e + 6) = v`, whose root `e` is well conditioned
+    /// relative to itself (unlike `b`'s, which rounding moves by `sqrt(eps)` next to pull-off).
+    /// For `v >= 1e-4`, Ferrari: with `u = v - 3` the resolvent cubic `y^3 + u y - 2 = 0` has
+    /// one positive root, by Cardano `y = A + B` with `A = (1 + sqrt(1 + u^3/27))^{1/3}`, `B =
+    /// -u / (3 A)`, evaluated as `y = 2 / (A^2 - A B + B^2)` (no cancellation for large `u`),
+    /// and `x = (s + sqrt(8/s - s^2)) / 2` with `s = sqrt(2 y)` (relative error in `e` about
+    /// `eps / v`), then one Newton step on `e^2 (e^2 + 4 e + 6) = v`; below, the expansion `e =
+    /// w - w^2/3 + 7 w^3/36` in `w = sqrt(v/6)` (relative error `O(w^3)`), then two. 0 past
+    /// pull-off (`v <= 0`). Requires `W > 0`.
+    pub fn pull_off_offset(&self, indentation_nm: f64) -> f64 {
+        let v = (indentation_nm + self.pull_off_gap_nm()) * self.indentation_scale;
+        if v <= 0.0 {
+            return 0.0;
         }
-        let u = indentation_nm * self.indentation_scale;
-        let x = if u < 1e100 {
+        let newton = |e: f64| {
+            let value = e * e * (e * e + 4.0 * e + 6.0) - v;
+            let slope = 4.0 * e * (e * e + 3.0 * e + 3.0);
+            e - value / slope
+        };
+        if v < 1e-4 {
+            let w = (v / 6.0).sqrt();
+            newton(newton(w * (1.0 - w / 3.0 + 7.0 / 36.0 * w * w)))
+        } else if v < 1e100 {
+            let u = v - 3.0;
             let a = (1.0 + (1.0 + u * u * u / 27.0).max(0.0).sqrt()).cbrt();
             let b = -u / (3.0 * a);
             let y = 2.0 / (a * a - a * b + b * b);
             let s = (2.0 * y).sqrt();
-            0.5 * (s + (8.0 / s - s * s).max(0.0).sqrt())
+            newton(0.5 * (s + (8.0 / s - s * s).max(0.0).sqrt()) - 1.0)
         } else {
-            // x^4 = u (1 + 4 x / u): the correction is below 1e-75 relative.
-            u.sqrt().sqrt()
-        };
-        let b = critical * x;
-        let b3 = b * b * b;
-        let value = b3 * b / r - k * b - indentation_nm;
-        let slope = 4.0 * b3 / r - k;
-        // Next to pull-off the slope vanishes and the value is rounding: the step is kept only
-        // where it lowers the residual.
-        let polished = (b - value / slope).max(critical);
-        let polished_value = polished.powi(4) / r - k * polished - indentation_nm;
-        if polished_value.abs() < value.abs() {
-            polished
-        } else {
-            b
+            // x^4 = v (1 + (4 x - 3) / v): the correction is below 1e-75 relative.
+            v.sqrt().sqrt() - 1.0
         }
     }
 
@@ -165,16 +169,26 @@ impl JkrContact {
     pub fn force_slopes(&self, gap_nm: f64) -> ForceSlopes {
         // In b = sqrt(a), with sqrt(8 pi W E*) = 2 E* k and sqrt(pi W / (2 E*)) = k / 2, the
         // relations above need no further square roots.
-        let b = self.contact_root(-gap_nm);
-        let (a, b3) = (b * b, b * b * b);
-        let e = self.effective_modulus_gpa;
         let r = self.tip_radius_nm;
         let k = self.adhesion_root;
+        let (b, indentation_rate) = if k == 0.0 {
+            let b = self.contact_root(-gap_nm);
+            (b, 2.0 * b * b / r)
+        } else {
+            // d delta/da = (4 b^3/R - k) / (2 b) = k (x^3 - 1) / (2 b), x^3 - 1 = e (e^2 + 3 e
+            // + 3): no cancellation next to pull-off.
+            let offset = self.pull_off_offset(-gap_nm);
+            let b = self.critical_root * (1.0 + offset);
+            let x3_minus_one = offset * (offset * offset + 3.0 * offset + 3.0);
+            (b, k * x3_minus_one / (2.0 * b))
+        };
+        let (a, b3) = (b * b, b * b * b);
+        let e = self.effective_modulus_gpa;
         let adhesion = 2.0 * e * k; // sqrt(8 pi W E*), nN/nm^{3/2}
         let force = 4.0 * e * b3 * b3 / (3.0 * r) - adhesion * b3;
         let force_rate = 4.0 * e * a * a / r - 1.5 * adhesion * b;
         let floor = 1e-12 * 2.0 * a / r;
-        let indentation_rate = (2.0 * a / r - 0.5 * k / b).max(floor);
+        let indentation_rate = indentation_rate.max(floor);
         ForceSlopes {
             force,
             gap_slope: -force_rate / indentation_rate,
@@ -296,6 +310,70 @@ mod tests {
                 lo = mid;
             } else {
                 hi = mid;
+            }
+        }
+    }
+
+    /// The root of `e^2 (e^2 + 4 e + 6) = v` (`e >= 0`) by bisection to adjacent doubles (the
+    /// left side increases from 0).
+    fn bisection_offset(v: f64) -> f64 {
+        let value = |e: f64| e * e * (e * e + 4.0 * e + 6.0) - v;
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        while value(hi) < 0.0 {
+            hi *= 2.0;
+        }
+        loop {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                return if value(hi).abs() < value(lo).abs() {
+                    hi
+                } else {
+                    lo
+                };
+            }
+            if value(mid) < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+    }
+
+    /// The offset from pull-off `e = b / b_c - 1` against a bisection of its quartic, to 1e-14
+    /// relative over `v = 4 (delta - delta_c) / (k b_c)` from 1e-300 to 1e200 (`e` from 4e-151
+    /// to 3e49; 1e-16 to 1e12 in steps of 10^{1/8}, both sides of the switch from the expansion
+    /// to Ferrari at 1e-4), on three laws; `e = 0` at and past pull-off.
+    #[test]
+    fn offset_from_pull_off_matches_bisection() {
+        let laws = [
+            JkrContact::new(1.2, 30.0, 0.02),
+            JkrContact::new(0.5, 500.0, 1.0),
+            JkrContact::new(100.0, 2.0, 1e-3),
+        ];
+        let mut vs: Vec<f64> = (0..=224)
+            .map(|j| 10f64.powf(-16.0 + f64::from(j) / 8.0))
+            .collect();
+        vs.extend([
+            1e-300, 1e-100, 1e-30, 0.99e-4, 1.01e-4, 3.0, 1e50, 1e99, 1.01e100, 1e200,
+        ]);
+        for jkr in &laws {
+            let scale = 4.0 / (jkr.adhesion_root * jkr.critical_root);
+            let d_po = jkr.pull_off_gap_nm();
+            assert_eq!(jkr.pull_off_offset(-d_po), 0.0);
+            assert_eq!(jkr.pull_off_offset(-2.0 * d_po), 0.0);
+            for &v in &vs {
+                let delta = v / scale - d_po;
+                // The v the law sees from this delta (rounded through delta).
+                let v = (delta + d_po) * scale;
+                if v <= 0.0 {
+                    continue;
+                }
+                let e = jkr.pull_off_offset(delta);
+                let reference = bisection_offset(v);
+                assert!(
+                    (e - reference).abs() <= 1e-14 * reference,
+                    "{jkr:?} v {v}: {e} vs {reference}"
+                );
             }
         }
     }
