@@ -7,12 +7,13 @@
 //! vanishing meniscus against the Hertz sphere's grazing points.
 
 mod hertz_limit;
+mod hysteretic_reference;
 
 use afm::{
     approach_diagram, builtin_cantilever, builtin_case, diagram, steady_orbit, DiagramSettings,
     OrbitStart, Sample, Separation, SteadyOrbitSettings, TappingModel,
 };
-use hybrid::HybridSystem;
+use hysteretic_reference::rk4;
 
 /// The built-in air case: the stiff silicon lever on mica at 40 % relative humidity.
 const CASE: &str = "rectangular-air-mica-humid";
@@ -58,38 +59,18 @@ impl Meniscus {
     }
 }
 
-/// The brute force's field: drumroll's free field (mode 0, no force at `d >= 0`) plus
-/// `(w_i^2 / k_i) F` on every acceleration with this test's force: Hertz inside contact, minus
-/// the meniscus while it exists.
-fn field(model: &TappingModel, m: &Meniscus, wet: bool, t: f64, x: &[f64], out: &mut [f64]) {
-    model.vector_field(0, t, x, out);
-    let gap = model.gap(t, x);
-    let force = if wet {
-        m.force(gap)
-    } else if gap < 0.0 {
-        m.hertz * (-gap).powf(1.5)
-    } else {
-        0.0
-    };
-    for (i, mode) in model.cantilever().modes.iter().enumerate() {
-        let omega = mode.angular_frequency();
-        out[2 * i + 1] += omega * omega / mode.stiffness_n_per_m * force;
+/// The brute force's force: Hertz inside contact, minus the meniscus while it exists (`wet`),
+/// nN at the gap `d`.
+fn meniscus_force(m: &Meniscus, wet: bool) -> impl Fn(f64) -> f64 + '_ {
+    move |gap| {
+        if wet {
+            m.force(gap)
+        } else if gap < 0.0 {
+            m.hertz * (-gap).powf(1.5)
+        } else {
+            0.0
+        }
     }
-}
-
-fn rk4(model: &TappingModel, m: &Meniscus, wet: bool, t: f64, x: &[f64], h: f64) -> Vec<f64> {
-    let n = x.len();
-    let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    field(model, m, wet, t, x, &mut k1);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k1[i]).collect();
-    field(model, m, wet, t + 0.5 * h, &y, &mut k2);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k2[i]).collect();
-    field(model, m, wet, t + 0.5 * h, &y, &mut k3);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + h * k3[i]).collect();
-    field(model, m, wet, t + h, &y, &mut k4);
-    (0..n)
-        .map(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
-        .collect()
 }
 
 /// The first place where the force's form changes over a step ending at `x` (time `t`):
@@ -115,7 +96,7 @@ fn brute_force(
     let (mut formed, mut ruptured) = (Vec::new(), Vec::new());
     while t < duration - 1e-9 * h {
         let step = h.min(duration - t);
-        let next = rk4(model, &m, wet, t, &x, step);
+        let next = rk4(model, meniscus_force(&m, wet), t, &x, step);
         if !changes(model, &m, wet, inside, t + step, &next) {
             x = next;
             t += step;
@@ -124,14 +105,14 @@ fn brute_force(
         let (mut lo, mut hi) = (0.0, step);
         while hi - lo > 1e-14 {
             let mid = 0.5 * (lo + hi);
-            let y = rk4(model, &m, wet, t, &x, mid);
+            let y = rk4(model, meniscus_force(&m, wet), t, &x, mid);
             if changes(model, &m, wet, inside, t + mid, &y) {
                 hi = mid;
             } else {
                 lo = mid;
             }
         }
-        x = rk4(model, &m, wet, t, &x, hi);
+        x = rk4(model, meniscus_force(&m, wet), t, &x, hi);
         t += hi;
         let gap = model.gap(t, &x);
         if wet && gap > m.rupture {

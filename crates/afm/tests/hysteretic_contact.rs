@@ -6,14 +6,13 @@
 //! `W = 0` against the Hertz sphere's grazing points.
 
 mod hertz_limit;
-
-use std::f64::consts::PI;
+mod hysteretic_reference;
 
 use afm::{
     approach_diagram, builtin_cantilever, steady_orbit, DiagramSettings, OrbitStart, Sample,
     Separation, SteadyOrbitSettings, TappingModel,
 };
-use hybrid::HybridSystem;
+use hysteretic_reference::{attached_force, rk4, Jkr};
 
 /// Work of adhesion of the test sample, mJ/m^2 (= 1e-3 nN/nm).
 const W_MJ: f64 = 0.2;
@@ -36,85 +35,6 @@ fn jkr_model(z: f64) -> TappingModel {
     )
 }
 
-/// The JKR law written out independently: `E*` from the model's Hertz coefficient
-/// `c = (4/3) E* sqrt(R)`, `R = 30 nm` (the Biolever's tip), `W` in nN/nm.
-struct Jkr {
-    e: f64,
-    r: f64,
-    w: f64,
-}
-
-impl Jkr {
-    fn of(model: &TappingModel) -> Self {
-        let r: f64 = 30.0;
-        Self {
-            e: model.hertz().coefficient / (4.0 / 3.0 * r.sqrt()),
-            r,
-            w: W_MJ * 1e-3,
-        }
-    }
-
-    fn indentation(&self, a: f64) -> f64 {
-        a * a / self.r - (2.0 * PI * self.w * a / self.e).sqrt()
-    }
-
-    /// The radius where `d delta / da = 0`: `a_c = (pi W R^2 / (8 E*))^{1/3}`.
-    fn critical_radius(&self) -> f64 {
-        (PI * self.w * self.r * self.r / (8.0 * self.e)).cbrt()
-    }
-
-    fn pull_off_gap(&self) -> f64 {
-        -self.indentation(self.critical_radius())
-    }
-
-    /// `F(a(delta))` with `a` by bisection on `[a_c, 1e3 nm]` to 1e-15 nm.
-    fn force(&self, gap: f64) -> f64 {
-        let delta = -gap;
-        let (mut lo, mut hi) = (self.critical_radius(), 1e3);
-        if delta <= self.indentation(lo) {
-            hi = lo;
-        }
-        while hi - lo > 1e-15 * hi.max(1.0) {
-            let mid = 0.5 * (lo + hi);
-            if self.indentation(mid) < delta {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let a = 0.5 * (lo + hi);
-        4.0 * self.e * a * a * a / (3.0 * self.r) - (8.0 * PI * self.w * self.e * a * a * a).sqrt()
-    }
-}
-
-/// The brute force's field: the cantilever's free field (drumroll's mode 0, no contact force)
-/// plus `(w_i^2 / k_i) F` on every acceleration, `F` this test's JKR force while attached.
-fn field(model: &TappingModel, jkr: &Jkr, attached: bool, t: f64, x: &[f64], out: &mut [f64]) {
-    model.vector_field(0, t, x, out);
-    if attached {
-        let force = jkr.force(model.gap(t, x));
-        for (i, mode) in model.cantilever().modes.iter().enumerate() {
-            let omega = mode.angular_frequency();
-            out[2 * i + 1] += omega * omega / mode.stiffness_n_per_m * force;
-        }
-    }
-}
-
-fn rk4(model: &TappingModel, jkr: &Jkr, attached: bool, t: f64, x: &[f64], h: f64) -> Vec<f64> {
-    let n = x.len();
-    let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    field(model, jkr, attached, t, x, &mut k1);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k1[i]).collect();
-    field(model, jkr, attached, t + 0.5 * h, &y, &mut k2);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k2[i]).collect();
-    field(model, jkr, attached, t + 0.5 * h, &y, &mut k3);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + h * k3[i]).collect();
-    field(model, jkr, attached, t + h, &y, &mut k4);
-    (0..n)
-        .map(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
-        .collect()
-}
-
 /// Whether the attachment changes over a step ending at state `x` (time `t`).
 fn switches(model: &TappingModel, jkr: &Jkr, attached: bool, t: f64, x: &[f64]) -> bool {
     let gap = model.gap(t, x);
@@ -135,13 +55,13 @@ fn brute_force(
     duration: f64,
     steps: usize,
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let jkr = Jkr::of(model);
+    let jkr = Jkr::of(model, W_MJ);
     let h = duration / steps as f64;
     let (mut t, mut x, mut attached) = (0.0, x0.to_vec(), attached0);
     let (mut attach, mut detach) = (Vec::new(), Vec::new());
     while t < duration - 1e-9 * h {
         let step = h.min(duration - t);
-        let next = rk4(model, &jkr, attached, t, &x, step);
+        let next = rk4(model, attached_force(&jkr, attached), t, &x, step);
         if !switches(model, &jkr, attached, t + step, &next) {
             x = next;
             t += step;
@@ -150,14 +70,14 @@ fn brute_force(
         let (mut lo, mut hi) = (0.0, step);
         while hi - lo > 1e-14 {
             let mid = 0.5 * (lo + hi);
-            let y = rk4(model, &jkr, attached, t, &x, mid);
+            let y = rk4(model, attached_force(&jkr, attached), t, &x, mid);
             if switches(model, &jkr, attached, t + mid, &y) {
                 hi = mid;
             } else {
                 lo = mid;
             }
         }
-        x = rk4(model, &jkr, attached, t, &x, hi);
+        x = rk4(model, attached_force(&jkr, attached), t, &x, hi);
         t += hi;
         if attached {
             detach.push(t);
@@ -183,7 +103,7 @@ fn jkr_flow_matches_the_brute_force() {
     let settings = SteadyOrbitSettings::default();
     let orbit = steady_orbit(&model, z, OrbitStart::Transient, &settings).unwrap();
     assert!(orbit.converged && orbit.multiplicity == 1);
-    let jkr = Jkr::of(&model);
+    let jkr = Jkr::of(&model, W_MJ);
     assert!(
         model.gap(0.0, &orbit.state) > jkr.pull_off_gap(),
         "t = 0 is in free flight"
@@ -237,7 +157,7 @@ fn jkr_dissipates_the_hysteresis_loop() {
     )
     .unwrap();
     let observables = orbit.observables();
-    let jkr = Jkr::of(&model);
+    let jkr = Jkr::of(&model, W_MJ);
     let d_po = jkr.pull_off_gap();
     // d = d_po - s^2, s in [0, sqrt(d_po)]: dd = -2 s ds.
     let n = 20_000;

@@ -1,91 +1,18 @@
 //! The grazing of JKR's pull-off surface (MODEL.md section 8, `pull-off`; section 9, JKR) on the
-//! approach of the built-in case `biolever-sticky`, against a brute force written here: a
-//! fixed-step RK4 with its own JKR force (the contact radius by bisection of `delta(a)`) and its
-//! own attachment flag (set where the gap falls below 0, cleared where it rises above the
-//! pull-off gap), sharing with drumroll only the cantilever's free field.
+//! approach of the built-in case `biolever-sticky`, against the brute force of
+//! `hysteretic_reference/`: a fixed-step RK4 with its own JKR force (the contact radius by
+//! bisection of `delta(a)`) and its own attachment flag (set where the gap falls below 0,
+//! cleared where it rises above the pull-off gap), sharing with drumroll only the cantilever's
+//! free field.
 
-use std::f64::consts::PI;
+mod hysteretic_reference;
 
 use afm::{approach_diagram, builtin_case, DiagramSettings, TappingModel};
 use continuation::Parametrised;
-use hybrid::HybridSystem;
+use hysteretic_reference::{attached_force, field, rk4, Jkr};
 
-/// The JKR law of the sample `sticky-soft` written out: `E*` from the model's Hertz coefficient
-/// `c = (4/3) E* sqrt(R)`, `R = 30 nm` (the Biolever's tip), `W = 2 mJ/m^2` in nN/nm.
-struct Jkr {
-    e: f64,
-    r: f64,
-    w: f64,
-}
-
-impl Jkr {
-    fn of(model: &TappingModel) -> Self {
-        let r: f64 = 30.0;
-        Self {
-            e: model.hertz().coefficient / (4.0 / 3.0 * r.sqrt()),
-            r,
-            w: 2.0e-3,
-        }
-    }
-
-    fn indentation(&self, a: f64) -> f64 {
-        a * a / self.r - (2.0 * PI * self.w * a / self.e).sqrt()
-    }
-
-    fn critical_radius(&self) -> f64 {
-        (PI * self.w * self.r * self.r / (8.0 * self.e)).cbrt()
-    }
-
-    fn pull_off_gap(&self) -> f64 {
-        -self.indentation(self.critical_radius())
-    }
-
-    /// `F(a(delta))` with `a` by bisection on `[a_c, 1e3 nm]` to 1e-15 relative.
-    fn force(&self, gap: f64) -> f64 {
-        let delta = -gap;
-        let (mut lo, mut hi) = (self.critical_radius(), 1e3);
-        if delta <= self.indentation(lo) {
-            hi = lo;
-        }
-        while hi - lo > 1e-15 * hi.max(1.0) {
-            let mid = 0.5 * (lo + hi);
-            if self.indentation(mid) < delta {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let a = 0.5 * (lo + hi);
-        4.0 * self.e * a * a * a / (3.0 * self.r) - (8.0 * PI * self.w * self.e * a * a * a).sqrt()
-    }
-}
-
-/// The cantilever's free field (drumroll's mode 0) plus `(w_i^2/k_i) F` while attached.
-fn field(model: &TappingModel, jkr: &Jkr, attached: bool, t: f64, x: &[f64], out: &mut [f64]) {
-    model.vector_field(0, t, x, out);
-    if attached {
-        let force = jkr.force(model.gap(t, x));
-        for (i, mode) in model.cantilever().modes.iter().enumerate() {
-            let omega = mode.angular_frequency();
-            out[2 * i + 1] += omega * omega / mode.stiffness_n_per_m * force;
-        }
-    }
-}
-
-fn rk4(model: &TappingModel, jkr: &Jkr, attached: bool, t: f64, x: &[f64], h: f64) -> Vec<f64> {
-    let n = x.len();
-    let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    field(model, jkr, attached, t, x, &mut k1);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k1[i]).collect();
-    field(model, jkr, attached, t + 0.5 * h, &y, &mut k2);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k2[i]).collect();
-    field(model, jkr, attached, t + 0.5 * h, &y, &mut k3);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + h * k3[i]).collect();
-    field(model, jkr, attached, t + h, &y, &mut k4);
-    (0..n)
-        .map(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
-        .collect()
-}
+/// The work of adhesion of the sample `sticky-soft`, mJ/m^2.
+const STICKY_W_MJ: f64 = 2.0;
 
 /// The gap's rate `sum_i q_i'` (the separation is constant).
 fn gap_rate(x: &[f64]) -> f64 {
@@ -99,7 +26,7 @@ fn gap_rate(x: &[f64]) -> f64 {
 /// through the three samples around it; at a release the virtual maximum `v^2 / (2 |a|)` of the
 /// attached flow continued through the surface (`v`, `a` the gap's rate and acceleration there).
 fn attached_heights(model: &TappingModel, x0: &[f64], steps: usize) -> Vec<f64> {
-    let jkr = Jkr::of(model);
+    let jkr = Jkr::of(model, STICKY_W_MJ);
     let d_po = jkr.pull_off_gap();
     let period = model.period_us();
     let h = period / steps as f64;
@@ -109,7 +36,7 @@ fn attached_heights(model: &TappingModel, x0: &[f64], steps: usize) -> Vec<f64> 
     let n = x.len();
     while t < period - 1e-9 * h {
         let step = h.min(period - t);
-        let next = rk4(model, &jkr, attached, t, &x, step);
+        let next = rk4(model, attached_force(&jkr, attached), t, &x, step);
         let gap = model.gap(t + step, &next);
         let switches = if attached { gap > d_po } else { gap < 0.0 };
         if !switches {
@@ -134,7 +61,7 @@ fn attached_heights(model: &TappingModel, x0: &[f64], steps: usize) -> Vec<f64> 
         let (mut lo, mut hi) = (0.0, step);
         while hi - lo > 1e-14 {
             let mid = 0.5 * (lo + hi);
-            let y = rk4(model, &jkr, attached, t, &x, mid);
+            let y = rk4(model, attached_force(&jkr, attached), t, &x, mid);
             let g = model.gap(t + mid, &y);
             if (attached && g > d_po) || (!attached && g < 0.0) {
                 hi = mid;
@@ -142,11 +69,11 @@ fn attached_heights(model: &TappingModel, x0: &[f64], steps: usize) -> Vec<f64> 
                 lo = mid;
             }
         }
-        x = rk4(model, &jkr, attached, t, &x, hi);
+        x = rk4(model, attached_force(&jkr, attached), t, &x, hi);
         t += hi;
         if attached {
             let mut f = vec![0.0; n];
-            field(model, &jkr, true, t, &x, &mut f);
+            field(model, &attached_force(&jkr, true), t, &x, &mut f);
             let v = gap_rate(&x);
             let a = gap_rate(&f);
             heights.push(v * v / (2.0 * a.abs()));
@@ -176,7 +103,7 @@ fn approach_locates_the_pull_off_grazing() {
     assert!(point.converged && point.precision_nm < 1e-8, "{point:?}");
     let mut at_point = model.clone();
     at_point.set_parameter(point.z_nm);
-    let d_po = Jkr::of(&model).pull_off_gap();
+    let d_po = Jkr::of(&model, STICKY_W_MJ).pull_off_gap();
     assert!(
         at_point.gap(0.0, &point.state) > d_po,
         "the orbit starts free"
