@@ -86,7 +86,6 @@ impl FreeFlightEnergy {
             return;
         }
         let w = self.angular_frequency;
-        let length = b - a;
         let (sin_a, cos_a) = (w * a).sin_cos();
         let rotation = Complex::new(cos_a, sin_a);
         let iw = Complex::new(0.0, w);
@@ -102,20 +101,7 @@ impl FreeFlightEnergy {
                 (c1 * l1, l1),
                 (c2 * l2, l2),
             ];
-            let mut square = Complex::new(0.0, 0.0);
-            let mut drive = Complex::new(0.0, 0.0);
-            for (j, &(g, z)) in terms.iter().enumerate() {
-                // The symmetric double sum: the diagonal once, each pair twice.
-                square += g * g * exponential_integral(z + z, length);
-                for &(h, y) in &terms[j + 1..] {
-                    square += 2.0 * g * h * exponential_integral(z + y, length);
-                }
-                drive += g
-                    * (rotation * exponential_integral(z + iw, length)
-                        + rotation.conj() * exponential_integral(z - iw, length));
-            }
-            total.velocity_square += square.re;
-            total.drive_work += mode.drive_force_nn * 0.5 * drive.re;
+            total.add_flight(mode.drive_force_nn, &terms, &[(1.0, rotation, iw)], b - a);
         }
     }
 }
@@ -136,12 +122,15 @@ impl FreeFlightEnergy {
     ) {
         let w = self.angular_frequency;
         let wb = second.angular_frequency;
-        let length = b - a;
         let (sin_a, cos_a) = (w * a).sin_cos();
         let rotation = Complex::new(cos_a, sin_a);
         let (sin_b, cos_b) = (wb * a).sin_cos();
         let rotation_b = Complex::new(cos_b, sin_b);
         let (iw, iwb) = (Complex::new(0.0, w), Complex::new(0.0, wb));
+        let drives = [
+            (1.0, rotation, iw),
+            (second.relative_force, rotation_b, iwb),
+        ];
         for ((i, mode), total) in self.modes.iter().enumerate().zip(totals.iter_mut()) {
             let [alpha, beta] = mode.flight.steady;
             let x = Complex::new(w * beta, w * alpha) * rotation;
@@ -157,24 +146,40 @@ impl FreeFlightEnergy {
                 (c1 * l1, l1),
                 (c2 * l2, l2),
             ];
-            let mut square = Complex::new(0.0, 0.0);
-            let mut drive = Complex::new(0.0, 0.0);
-            for (j, &(g, z)) in terms.iter().enumerate() {
-                square += g * g * exponential_integral(z + z, length);
-                for &(h, y) in &terms[j + 1..] {
-                    square += 2.0 * g * h * exponential_integral(z + y, length);
-                }
-                drive += g
-                    * (rotation * exponential_integral(z + iw, length)
-                        + rotation.conj() * exponential_integral(z - iw, length));
-                drive += second.relative_force
-                    * g
-                    * (rotation_b * exponential_integral(z + iwb, length)
-                        + rotation_b.conj() * exponential_integral(z - iwb, length));
-            }
-            total.velocity_square += square.re;
-            total.drive_work += mode.drive_force_nn * 0.5 * drive.re;
+            total.add_flight(mode.drive_force_nn, &terms, &drives, b - a);
         }
+    }
+}
+
+impl ModeIntegrals {
+    /// Add the integrals over a free flight of length `L` (us) whose velocity is
+    /// `q' = sum_j g_j e^{z_j s}` (`terms` the pairs `(g_j, z_j)`): `S += Re sum_{j,l} g_j g_l
+    /// E(z_j + z_l)`, the diagonal once and each pair twice, and for each drive `(r, e^{i nu
+    /// a}, i nu)` of `drives` (relative force `r`, the first's 1) `W += F_i Re sum_j r g_j
+    /// [e^{i nu a} E(z_j + i nu) + e^{-i nu a} E(z_j - i nu)] / 2`, `F_i` = `drive_force_nn`.
+    fn add_flight(
+        &mut self,
+        drive_force_nn: f64,
+        terms: &[(Complex<f64>, Complex<f64>)],
+        drives: &[(f64, Complex<f64>, Complex<f64>)],
+        length: f64,
+    ) {
+        let mut square = Complex::new(0.0, 0.0);
+        let mut drive = Complex::new(0.0, 0.0);
+        for (j, &(g, z)) in terms.iter().enumerate() {
+            square += g * g * exponential_integral(z + z, length);
+            for &(h, y) in &terms[j + 1..] {
+                square += 2.0 * g * h * exponential_integral(z + y, length);
+            }
+            for &(relative_force, rotation, i_nu) in drives {
+                drive += relative_force
+                    * g
+                    * (rotation * exponential_integral(z + i_nu, length)
+                        + rotation.conj() * exponential_integral(z - i_nu, length));
+            }
+        }
+        self.velocity_square += square.re;
+        self.drive_work += drive_force_nn * 0.5 * drive.re;
     }
 }
 
