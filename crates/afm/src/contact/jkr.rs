@@ -289,14 +289,16 @@ mod tests {
         b
     }
 
-    /// The root of `b^4/R - k b = delta` on `[b_c, b_hi]` by bisection to adjacent doubles (the
-    /// function increases there).
-    fn bisection_root(jkr: &JkrContact, delta: f64) -> f64 {
-        let (r, k) = (jkr.tip_radius_nm, jkr.adhesion_root);
-        let value = |b: f64| b * b * b * b / r - k * b - delta;
-        let (mut lo, mut hi) = (jkr.critical_root, jkr.critical_root);
+    /// The root of the increasing `value` above `lo` (`value(lo) <= 0`) by bisection to adjacent
+    /// doubles, its bracket's upper end grown by `grow` from `hi` until `value` is positive.
+    fn bisection(
+        value: impl Fn(f64) -> f64,
+        mut lo: f64,
+        mut hi: f64,
+        grow: impl Fn(f64) -> f64,
+    ) -> f64 {
         while value(hi) < 0.0 {
-            hi = 2.0 * hi + 1.0;
+            hi = grow(hi);
         }
         loop {
             let mid = 0.5 * (lo + hi);
@@ -315,29 +317,21 @@ mod tests {
         }
     }
 
+    /// The root of `b^4/R - k b = delta` on `[b_c, b_hi]` by bisection to adjacent doubles (the
+    /// function increases there).
+    fn bisection_root(jkr: &JkrContact, delta: f64) -> f64 {
+        let (r, k) = (jkr.tip_radius_nm, jkr.adhesion_root);
+        let value = |b: f64| b * b * b * b / r - k * b - delta;
+        bisection(value, jkr.critical_root, jkr.critical_root, |hi| {
+            2.0 * hi + 1.0
+        })
+    }
+
     /// The root of `e^2 (e^2 + 4 e + 6) = v` (`e >= 0`) by bisection to adjacent doubles (the
     /// left side increases from 0).
     fn bisection_offset(v: f64) -> f64 {
         let value = |e: f64| e * e * (e * e + 4.0 * e + 6.0) - v;
-        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-        while value(hi) < 0.0 {
-            hi *= 2.0;
-        }
-        loop {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                return if value(hi).abs() < value(lo).abs() {
-                    hi
-                } else {
-                    lo
-                };
-            }
-            if value(mid) < 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
+        bisection(value, 0.0, 1.0, |hi| 2.0 * hi)
     }
 
     /// The offset from pull-off `e = b / b_c - 1` against a bisection of its quartic, to 1e-14
