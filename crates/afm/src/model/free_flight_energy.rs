@@ -164,18 +164,19 @@ impl ModeIntegrals {
         drives: &[(f64, Complex<f64>, Complex<f64>)],
         length: f64,
     ) {
+        let mut integrals = ExponentialIntegrals::new(length, terms.len(), drives.len());
         let mut square = Complex::new(0.0, 0.0);
         let mut drive = Complex::new(0.0, 0.0);
         for (j, &(g, z)) in terms.iter().enumerate() {
-            square += g * g * exponential_integral(z + z, length);
+            square += g * g * integrals.at(z + z);
             for &(h, y) in &terms[j + 1..] {
-                square += 2.0 * g * h * exponential_integral(z + y, length);
+                square += 2.0 * g * h * integrals.at(z + y);
             }
             for &(relative_force, rotation, i_nu) in drives {
                 drive += relative_force
                     * g
-                    * (rotation * exponential_integral(z + i_nu, length)
-                        + rotation.conj() * exponential_integral(z - i_nu, length));
+                    * (rotation * integrals.at(z + i_nu)
+                        + rotation.conj() * integrals.at(z - i_nu));
             }
         }
         self.velocity_square += square.re;
@@ -183,17 +184,55 @@ impl ModeIntegrals {
     }
 }
 
+/// The values of [`exponential_integral`] over one interval of length `L`, each computed once
+/// per argument: the drive's exponents `z_j +- i nu` are mostly the velocity's own pair sums
+/// `z_j + z_l` (`+-i w` is a velocity exponent), so an interval needs about half the
+/// evaluations. Arguments are matched by their bits, so every value is the one
+/// [`exponential_integral`] gives.
+struct ExponentialIntegrals {
+    length: f64,
+    /// `(z, E(z))` for every argument so far.
+    known: Vec<(Complex<f64>, Complex<f64>)>,
+}
+
+impl ExponentialIntegrals {
+    /// No values yet, for an interval of `length` us with `terms` exponentials and `drives`
+    /// drives (the table's capacity: every pair sum and every drive term).
+    fn new(length: f64, terms: usize, drives: usize) -> Self {
+        Self {
+            length,
+            known: Vec::with_capacity(terms * (terms + 1) / 2 + 2 * terms * drives),
+        }
+    }
+
+    /// `E(z)` (us) over the interval.
+    fn at(&mut self, z: Complex<f64>) -> Complex<f64> {
+        let bits = (z.re.to_bits(), z.im.to_bits());
+        if let Some(&(_, value)) = self
+            .known
+            .iter()
+            .find(|(known, _)| (known.re.to_bits(), known.im.to_bits()) == bits)
+        {
+            return value;
+        }
+        let value = exponential_integral(z, self.length);
+        self.known.push((z, value));
+        value
+    }
+}
+
 /// `E(z) = int_0^L e^{z s} ds = (e^{z L} - 1) / z` (`L` at `z = 0`), by its Taylor series
 /// `L sum_n (z L)^n / (n + 1)!` where `|z L| < 1`, so that short intervals lose no digits.
 fn exponential_integral(z: Complex<f64>, length: f64) -> Complex<f64> {
     let zl = z * length;
-    if zl.norm() < 1.0 {
+    // Squared moduli (no square roots): `|zL| < 1` and `|term| < 1e-17 |sum|`.
+    if zl.norm_sqr() < 1.0 {
         let mut term = Complex::new(1.0, 0.0);
         let mut sum = term;
         for n in 1..25 {
             term = term * zl / (n + 1) as f64;
             sum += term;
-            if term.norm() < 1e-17 * sum.norm() {
+            if term.norm_sqr() < 1e-34 * sum.norm_sqr() {
                 break;
             }
         }

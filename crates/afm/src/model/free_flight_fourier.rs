@@ -191,6 +191,52 @@ impl FreeFlightFourier {
         if self.second.is_some() {
             return self.integrate_frequency(k as f64 * self.angular_frequency, a, x_a, b);
         }
+        let coefficients = self.homogeneous_coefficients(a, x_a);
+        self.integrate_harmonic_from(k, a, &coefficients, b)
+    }
+
+    /// Add [`FreeFlightFourier::integrate_harmonic`] for every harmonic `k = 1..=totals.len()`
+    /// to `totals[k - 1]` (nm us), for free flight from state `x_a` at time `a` (us) to time
+    /// `b >= a`. The homogeneous parts' coefficients, which do not depend on `k`, are
+    /// computed once for all harmonics (the same numbers as harmonic by harmonic).
+    pub fn add_harmonics(&self, a: f64, x_a: &[f64], b: f64, totals: &mut [[f64; 2]]) {
+        if self.second.is_some() {
+            for (k, total) in totals.iter_mut().enumerate() {
+                let frequency = (k + 1) as f64 * self.angular_frequency;
+                let [cosine, sine] = self.integrate_frequency(frequency, a, x_a, b);
+                total[0] += cosine;
+                total[1] += sine;
+            }
+            return;
+        }
+        let coefficients = self.homogeneous_coefficients(a, x_a);
+        for (k, total) in totals.iter_mut().enumerate() {
+            let [cosine, sine] = self.integrate_harmonic_from(k + 1, a, &coefficients, b);
+            total[0] += cosine;
+            total[1] += sine;
+        }
+    }
+
+    /// Each mode's homogeneous coefficients `[c_1, c_2]` (nm) of the single-drive flight from
+    /// `x_a` at `a` ([`FreeFlightMode::homogeneous`]).
+    fn homogeneous_coefficients(&self, a: f64, x_a: &[f64]) -> Vec<[Complex<f64>; 2]> {
+        let w = self.angular_frequency;
+        self.modes
+            .iter()
+            .enumerate()
+            .map(|(i, mode)| mode.homogeneous(w, a, x_a[2 * i], x_a[2 * i + 1]))
+            .collect()
+    }
+
+    /// [`FreeFlightFourier::integrate_harmonic`] of a single drive, from the modes' homogeneous
+    /// coefficients at `a` (one `[c_1, c_2]` per mode).
+    fn integrate_harmonic_from(
+        &self,
+        k: usize,
+        a: f64,
+        homogeneous_coefficients: &[[Complex<f64>; 2]],
+        b: f64,
+    ) -> [f64; 2] {
         let w = self.angular_frequency;
         let kw = k as f64 * w;
         let length = b - a;
@@ -203,14 +249,13 @@ impl FreeFlightFourier {
         let counter_rotating = exponential_integral(-(1.0 + k as f64) * w, a, length);
         let minus_ikw = Complex::new(0.0, -kw);
         let mut total = Complex::new(0.0, 0.0);
-        for (i, mode) in self.modes.iter().enumerate() {
+        for (mode, coefficients) in self.modes.iter().zip(homogeneous_coefficients) {
             let [alpha, beta] = mode.steady;
             // The steady part.
             let steady = Complex::new(alpha, -beta) * 0.5 * co_rotating
                 + Complex::new(alpha, beta) * 0.5 * counter_rotating;
-            let coefficients = mode.homogeneous(w, a, x_a[2 * i], x_a[2 * i + 1]);
             let mut homogeneous = Complex::new(0.0, 0.0);
-            for (c, l) in coefficients.into_iter().zip(mode.roots) {
+            for (&c, l) in coefficients.iter().zip(mode.roots) {
                 let z = l + minus_ikw;
                 homogeneous += c * ((z * length).exp() - 1.0) / z;
             }

@@ -181,12 +181,12 @@ impl CycleLockIn {
     /// Add the closed-form integrals over the free-flight interval in progress, up to `end`.
     fn close_free_flight(&mut self, end: f64) {
         if let (Some(start), Some(free_flight)) = (self.free_start.take(), &self.free_flight) {
-            for (k, coefficient) in self.fourier[..self.harmonic_count].iter_mut().enumerate() {
-                let [cosine, sine] =
-                    free_flight.integrate_harmonic(k + 1, start, &self.free_state, end);
-                coefficient[0] += cosine;
-                coefficient[1] += sine;
-            }
+            free_flight.add_harmonics(
+                start,
+                &self.free_state,
+                end,
+                &mut self.fourier[..self.harmonic_count],
+            );
         }
     }
 

@@ -451,12 +451,7 @@ impl PeriodObserver {
     /// progress, up to `end`, and close it (`F_ts = 0` there: no force integral).
     fn close_free_flight(&mut self, end: f64) {
         if let (Some(start), Some(free_flight)) = (self.free_start.take(), &self.free_flight) {
-            for (k, coefficient) in self.fourier.iter_mut().enumerate() {
-                let [cosine, sine] =
-                    free_flight.integrate_harmonic(k + 1, start, &self.free_state, end);
-                coefficient[0] += cosine;
-                coefficient[1] += sine;
-            }
+            free_flight.add_harmonics(start, &self.free_state, end, &mut self.fourier);
             if let (Some((_, coefficients)), Some([cosine, sine])) = (
                 &mut self.second_fourier,
                 free_flight.integrate_second(start, &self.free_state, end),
