@@ -154,7 +154,6 @@ pub(crate) fn relaxing_tangent_series(
 ) {
     let p = tangents.order().min(state.order());
     let n = state.dim();
-    let last = n - 1;
     let columns = tangents.dim() / n;
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
     let onset = hertz_onset(clock, state.row(0));
@@ -177,56 +176,139 @@ pub(crate) fn relaxing_tangent_series(
     for m in 0..p {
         indentation_root(&mut root, &delta, m, onset);
     }
-    let c0 = sls.coefficient();
-    let inverse_time = 1.0 / sls.relaxation_time_us;
-    let beta = sls.relaxing_fraction();
-    // Rows 0..p of the gaps `sum_i V_{q_i}` (+ 1 on the parameter column at power 0), then
-    // the force's and the relaxation's change at the power below, per column.
-    scratch.clear();
-    scratch.resize((p + 2) * columns, 0.0);
-    let (gaps, previous) = scratch.split_at_mut(p * columns);
-    let (previous_force, previous_relaxation) = previous.split_at_mut(columns);
-    let dim = n * columns;
+    let recurrence = RelaxingTangents {
+        modes,
+        root: &root[..p],
+        force_gain: sls.coefficient(),
+        relaxation_gain: 1.0 / sls.relaxation_time_us,
+        beta: sls.relaxing_fraction(),
+        rate: a,
+        curvature: b2,
+        parameter_column,
+    };
     let v = tangents.coefficients_mut();
-    for k in 0..p {
-        let (done, after) = v.split_at_mut((k + 1) * dim);
-        let (earlier, row) = done.split_at(k * dim);
-        let next = &mut after[..dim];
-        let scale = 1.0 / (k + 1) as f64;
-        let rate = a * scale;
-        let (curvature, below) = if k > 0 {
-            (b2 * scale, &earlier[(k - 1) * dim..])
-        } else {
-            (0.0, row)
-        };
-        for c in 0..columns {
-            let mut gap: f64 = (0..modes.len()).map(|i| row[2 * i * columns + c]).sum();
-            if k == 0 && parameter_column && c + 1 == columns {
-                gap += 1.0;
+    // The common column counts (N = 1, 2 with and without dZ) as constants, so that the loops
+    // over columns unroll.
+    match columns {
+        3 => recurrence.run(3, v, scratch),
+        4 => recurrence.run(4, v, scratch),
+        5 => recurrence.run(5, v, scratch),
+        6 => recurrence.run(6, v, scratch),
+        _ => recurrence.run(columns, v, scratch),
+    }
+}
+
+/// The coefficients of the tangent recurrence of [`relaxing_tangent_series`].
+struct RelaxingTangents<'a> {
+    modes: &'a [ModalConstants],
+    /// The indentation's square root to order `p - 1`.
+    root: &'a [f64],
+    /// `c_0`, nN/nm^{3/2}.
+    force_gain: f64,
+    /// `1 / tau_r`, 1/us.
+    relaxation_gain: f64,
+    /// `beta = 1 - E_inf*/E_0*`.
+    beta: f64,
+    /// `tau = rate + curvature s` (`curvature` twice the clock's).
+    rate: f64,
+    curvature: f64,
+    parameter_column: bool,
+}
+
+impl RelaxingTangents<'_> {
+    /// Rows `1..=p` of `v` (row-major `(2N + 1) x columns` matrices) from row 0: with the gap
+    /// `g = sum_j V_{q_j}` of each column (plus `dZ/dZ = 1` on the parameter column) and the
+    /// coupling `(r g)_k`, `(k + 1) q_{i,k+1} = (tau v_i)_k`, `(k + 1) v_{i,k+1} = (w_i^2/k_i)
+    /// (tau dF)_k - w_i^2 (tau q_i)_k - (w_i/Q_i) (tau v_i)_k` with `dF = -(3/2) c_0 (r g) -
+    /// c_0 rho`, and `(k + 1) rho_{k+1} = (tau drho')_k` with `drho' = (-(3/2) beta (r g) -
+    /// rho) / tau_r`. `scratch` holds the gaps' rows and `dF`, `drho'` at the power below.
+    #[inline(always)]
+    fn run(&self, columns: usize, v: &mut [f64], scratch: &mut Vec<f64>) {
+        let modes = self.modes;
+        let p = self.root.len();
+        let n = 2 * modes.len() + 1;
+        let last = n - 1;
+        let dim = n * columns;
+        let (a, b2) = (self.rate, self.curvature);
+        let (c0, beta, inverse_time) = (self.force_gain, self.beta, self.relaxation_gain);
+        scratch.clear();
+        scratch.resize((p + 2) * columns, 0.0);
+        let (gaps, previous) = scratch.split_at_mut(p * columns);
+        let (previous_force, previous_relaxation) = previous.split_at_mut(columns);
+        for k in 0..p {
+            let (done, after) = v.split_at_mut((k + 1) * dim);
+            let (earlier, row) = done.split_at(k * dim);
+            let next = &mut after[..dim];
+            let scale = 1.0 / (k + 1) as f64;
+            let rate = a * scale;
+            let (curvature, below) = if k > 0 {
+                (b2 * scale, &earlier[(k - 1) * dim..])
+            } else {
+                (0.0, row)
+            };
+            {
+                let gap_row = &mut gaps[k * columns..(k + 1) * columns];
+                gap_row.fill(0.0);
+                for q in row.chunks_exact(2 * columns).take(modes.len()) {
+                    for (g, q) in gap_row.iter_mut().zip(&q[..columns]) {
+                        *g += q;
+                    }
+                }
+                if k == 0 && self.parameter_column {
+                    gap_row[columns - 1] += 1.0;
+                }
             }
-            gaps[k * columns + c] = gap;
-            // (r g)_k, the coupling's coefficient k.
-            let coupling: f64 = (0..=k).map(|j| root[k - j] * gaps[j * columns + c]).sum();
-            let rho = row[last * columns + c];
-            let force = -1.5 * c0 * coupling - c0 * rho;
-            let relaxation = (-1.5 * beta * coupling - rho) * inverse_time;
-            let tau_force = rate * force + curvature * previous_force[c];
-            let tau_relaxation = rate * relaxation + curvature * previous_relaxation[c];
-            previous_force[c] = force;
-            previous_relaxation[c] = relaxation;
-            for (i, m) in modes.iter().enumerate() {
-                let (q, velocity) = (2 * i * columns + c, (2 * i + 1) * columns + c);
-                let tau_q = rate * row[q] + curvature * below[q];
-                let tau_v = rate * row[velocity] + curvature * below[velocity];
-                next[q] = tau_v;
-                next[velocity] = m.omega_squared_over_stiffness * tau_force
-                    - m.omega_squared * tau_q
-                    - m.damping * tau_v;
+            let gaps = &gaps[..(k + 1) * columns];
+            for start in (0..columns).step_by(COLUMN_BLOCK) {
+                let width = COLUMN_BLOCK.min(columns - start);
+                let block = start..start + width;
+                // (r g)_k, the coupling's coefficient k, for the block's columns.
+                let mut coupling = [0.0; COLUMN_BLOCK];
+                for (gap, r) in gaps.chunks_exact(columns).zip(self.root[..=k].iter().rev()) {
+                    for (c, g) in coupling[..width].iter_mut().zip(&gap[block.clone()]) {
+                        *c += r * g;
+                    }
+                }
+                let mut tau_force = [0.0; COLUMN_BLOCK];
+                let mut tau_relaxation = [0.0; COLUMN_BLOCK];
+                let rho = &row[last * columns..][block.clone()];
+                for c in 0..width {
+                    let force = -1.5 * c0 * coupling[c] - c0 * rho[c];
+                    let relaxation = (-1.5 * beta * coupling[c] - rho[c]) * inverse_time;
+                    let column = start + c;
+                    tau_force[c] = rate * force + curvature * previous_force[column];
+                    tau_relaxation[c] = rate * relaxation + curvature * previous_relaxation[column];
+                    previous_force[column] = force;
+                    previous_relaxation[column] = relaxation;
+                }
+                for ((m, out), (qv, below_qv)) in
+                    modes.iter().zip(next.chunks_exact_mut(2 * columns)).zip(
+                        row.chunks_exact(2 * columns)
+                            .zip(below.chunks_exact(2 * columns)),
+                    )
+                {
+                    let (q, velocity) = qv.split_at(columns);
+                    let (below_q, below_velocity) = below_qv.split_at(columns);
+                    let (next_q, next_v) = out.split_at_mut(columns);
+                    for c in 0..width {
+                        let column = start + c;
+                        let tau_q = rate * q[column] + curvature * below_q[column];
+                        let tau_v = rate * velocity[column] + curvature * below_velocity[column];
+                        next_q[column] = tau_v;
+                        next_v[column] = m.omega_squared_over_stiffness * tau_force[c]
+                            - m.omega_squared * tau_q
+                            - m.damping * tau_v;
+                    }
+                }
+                next[last * columns..][block].copy_from_slice(&tau_relaxation[..width]);
             }
-            next[last * columns + c] = tau_relaxation;
         }
     }
 }
+
+/// The widest block of tangent columns [`relaxing_tangent_series`] forms at once in registers
+/// (`2N + 2` columns for `N` up to 3 in one).
+const COLUMN_BLOCK: usize = 8;
 
 /// The Taylor coefficients `0..coefficients.len()` of the contact surface `h_0 = d +
 /// rho^{2/3}` along the state series `state` (any mode: `rho` is its last component) on

@@ -158,6 +158,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 self.settings.relative_tolerance,
                 self.settings.absolute_tolerance,
             ));
+            // Kept for the surface's zeros ahead and the step's proofs.
+            taylor.surface = Some((k, power));
         }
         if self.sensitivity.transition() {
             // The tangents' order was fixed with the workspace (it fits these settings).
@@ -296,6 +298,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let taylor = &self.buffers.taylor;
         let mut power = [0.0; TAYLOR_ORDER + 1];
         if self.given_series & (1 << k) != 0 {
+            if let Some((kept, mut power)) = taylor.surface {
+                if kept == k {
+                    power[0] = start_value;
+                    return Some(power);
+                }
+            }
             let order = taylor.state.order().min(TAYLOR_ORDER);
             if !accelerations_series(
                 self.accelerations,
