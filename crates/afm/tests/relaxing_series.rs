@@ -7,7 +7,10 @@
 //! recovered sample (`rho = 0`: the first contact enters at `d = 0`, Hertz's onset), with the
 //! transition matrix and `dx/dZ`.
 
-use afm::{builtin_case, steady_orbit, OrbitStart, Separation, SteadyOrbitSettings, TappingModel};
+use afm::{
+    approach_diagram, builtin_case, steady_orbit, DiagramSettings, OrbitStart, Separation,
+    SteadyOrbitSettings, TappingModel,
+};
 use hybrid::{flow_map, FlowMap, Sensitivity, Settings};
 
 fn model(z: f64) -> TappingModel {
@@ -147,4 +150,39 @@ fn contact_series_steps_match_runge_kutta_and_finite_differences() {
     let mut recovered = x0;
     recovered[4] = 0.0;
     check_from(&model, &recovered);
+}
+
+/// The approach diagram's grazing points at the default tolerance (1e-12, contact by series)
+/// against those of a finer reference, DOP853 everywhere at tolerance 1e-13: within 1e-10 nm
+/// (measured: G1 1e-12, G2 1e-12, G3 7e-12 nm; DOP853 at the default tolerance, the path before
+/// the series, was 3.3e-10 and 2.0e-9 nm off at G2 and G3).
+#[test]
+fn grazing_points_match_a_finer_runge_kutta_diagram() {
+    let case = builtin_case("biolever-soft-viscoelastic").expect("built-in case");
+    let model = TappingModel::from_case(&case).expect("model");
+    let settings = DiagramSettings::approach(&model);
+    let mut finer = settings.clone();
+    finer.orbit.integration.relative_tolerance = 1e-13;
+    finer.orbit.integration.absolute_tolerance = 1e-13;
+    finer.orbit.integration.taylor_series = false;
+    let diagram = approach_diagram(&model, &settings).expect("diagram");
+    let reference = approach_diagram(&model, &finer).expect("reference diagram");
+    let labels = |d: &afm::BifurcationDiagram| {
+        d.special_points
+            .iter()
+            .map(|p| p.label.clone())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(labels(&diagram), ["G1", "G2", "G3"]);
+    assert_eq!(labels(&diagram), labels(&reference));
+    for (a, b) in diagram.special_points.iter().zip(&reference.special_points) {
+        println!("{}: {:.13} vs {:.13}", a.label, a.z_nm, b.z_nm);
+        assert!(
+            (a.z_nm - b.z_nm).abs() < 1e-10,
+            "{} {} vs {}",
+            a.label,
+            a.z_nm,
+            b.z_nm
+        );
+    }
 }

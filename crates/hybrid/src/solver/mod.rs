@@ -61,7 +61,12 @@
 //!   in the state only, with a time part whose series the system gives
 //!   ([`crate::SwitchingStructure::switching_is_affine_in_state`], a gap with a base motion in
 //!   it), the same holds over Taylor steps (the state's series weighted by the gradient plus the
-//!   time part's series) but not over Runge-Kutta steps, which are then sampled.
+//!   time part's series) but not over Runge-Kutta steps, which are then sampled. Where an `h_k`
+//!   is not affine in the state but the system gives its series along a Taylor step's
+//!   ([`crate::SwitchingStructure::switching_series`], a standard linear solid's `d +
+//!   rho^{2/3}`), that series is its polynomial over the step, which is kept within the reach
+//!   at which the series' last two terms stay below the state's tolerance; a step from where the
+//!   system gives none is a Runge-Kutta step.
 //!
 //! # Step-size control
 //!
