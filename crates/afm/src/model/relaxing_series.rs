@@ -290,12 +290,11 @@ impl RelaxingTangents<'_> {
                     let (q, velocity) = qv.split_at(columns);
                     let (below_q, below_velocity) = below_qv.split_at(columns);
                     let (next_q, next_v) = out.split_at_mut(columns);
-                    for c in 0..width {
-                        let column = start + c;
+                    for (column, tau_force) in block.clone().zip(&tau_force[..width]) {
                         let tau_q = rate * q[column] + curvature * below_q[column];
                         let tau_v = rate * velocity[column] + curvature * below_velocity[column];
                         next_q[column] = tau_v;
-                        next_v[column] = m.omega_squared_over_stiffness * tau_force[c]
+                        next_v[column] = m.omega_squared_over_stiffness * tau_force
                             - m.omega_squared * tau_q
                             - m.damping * tau_v;
                     }
@@ -325,7 +324,7 @@ pub(crate) fn relaxing_surface_series(
     let n = state.dim();
     let order = coefficients.len().saturating_sub(1).min(state.order());
     let rho0 = state.row(0)[n - 1];
-    if !(rho0 > 0.0) || order > MAX_ORDER {
+    if rho0.is_nan() || rho0 <= 0.0 || order > MAX_ORDER {
         return false;
     }
     let separation = separation_coefficients(separation, clock);
