@@ -80,21 +80,17 @@ pub(crate) enum SeriesForce {
 
 /// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`; real parts in
 /// `re`, imaginary in `im`) from `delta`'s coefficients to `k` and `w`'s below `k`:
-/// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`. The products `j
-/// delta_j` are kept in `weighted` (written at `k`, read below it), so that the calls for `k =
-/// 0, 1, ...` in turn form each once.
+/// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`.
 #[inline]
 fn update_layer_exponential(
     re: &mut [f64],
     im: &mut [f64],
-    weighted: &mut [f64],
     delta: &[f64],
     k: usize,
     wavenumber: f64,
     decay_length: f64,
 ) {
     let (c_re, c_im) = (1.0 / decay_length, -wavenumber);
-    weighted[k] = k as f64 * delta[k];
     if k == 0 {
         let magnitude = (c_re * delta[0]).exp();
         let (sin, cos) = (c_im * delta[0]).sin_cos();
@@ -103,12 +99,10 @@ fn update_layer_exponential(
         return;
     }
     let (mut sum_re, mut sum_im) = (0.0, 0.0);
-    for (weight, (r, i)) in weighted[1..=k]
-        .iter()
-        .zip(re[..k].iter().rev().zip(im[..k].iter().rev()))
-    {
-        sum_re += weight * r;
-        sum_im += weight * i;
+    for j in 1..=k {
+        let weight = j as f64 * delta[j];
+        sum_re += weight * re[k - j];
+        sum_im += weight * im[k - j];
     }
     let scale = 1.0 / k as f64;
     re[k] = scale * (c_re * sum_re - c_im * sum_im);
@@ -397,9 +391,8 @@ fn force_coefficient(
             if onset {
                 return None;
             }
-            let (re, rest) = root.split_at_mut(MAX_ORDER + 1);
-            let (im, weighted) = rest.split_at_mut(MAX_ORDER + 1);
-            update_layer_exponential(re, im, weighted, delta, k, wavenumber, decay_length);
+            let (re, im) = root.split_at_mut(MAX_ORDER + 1);
+            update_layer_exponential(re, im, delta, k, wavenumber, decay_length);
             Some(amplitude * (re[k] - wavenumber * decay_length * im[k]))
         }
     }
@@ -486,76 +479,7 @@ fn state_recurrence(
             total += out[0] + out[1];
         }
     }
-    if let SeriesForce::Hydration {
-        wavenumber,
-        decay_length,
-        ..
-    } = law
-    {
-        LAYER_SERIES.with(|kept| {
-            kept.borrow_mut()
-                .keep(wavenumber, decay_length, &delta[..p], &root[..p]);
-        });
-    }
     total.is_finite()
-}
-
-/// The real parts of the hydration force's `w = exp(c delta)` along the last state series a
-/// thread formed ([`contact_state_series`]), with the indentation's coefficients they came
-/// from, so that [`contact_tangent_series`] along the same series (the solver expands the
-/// tangents right after the state) reuses them instead of forming them again.
-struct LayerSeries {
-    /// `k_w` and `lambda` of the force, 1/nm and nm.
-    wavenumber: f64,
-    decay_length: f64,
-    /// How many coefficients are kept.
-    order: usize,
-    /// The indentation's coefficients `0..order`.
-    delta: [f64; MAX_ORDER + 1],
-    /// `Re w`'s coefficients `0..order`.
-    re: [f64; MAX_ORDER + 1],
-}
-
-impl LayerSeries {
-    /// Keep `re` formed from `delta` (as many coefficients) for the force `(k_w, lambda)`.
-    fn keep(&mut self, wavenumber: f64, decay_length: f64, delta: &[f64], re: &[f64]) {
-        self.wavenumber = wavenumber;
-        self.decay_length = decay_length;
-        self.order = delta.len();
-        self.delta[..delta.len()].copy_from_slice(delta);
-        self.re[..re.len()].copy_from_slice(re);
-    }
-
-    /// Copy the kept `Re w` into `re` if it was formed for the force `(k_w, lambda)` from an
-    /// indentation whose first `re.len()` coefficients are `delta`'s, bit for bit (coefficient
-    /// `m` of `w` depends on the indentation's to `m` only); `false` otherwise.
-    fn reuse(&self, wavenumber: f64, decay_length: f64, delta: &[f64], re: &mut [f64]) -> bool {
-        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
-        let hit = re.len() <= self.order
-            && same(self.wavenumber, wavenumber)
-            && same(self.decay_length, decay_length)
-            && delta[..re.len()]
-                .iter()
-                .zip(&self.delta)
-                .all(|(a, b)| same(*a, *b));
-        if hit {
-            re.copy_from_slice(&self.re[..re.len()]);
-        }
-        hit
-    }
-}
-
-thread_local! {
-    /// The thread's last hydration series ([`LayerSeries`]).
-    static LAYER_SERIES: std::cell::RefCell<LayerSeries> = const {
-        std::cell::RefCell::new(LayerSeries {
-            wavenumber: f64::NAN,
-            decay_length: f64::NAN,
-            order: 0,
-            delta: [0.0; MAX_ORDER + 1],
-            re: [0.0; MAX_ORDER + 1],
-        })
-    };
 }
 
 /// The Taylor coefficients of the tangent matrix `V` (`2N` rows: the transition matrix's
@@ -643,27 +567,10 @@ pub(crate) fn contact_tangent_series(
             wavenumber,
             decay_length,
         } => {
-            // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w: the state
-            // series' own `w` when it was formed along the same indentation (the same numbers),
-            // else formed here.
-            let kept = LAYER_SERIES.with(|kept| {
-                kept.borrow()
-                    .reuse(wavenumber, decay_length, &delta[..p], &mut root[..p])
-            });
-            if !kept {
-                let mut im = [0.0; MAX_ORDER + 1];
-                let mut weighted = [0.0; MAX_ORDER + 1];
-                for m in 0..p {
-                    update_layer_exponential(
-                        &mut root,
-                        &mut im,
-                        &mut weighted,
-                        &delta,
-                        m,
-                        wavenumber,
-                        decay_length,
-                    );
-                }
+            // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w.
+            let mut im = [0.0; MAX_ORDER + 1];
+            for m in 0..p {
+                update_layer_exponential(&mut root, &mut im, &delta, m, wavenumber, decay_length);
             }
             -amplitude * (1.0 / decay_length + wavenumber * wavenumber * decay_length)
         }
