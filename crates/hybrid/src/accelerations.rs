@@ -83,6 +83,27 @@ impl<'a> Accelerations<'a> {
         }
     }
 
+    /// [`SwitchingStructure::switching_has_series`] for surface `k`; `false` when unknown.
+    pub fn switching_has_series(&self, k: usize) -> bool {
+        self.switching
+            .is_some_and(|switching| switching.switching_has_series(k))
+    }
+
+    /// [`SwitchingStructure::switching_series`] of surface `k` along `state`; `false` without a
+    /// switching structure.
+    pub fn switching_series(
+        &self,
+        k: usize,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        state: &TaylorSeries,
+        coefficients: &mut [f64],
+    ) -> bool {
+        self.switching.is_some_and(|switching| {
+            switching.switching_series(k, mode, clock, state, coefficients)
+        })
+    }
+
     /// [`SwitchingStructure::half_power_surface`] of mode `mode`; `None` when unknown.
     pub fn half_power_surface(&self, mode: Mode) -> Option<usize> {
         self.switching
@@ -267,6 +288,37 @@ pub trait SwitchingStructure {
         for c in coefficients.iter_mut().skip(1) {
             *c = 0.0;
         }
+    }
+
+    /// Whether the system gives the Taylor series of `h_k` along a step's state series
+    /// ([`SwitchingStructure::switching_series`]) for an `h_k` that is not affine in the state
+    /// (a standard linear solid's contact surface `d + rho^{2/3}`). The default is `false`.
+    ///
+    /// Along a Taylor step such an `h_k` is then a polynomial in the step's clock offset, used
+    /// as an affine one's is (its zeros ahead for a half-power surface, the proof that a step
+    /// is settled), and the step is kept within the reach at which that polynomial's last two
+    /// terms stay below the state's tolerance; where the system cannot give it, the step is a
+    /// Runge-Kutta step.
+    fn switching_has_series(&self, k: usize) -> bool {
+        let _ = k;
+        false
+    }
+
+    /// For an `h_k` with [`SwitchingStructure::switching_has_series`], the Taylor coefficients
+    /// `0..coefficients.len()` of `h_k(t(s), x(s))` in the clock offset `s` of `clock`, along
+    /// the state's series `state` of mode `mode` (its order at least `coefficients.len() - 1`);
+    /// `false` where the series does not exist there (`h_k` not analytic at the step's start).
+    /// The default returns `false`.
+    fn switching_series(
+        &self,
+        k: usize,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        state: &TaylorSeries,
+        coefficients: &mut [f64],
+    ) -> bool {
+        let _ = (k, mode, clock, state, coefficients);
+        false
     }
 
     /// A rigorous upper bound of `|d^2 h_k / dt^2|` along the flow of mode `mode` from

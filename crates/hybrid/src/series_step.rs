@@ -185,6 +185,25 @@ impl TaylorStep {
     }
 }
 
+impl TaylorStep {
+    /// [`TaylorStep::reach`] of one polynomial `power` (power-basis coefficients, a switching
+    /// function along the series): the longest clock step over which its last two terms stay
+    /// below `absolute + relative |power[0]|`.
+    pub fn polynomial_reach(power: &[f64], relative: f64, absolute: f64) -> f64 {
+        let p = power.len() - 1;
+        let weight = 1.0 / (absolute + relative * power[0].abs());
+        [
+            (power[p - 1].abs() * weight, p - 1),
+            (power[p].abs() * weight, p),
+        ]
+        .into_iter()
+        .filter(|&(size, _)| size > 0.0)
+        .map(|(size, k)| -size.ln() / k as f64)
+        .fold(f64::INFINITY, f64::min)
+        .exp()
+    }
+}
+
 /// What a step's series shows of a surface ahead, from the polynomial of `h_k` in the clock
 /// offset: its first zero, and the radius of convergence a ridge limits the series to.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -48,7 +48,8 @@ impl StandardLinearSolid {
     /// The unrecovered depth `sigma = rho^{2/3}` of the surface, nm (0 for `rho <= 0`).
     pub fn unrecovered_depth_nm(state: f64) -> f64 {
         if state > 0.0 {
-            state.cbrt() * state.cbrt()
+            let root = state.cbrt();
+            root * root
         } else {
             0.0
         }

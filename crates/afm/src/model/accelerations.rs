@@ -9,10 +9,12 @@ use hybrid::{
 use nalgebra::DMatrix;
 
 use super::{TappingModel, CONTACT, FREE_FLIGHT, GAP_SURFACE, PULL_OFF_SURFACE};
+use crate::contact::standard_linear_solid::StandardLinearSolid;
 use crate::contact::{ContactLaw, HertzShape, HertzTip};
 use crate::model::contact_series::{self, SeriesDrive, SeriesForce};
 use crate::model::modal_constants::{grid_spacing, KEPT_GRIDS};
 use crate::model::phase;
+use crate::model::relaxing_series;
 
 /// The most grid times at which [`ExactFlow::exact_flow_grid`] computes a bimodal drive's second
 /// phase once for every mode (the solver's grids have 8).
@@ -232,6 +234,18 @@ impl TappingModel {
         }
     }
 
+    /// The standard linear solid whose contact mode `mode` is, when the sample is one without a
+    /// double layer or hydration force: its Taylor series are module `relaxing_series`'s.
+    fn relaxing_contact(&self, mode: Mode) -> Option<&StandardLinearSolid> {
+        if self.force.double_layer.is_some() || self.force.hydration.is_some() {
+            return None;
+        }
+        self.force
+            .law
+            .standard_linear_solid()
+            .filter(|_| Self::in_contact(mode))
+    }
+
     /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
     /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
     /// outside it (van der Waals, when `H > 0`), the Hertz sphere with a hydration force (in
@@ -312,7 +326,7 @@ impl TaylorExpansion for TappingModel {
     /// recurrences of automatic differentiation (module `contact_series`), whose intermediate
     /// series live on the stack.
     fn taylor_order_limit(&self, mode: Mode) -> usize {
-        if self.series_force(mode).is_some() {
+        if self.series_force(mode).is_some() || self.relaxing_contact(mode).is_some() {
             contact_series::MAX_ORDER
         } else {
             0
@@ -328,6 +342,16 @@ impl TaylorExpansion for TappingModel {
         clock: &ClockPolynomial,
         series: &mut TaylorSeries,
     ) -> bool {
+        if let Some(sls) = self.relaxing_contact(mode) {
+            return relaxing_series::relaxing_state_series(
+                &self.modes,
+                sls,
+                &self.series_drive(),
+                &self.separation,
+                clock,
+                series,
+            );
+        }
         self.series_force(mode).is_some_and(|force| {
             contact_series::contact_state_series(
                 &self.modes,
@@ -351,7 +375,19 @@ impl TaylorExpansion for TappingModel {
         parameter_column: bool,
         scratch: &mut Vec<f64>,
     ) {
-        if let Some(force) = self.series_force(mode) {
+        if let Some(sls) = self.relaxing_contact(mode) {
+            relaxing_series::relaxing_tangent_series(
+                &self.modes,
+                sls,
+                &self.series_drive(),
+                &self.separation,
+                clock,
+                state,
+                tangents,
+                parameter_column,
+                scratch,
+            );
+        } else if let Some(force) = self.series_force(mode) {
             contact_series::contact_tangent_series(
                 &self.modes,
                 force,
@@ -457,6 +493,33 @@ impl SwitchingStructure for TappingModel {
             .law
             .standard_linear_solid()
             .is_none_or(|sls| sls.relaxing_fraction() == 0.0)
+    }
+
+    /// A relaxing standard linear solid's contact surface `h_0 = d + rho^{2/3}`: its series
+    /// along a Taylor step's (module `relaxing_series`).
+    fn switching_has_series(&self, k: usize) -> bool {
+        k == GAP_SURFACE && self.force.law.standard_linear_solid().is_some()
+    }
+
+    /// The series of `h_0 = d + rho^{2/3}` along `state` (module `relaxing_series`); `false`
+    /// for another surface or law, or from a recovered sample (`rho = 0`, where `rho^{2/3}` is
+    /// not analytic).
+    fn switching_series(
+        &self,
+        k: usize,
+        _mode: Mode,
+        clock: &ClockPolynomial,
+        state: &TaylorSeries,
+        coefficients: &mut [f64],
+    ) -> bool {
+        self.switching_has_series(k)
+            && relaxing_series::relaxing_surface_series(
+                &self.series_drive(),
+                &self.separation,
+                clock,
+                state,
+                coefficients,
+            )
     }
 
     /// The time part of `h_k` along the clock: `Z(t(s)) + Y cos(w t(s))` (nm) for `h_0` and a

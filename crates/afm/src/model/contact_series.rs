@@ -194,7 +194,7 @@ fn update_reciprocal_gap(reciprocal: &mut [f64], delta: &[f64], k: usize) {
 /// Coefficient `m` of the product of two series from their coefficients `0..=m`, `a` and `b`
 /// (`b` at least as long as `a`, of length `m + 1`): `sum_{j=0}^{m} a_j b_{m-j}`.
 #[inline]
-fn convolution(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn convolution(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b[..a.len()].iter().rev())
         .map(|(x, y)| x * y)
@@ -222,7 +222,7 @@ fn update_root(root: &mut [f64], y: &[f64], k: usize) {
 /// Coefficient `k` of the indentation `delta = -(Z(t(s)) + sum_i q_i)` from the state's
 /// coefficient row `k` (`[q_1, v_1, ...]`) and `Z(t(s))`'s coefficients `separation`.
 #[inline]
-fn indentation_coefficient(separation: &[f64; 3], row: &[f64], k: usize) -> f64 {
+pub(crate) fn indentation_coefficient(separation: &[f64; 3], row: &[f64], k: usize) -> f64 {
     let gap: f64 = row.chunks_exact(2).map(|qv| qv[0]).sum();
     -(separation.get(k).copied().unwrap_or(0.0) + gap)
 }
@@ -270,7 +270,7 @@ fn update_jkr_root(
 /// (`delta = s^2 g`, `g_j = delta_{j+2}`), `r = s sqrt(g)`: `r_0 = 0` and `r_m = sqrt(g)_{m-1}`
 /// (it needs `delta` to `m + 1`).
 #[inline]
-fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
+pub(crate) fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
     if !onset {
         update_root(root, delta, m);
     } else if m == 0 {

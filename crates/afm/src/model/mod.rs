@@ -26,6 +26,7 @@ pub mod hertz_contact;
 mod hybrid_system;
 pub(crate) mod modal_constants;
 pub mod phase;
+pub(crate) mod relaxing_series;
 pub mod sample;
 mod sample_relaxation;
 pub mod second_drive;

@@ -61,7 +61,12 @@
 //!   in the state only, with a time part whose series the system gives
 //!   ([`crate::SwitchingStructure::switching_is_affine_in_state`], a gap with a base motion in
 //!   it), the same holds over Taylor steps (the state's series weighted by the gradient plus the
-//!   time part's series) but not over Runge-Kutta steps, which are then sampled.
+//!   time part's series) but not over Runge-Kutta steps, which are then sampled. Where an `h_k`
+//!   is not affine in the state but the system gives its series along a Taylor step's
+//!   ([`crate::SwitchingStructure::switching_series`], a standard linear solid's `d +
+//!   rho^{2/3}`), that series is its polynomial over the step, which is kept within the reach
+//!   at which the series' last two terms stay below the state's tolerance; a step from where the
+//!   system gives none is a Runge-Kutta step.
 //!
 //! # Step-size control
 //!
@@ -244,6 +249,9 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// [`crate::SwitchingStructure::switching_time_series`]), so that its polynomial along a
     /// Taylor step's series is known.
     series_switching: bool,
+    /// The surfaces (bit `k`) that are not affine in the state but whose series along a
+    /// Taylor step the system gives ([`crate::SwitchingStructure::switching_series`]).
+    given_series: u32,
     /// The crossing of the mode's half-power surface that the last Taylor step's series
     /// predicts (its first zero up to [`RELEASE_LOOKAHEAD`] reaches past the step).
     predicted_crossing: Option<f64>,
@@ -322,7 +330,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             || (0..surfaces).all(|k| {
                 accelerations.switching_is_affine(k)
                     || accelerations.switching_is_affine_in_state(k)
+                    || accelerations.switching_has_series(k)
             });
+        // The surfaces whose series along a Taylor step the system gives (bit `k`).
+        let given_series = (0..surfaces)
+            .filter(|&k| {
+                !affine_switching
+                    && !accelerations.switching_is_affine(k)
+                    && !accelerations.switching_is_affine_in_state(k)
+                    && accelerations.switching_has_series(k)
+            })
+            .fold(0_u32, |bits, k| bits | 1 << k);
         if series_switching {
             for k in 0..surfaces {
                 let partials = system.switching_gradient(
@@ -360,6 +378,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             proven_clear: false,
             affine_switching,
             series_switching,
+            given_series,
             predicted_crossing: None,
             ridge: None,
             last_series_step: 0.0,

@@ -100,12 +100,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             if self.kind == StepKind::Taylor {
                 // The series' polynomial in the clock offset, in the fraction of the step.
                 let length = self.buffers.taylor.length;
-                let mut power = match self.buffers.taylor.surface {
+                let kept = match self.buffers.taylor.surface {
                     Some((kept, mut power)) if kept == k => {
                         power[0] = start_value;
-                        power
+                        Some(power)
                     }
                     _ => self.series_surface_polynomial(k, start_value),
+                };
+                let Some(mut power) = kept else {
+                    return false;
                 };
                 let mut scale = 1.0;
                 for c in power.iter_mut() {

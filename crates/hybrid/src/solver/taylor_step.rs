@@ -1,7 +1,9 @@
 //! The Taylor-series step (module docs of [`crate::solver`], "Taylor-series steps").
 
+use crate::accelerations::Accelerations;
 use crate::clock::Clock;
 use crate::error::HybridError;
+use crate::mode::Mode;
 use crate::series_step::{
     surface_ahead, tangent_control, Ridge, SurfaceAhead, TaylorStep, TAYLOR_ORDER,
 };
@@ -140,6 +142,25 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             self.settings.relative_tolerance,
             self.settings.absolute_tolerance,
         );
+        // A surface whose series the system gives is summed within the same tolerance, so
+        // that its polynomial is as accurate as the state's over the step.
+        let mut given = self.given_series;
+        while given != 0 {
+            let k = given.trailing_zeros() as usize;
+            given &= given - 1;
+            let order = taylor.state.order().min(TAYLOR_ORDER);
+            let mut power = [0.0; TAYLOR_ORDER + 1];
+            if !accelerations_series(self.accelerations, k, mode, taylor, &mut power[..=order]) {
+                return None;
+            }
+            reach = reach.min(TaylorStep::polynomial_reach(
+                &power[..=order],
+                self.settings.relative_tolerance,
+                self.settings.absolute_tolerance,
+            ));
+            // Kept for the surface's zeros ahead and the step's proofs.
+            taylor.surface = Some((k, power));
+        }
         if self.sensitivity.transition() {
             // The tangents' order was fixed with the workspace (it fits these settings).
             let (_, tolerance) = tangent_control(&self.settings);
@@ -252,7 +273,12 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     pub(super) fn surface_ahead(&mut self, k: usize, upto: f64) -> SurfaceAhead {
         let start = self.buffers.taylor.clock.start;
         let start_value = self.system.switching(k, start, &self.buffers.z[..self.n]);
-        let power = self.series_surface_polynomial(k, start_value);
+        let Some(power) = self.series_surface_polynomial(k, start_value) else {
+            return SurfaceAhead {
+                zero: None,
+                ridge: None,
+            };
+        };
         self.buffers.taylor.surface = Some((k, power));
         surface_ahead(&power, upto, side_sign(self.mode, k))
     }
@@ -261,15 +287,36 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// the last Taylor series: `h_k(t0) + g . (x(s) - x(0)) + b (t(s) - t0)` for an affine
     /// one, with `h_k(t0) = start_value`; for a time part `b_k(t)` that is not affine, its
     /// series from the system ([`crate::SwitchingStructure::switching_time_series`]) in place of
-    /// `b (t(s) - t0)`.
+    /// `b (t(s) - t0)`; for a surface not affine in the state, the system's series of it
+    /// ([`crate::SwitchingStructure::switching_series`]; `None` where it gives none).
     pub(super) fn series_surface_polynomial(
         &self,
         k: usize,
         start_value: f64,
-    ) -> [f64; TAYLOR_ORDER + 1] {
+    ) -> Option<[f64; TAYLOR_ORDER + 1]> {
         let n = self.n;
         let taylor = &self.buffers.taylor;
         let mut power = [0.0; TAYLOR_ORDER + 1];
+        if self.given_series & (1 << k) != 0 {
+            if let Some((kept, mut power)) = taylor.surface {
+                if kept == k {
+                    power[0] = start_value;
+                    return Some(power);
+                }
+            }
+            let order = taylor.state.order().min(TAYLOR_ORDER);
+            if !accelerations_series(
+                self.accelerations,
+                k,
+                self.mode,
+                taylor,
+                &mut power[..=order],
+            ) {
+                return None;
+            }
+            power[0] = start_value;
+            return Some(power);
+        }
         taylor.state.weighted_sum(
             &self.buffers.affine_gradients[k * n..(k + 1) * n],
             &mut power,
@@ -288,8 +335,20 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             }
         }
         power[0] = start_value;
-        power
+        Some(power)
     }
+}
+
+/// The system's series of surface `k` along the step's state series `taylor` in mode `mode`
+/// ([`crate::SwitchingStructure::switching_series`]) into `power`.
+fn accelerations_series(
+    accelerations: Accelerations<'_>,
+    k: usize,
+    mode: Mode,
+    taylor: &TaylorStep,
+    power: &mut [f64],
+) -> bool {
+    accelerations.switching_series(k, mode, &taylor.clock, &taylor.state, power)
 }
 
 /// The time along a step on `clock` from `t0` (reading `sigma0`) as a polynomial in the
