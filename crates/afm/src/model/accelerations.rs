@@ -327,6 +327,7 @@ impl TaylorExpansion for TappingModel {
         mode: Mode,
         clock: &ClockPolynomial,
         series: &mut TaylorSeries,
+        shared: &mut Vec<f64>,
     ) -> bool {
         self.series_force(mode).is_some_and(|force| {
             contact_series::contact_state_series(
@@ -336,6 +337,7 @@ impl TaylorExpansion for TappingModel {
                 &self.separation,
                 clock,
                 series,
+                shared,
             )
         })
     }
@@ -347,6 +349,7 @@ impl TaylorExpansion for TappingModel {
         mode: Mode,
         clock: &ClockPolynomial,
         state: &TaylorSeries,
+        shared: &mut Vec<f64>,
         tangents: &mut TaylorSeries,
         parameter_column: bool,
         scratch: &mut Vec<f64>,
@@ -359,6 +362,7 @@ impl TaylorExpansion for TappingModel {
                 &self.separation,
                 clock,
                 state,
+                shared,
                 tangents,
                 parameter_column,
                 scratch,
