@@ -663,14 +663,25 @@ pub(crate) fn contact_tangent_series(
         parameter_column,
     };
     let v = tangents.coefficients_mut();
-    // The common column counts (N = 1, 2 with and without dZ) as constants, so that the
-    // loops over columns unroll.
+    // The column counts of N = 1 to 3 modes, with and without dZ, as one block of constant
+    // width (its loops unrolled, its values in registers); more columns in blocks of
+    // COLUMN_BLOCK, the rest one by one.
     match columns {
-        2 => recurrence.run(2, v, gaps),
-        3 => recurrence.run(3, v, gaps),
-        4 => recurrence.run(4, v, gaps),
-        5 => recurrence.run(5, v, gaps),
-        _ => recurrence.run(columns, v, gaps),
+        2 => recurrence.run::<2>(2, 0, v, gaps),
+        3 => recurrence.run::<3>(3, 0, v, gaps),
+        4 => recurrence.run::<4>(4, 0, v, gaps),
+        5 => recurrence.run::<5>(5, 0, v, gaps),
+        6 => recurrence.run::<6>(6, 0, v, gaps),
+        7 => recurrence.run::<7>(7, 0, v, gaps),
+        _ => {
+            let blocks = columns / COLUMN_BLOCK * COLUMN_BLOCK;
+            for start in (0..blocks).step_by(COLUMN_BLOCK) {
+                recurrence.run::<COLUMN_BLOCK>(columns, start, v, gaps);
+            }
+            for start in blocks..columns {
+                recurrence.run::<1>(columns, start, v, gaps);
+            }
+        }
     }
 }
 
@@ -689,40 +700,52 @@ struct TangentRecurrence<'a> {
 }
 
 impl TangentRecurrence<'_> {
-    /// Rows `1..=p` of `v` (row-major `2N x columns` matrices) from row 0: with the gap `g =
-    /// sum_j q_j` of each column (plus `dZ/dZ = 1` on the parameter column), `(k + 1) q_{i,k+1}
-    /// = (tau v_i)_k` and `(k + 1) v_{i,k+1} = (w_i^2/k_i) (-(3/2) c) (tau r g)_k - w_i^2 (tau
-    /// q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a convolution. The columns evolve
-    /// independently along the given state series, so the recurrence runs over them in blocks
-    /// of up to [`COLUMN_BLOCK`], each block's sums kept in registers.
+    /// Rows `1..=p` of columns `start..start + C` of `v` (row-major `2N x columns` matrices)
+    /// from row 0: with the gap `g = sum_j q_j` of each column (plus `dZ/dZ = 1` on the
+    /// parameter column), `(k + 1) q_{i,k+1} = (tau v_i)_k` and `(k + 1) v_{i,k+1} = (w_i^2/k_i)
+    /// (-(3/2) c) (tau r g)_k - w_i^2 (tau q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a
+    /// convolution. The columns evolve independently along the given state series, so the
+    /// recurrence runs over a block of them at once, its values in arrays of the constant width
+    /// `C`. `scratch` holds the gap's coefficients (resized here).
     #[inline(always)]
-    fn run(&self, columns: usize, v: &mut [f64], scratch: &mut Vec<f64>) {
+    fn run<const C: usize>(
+        &self,
+        columns: usize,
+        start: usize,
+        v: &mut [f64],
+        scratch: &mut Vec<f64>,
+    ) {
         let modes = self.modes;
         let p = self.root_reversed.len();
         let dim = 2 * modes.len() * columns;
         let (a, b2) = (self.rate, self.curvature);
-        // Rows of the gap's coefficients (one per power, the gap `sum_i q_i` plus, on the
-        // parameter column, `dZ/dZ = 1`) and the coupling `r gap` at the previous power.
-        scratch.resize((p + 2) * columns, 0.0);
-        let (gaps, previous_coupling) = scratch.split_at_mut((p + 1) * columns);
-        previous_coupling.fill(0.0);
-        let gap = &mut gaps[..columns];
-        gap.fill(0.0);
-        for q in v[..dim].chunks_exact(2 * columns) {
-            for (g, q) in gap.iter_mut().zip(&q[..columns]) {
+        // The block's `q` (half 0) or `v` (half 1) values of one mode's rows `qv`.
+        let block = |qv: &[f64], half: usize| -> [f64; C] {
+            qv[half * columns + start..][..C]
+                .try_into()
+                .expect("a block of C columns")
+        };
+        // Rows of the gap's coefficients, one per power: the gap `sum_i q_i` plus, on the
+        // parameter column, `dZ/dZ = 1`.
+        scratch.resize((p + 1) * C, 0.0);
+        let (gaps, _) = scratch.as_chunks_mut::<C>();
+        let mut gap = [0.0; C];
+        for qv in v[..dim].chunks_exact(2 * columns) {
+            for (g, q) in gap.iter_mut().zip(block(qv, 0)) {
                 *g += q;
             }
         }
-        if self.parameter_column {
-            gap[columns - 1] += 1.0;
+        if self.parameter_column && start + C == columns {
+            gap[C - 1] += 1.0;
         }
+        gaps[0] = gap;
+        // The coupling `r gap` at the previous power.
+        let mut previous_coupling = [0.0; C];
         let mut power = 0.0;
         for k in 0..p {
             let (done, after) = v.split_at_mut((k + 1) * dim);
             let (earlier, row) = done.split_at(k * dim);
             let next = &mut after[..dim];
-            let (gaps, next_gap) = gaps.split_at_mut((k + 1) * columns);
-            let next_gap = &mut next_gap[..columns];
             // y' = tau z: y_{k+1} = (a z_k + b2 z_{k-1}) / (k + 1), z_{-1} = 0 (the
             // coefficient below k is row k itself at k = 0, times zero).
             power += 1.0;
@@ -732,62 +755,47 @@ impl TangentRecurrence<'_> {
             } else {
                 (0.0, row)
             };
-            for start in (0..columns).step_by(COLUMN_BLOCK) {
-                let width = COLUMN_BLOCK.min(columns - start);
-                let block = start..start + width;
-                // The coupling's coefficient k, sum_{j=0}^{k} r_{k-j} gap_j, and tau times it.
-                let mut coupling = [0.0; COLUMN_BLOCK];
-                for (gap, r) in gaps
-                    .chunks_exact(columns)
-                    .zip(&self.root_reversed[p - 1 - k..])
-                {
-                    for (c, g) in coupling[..width].iter_mut().zip(&gap[block.clone()]) {
-                        *c += r * g;
-                    }
+            // The coupling's coefficient k, sum_{j=0}^{k} r_{k-j} gap_j, and tau times it.
+            let mut coupling = [0.0; C];
+            for (gap, r) in gaps[..=k].iter().zip(&self.root_reversed[p - 1 - k..]) {
+                for (c, g) in coupling.iter_mut().zip(gap) {
+                    *c += r * g;
                 }
-                let mut tau_coupling = [0.0; COLUMN_BLOCK];
-                for ((t, c), previous) in tau_coupling[..width]
-                    .iter_mut()
-                    .zip(&coupling[..width])
-                    .zip(&mut previous_coupling[block.clone()])
-                {
-                    *t = rate * c + curvature * *previous;
-                    *previous = *c;
-                }
-                // Every mode's new coefficients formed in registers, then stored, and the
-                // gap's next coefficient summed on the way.
-                let mut gap = [0.0; COLUMN_BLOCK];
-                for ((m, out), (qv, previous_qv)) in
-                    modes.iter().zip(next.chunks_exact_mut(2 * columns)).zip(
-                        row.chunks_exact(2 * columns)
-                            .zip(previous.chunks_exact(2 * columns)),
-                    )
-                {
-                    let coupling_gain = m.omega_squared_over_stiffness * self.slope;
-                    let (q, velocity) = qv.split_at(columns);
-                    let (previous_q, previous_velocity) = previous_qv.split_at(columns);
-                    let mut new_q = [0.0; COLUMN_BLOCK];
-                    let mut new_v = [0.0; COLUMN_BLOCK];
-                    for c in 0..width {
-                        let column = start + c;
-                        let tau_q = rate * q[column] + curvature * previous_q[column];
-                        let tau_v = rate * velocity[column] + curvature * previous_velocity[column];
-                        new_q[c] = tau_v;
-                        new_v[c] = coupling_gain * tau_coupling[c]
-                            - m.omega_squared * tau_q
-                            - m.damping * tau_v;
-                        gap[c] += tau_v;
-                    }
-                    let (next_q, next_v) = out.split_at_mut(columns);
-                    next_q[block.clone()].copy_from_slice(&new_q[..width]);
-                    next_v[block.clone()].copy_from_slice(&new_v[..width]);
-                }
-                next_gap[block].copy_from_slice(&gap[..width]);
             }
+            let mut tau_coupling = [0.0; C];
+            for c in 0..C {
+                tau_coupling[c] = rate * coupling[c] + curvature * previous_coupling[c];
+            }
+            previous_coupling = coupling;
+            // Every mode's new coefficients, and the gap's next coefficient summed on the way.
+            let mut gap = [0.0; C];
+            for ((m, out), (qv, previous_qv)) in modes
+                .iter()
+                .zip(next.chunks_exact_mut(2 * columns))
+                .zip(row.chunks_exact(2 * columns).zip(previous.chunks_exact(2 * columns)))
+            {
+                let coupling_gain = m.omega_squared_over_stiffness * self.slope;
+                let (q, velocity) = (block(qv, 0), block(qv, 1));
+                let (previous_q, previous_velocity) = (block(previous_qv, 0), block(previous_qv, 1));
+                let mut new_q = [0.0; C];
+                let mut new_v = [0.0; C];
+                for c in 0..C {
+                    let tau_q = rate * q[c] + curvature * previous_q[c];
+                    let tau_v = rate * velocity[c] + curvature * previous_velocity[c];
+                    new_q[c] = tau_v;
+                    new_v[c] = coupling_gain * tau_coupling[c]
+                        - m.omega_squared * tau_q
+                        - m.damping * tau_v;
+                    gap[c] += tau_v;
+                }
+                out[start..start + C].copy_from_slice(&new_q);
+                out[columns + start..][..C].copy_from_slice(&new_v);
+            }
+            gaps[k + 1] = gap;
         }
     }
 }
 
-/// The widest block of tangent columns [`TangentRecurrence::run`] handles at once (`2N + 1`
-/// columns for `N` up to 3 in one).
+/// The width of the blocks of tangent columns [`TangentRecurrence::run`] handles at once
+/// beyond 7 columns (`2N + 1` for `N` up to 3 take one block of their own width).
 const COLUMN_BLOCK: usize = 8;
