@@ -612,6 +612,16 @@ pub(crate) fn contact_tangent_series(
     let SharedSeries {
         delta, root, cos, ..
     } = SharedSeries::in_storage(shared);
+    debug_assert_eq!(
+        delta[0].to_bits(),
+        (indentation_coefficient(
+            &shifted_separation(separation, clock, force),
+            state.row(0),
+            0
+        ) - drive.base_amplitude * cos[0])
+            .to_bits(),
+        "the shared series come from another state series"
+    );
     // The series of F_ts'(d) / slope to order p - 1 (all the recurrence below uses; on an
     // onset it needs the indentation to order p), from the state recurrence's indentation and
     // auxiliary series (`SharedSeries`), extended where the state's stopped short: the
