@@ -119,16 +119,23 @@ fn series_steps_reproduce_the_runge_kutta_flow_events_and_transition() {
     }
 }
 
-/// One and three modes (the recurrences' other unrolled mode counts and the general tangent
-/// path: 3 and 7 tangent columns with `dx/dZ`), 1.5 nm into mica: two periods with the
-/// transition matrix and `dx/dZ`, series against DOP853 alone. Measured: 22 and 57 series
-/// steps; the state within 7e-14 and 2.3e-13, the transition matrix within 2.1e-9 and 2.3e-8,
-/// `dx/dZ` within 1.9e-9 and 1.4e-8.
+/// One, three and four modes (the recurrences' other unrolled mode counts and the tangent
+/// recurrence's column blocks: 3, 7 and 9 tangent columns with `dx/dZ`, the last a block of 8
+/// and a single column), 1.5 nm into mica: two periods with the transition matrix and
+/// `dx/dZ`, series against DOP853 alone. Measured: 22 and 57 series steps for one and three
+/// modes; the state within 7.3e-14, 2.2e-13 and 6.0e-13, the transition matrix within 2.1e-9,
+/// 2.3e-8 and 1.7e-8, `dx/dZ` within 1.9e-9, 1.4e-8 and 6.1e-8 (the four-mode bar on the
+/// sensitivities 1e-7, the others 5e-8).
 #[test]
-fn series_steps_match_runge_kutta_for_one_and_three_modes() {
+fn series_steps_match_runge_kutta_for_one_three_and_four_modes() {
     let third = (12.0, 210.0, 3.0, 5.9, 0.35);
+    let fourth = (46.0, 410.0, 4.0, 8.4, -0.2);
     let biolever = [(0.036, 9.3, 1.2, 1.0, 1.0), (1.4, 72.0, 2.0, 3.47, -0.554)];
-    for modes in [&biolever[..1], &[biolever[0], biolever[1], third][..]] {
+    for (modes, sensitivity_bar) in [
+        (&biolever[..1], 5e-8),
+        (&[biolever[0], biolever[1], third][..], 5e-8),
+        (&[biolever[0], biolever[1], third, fourth][..], 1e-7),
+    ] {
         let mut model = TappingModel::new(
             common::cantilever(modes),
             common::mica(),
@@ -174,9 +181,18 @@ fn series_steps_match_runge_kutta_for_one_and_three_modes() {
             &series.parameter_sensitivity,
             &reference.parameter_sensitivity,
         );
+        eprintln!(
+            "{n} modes: state {state:.3e} transition {transition:.3e} parameter {parameter:.3e}"
+        );
         assert!(state < 2e-11, "{n} modes: state {state:.2e}");
-        assert!(transition < 5e-8, "{n} modes: transition {transition:.2e}");
-        assert!(parameter < 5e-8, "{n} modes: dx/dZ {parameter:.2e}");
+        assert!(
+            transition < sensitivity_bar,
+            "{n} modes: transition {transition:.2e}"
+        );
+        assert!(
+            parameter < sensitivity_bar,
+            "{n} modes: dx/dZ {parameter:.2e}"
+        );
     }
 }
 

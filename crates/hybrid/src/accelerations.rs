@@ -218,8 +218,17 @@ pub trait TaylorExpansion {
     /// which a step starts from only at the crossing of the mode's
     /// [`SwitchingStructure::half_power_surface`] that entered the mode: the state is on that
     /// surface.
-    fn taylor_series(&self, mode: Mode, clock: &ClockPolynomial, series: &mut TaylorSeries)
-        -> bool;
+    ///
+    /// `shared` is space the implementation may resize and keep intermediate series in (its
+    /// own layout) for [`TaylorExpansion::taylor_tangents`] along the same series: the solver
+    /// passes the same vector to both, the tangents' call (if any) right after this one.
+    fn taylor_series(
+        &self,
+        mode: Mode,
+        clock: &ClockPolynomial,
+        series: &mut TaylorSeries,
+        shared: &mut Vec<f64>,
+    ) -> bool;
 
     /// The Taylor coefficients, to `tangents.order()` (at most `state.order()`; the solver asks for
     /// fewer under [`crate::SensitivityMethod::Decoupled`]), of a tangent matrix `V` (`n` rows,
@@ -230,14 +239,19 @@ pub trait TaylorExpansion {
     /// recurrences then run along rows of contiguous columns); the constant terms hold `V` at `s =
     /// 0`, and every other coefficient is written. `scratch` is free space the implementation may
     /// resize; the solver's has capacity for `(tangents.order() + 2) * columns` values, so that an
-    /// implementation needing no more allocates nothing in a step.
+    /// implementation needing no more allocates nothing in a step. `shared` is what
+    /// [`TaylorExpansion::taylor_series`] left there when it computed `state` (the
+    /// implementation may read and extend it).
     ///
-    /// To be called only where [`TaylorExpansion::taylor_series`] returned `true` for `state`.
+    /// To be called only where [`TaylorExpansion::taylor_series`] returned `true` for `state`,
+    /// with the `shared` it was given and nothing computed in between.
+    #[allow(clippy::too_many_arguments)]
     fn taylor_tangents(
         &self,
         mode: Mode,
         clock: &ClockPolynomial,
         state: &TaylorSeries,
+        shared: &mut Vec<f64>,
         tangents: &mut TaylorSeries,
         parameter_column: bool,
         scratch: &mut Vec<f64>,

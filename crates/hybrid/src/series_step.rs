@@ -65,6 +65,9 @@ pub(crate) struct TaylorStep {
     /// `(k, coefficients)`, where the solver formed it for this series (its constant term is
     /// the caller's; cleared by [`TaylorStep::expand`]).
     pub surface: Option<(usize, [f64; TAYLOR_ORDER + 1])>,
+    /// What the system's state recurrence leaves for its tangent recurrence along the same
+    /// series (the `shared` of [`crate::TaylorExpansion::taylor_series`]).
+    shared: Vec<f64>,
     /// Scratch for [`crate::TaylorExpansion::taylor_tangents`] and the tangents' row-major
     /// start and value.
     scratch: Vec<f64>,
@@ -88,6 +91,7 @@ impl TaylorStep {
             },
             length: 0.0,
             surface: None,
+            shared: Vec::new(),
             scratch: Vec::with_capacity((order + TANGENT_SCRATCH_ROWS) * columns),
             rows: vec![0.0; n * columns],
         }
@@ -104,11 +108,12 @@ impl TaylorStep {
         self.clock = clock;
         self.surface = None;
         self.state.start_at(x0);
-        expansion.taylor_series(mode, &clock, &mut self.state)
+        expansion.taylor_series(mode, &clock, &mut self.state, &mut self.shared)
     }
 
     /// Expand the tangents from `start` (column-major `n x columns`, the solver's layout)
-    /// along the state's series.
+    /// along the state's series: to be called only right after [`TaylorStep::expand`]
+    /// succeeded (the system reuses what its state recurrence left).
     pub fn expand_tangents(
         &mut self,
         expansion: &dyn TaylorExpansion,
@@ -123,6 +128,7 @@ impl TaylorStep {
             mode,
             &self.clock,
             &self.state,
+            &mut self.shared,
             &mut self.tangents,
             parameter_column,
             &mut self.scratch,
@@ -257,6 +263,25 @@ pub(crate) fn surface_ahead<const D: usize>(
     upto: f64,
     side: f64,
 ) -> SurfaceAhead {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the CPU has AVX, checked just above.
+        return unsafe { surface_ahead_avx(power, upto, side) };
+    }
+    surface_ahead_any(power, upto, side)
+}
+
+/// [`surface_ahead_any`] compiled for AVX (wider lanes for the samples, the same operations in
+/// the same order: the same bits).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn surface_ahead_avx<const D: usize>(power: &[f64; D], upto: f64, side: f64) -> SurfaceAhead {
+    surface_ahead_any(power, upto, side)
+}
+
+/// [`surface_ahead`] for any CPU.
+#[inline(always)]
+fn surface_ahead_any<const D: usize>(power: &[f64; D], upto: f64, side: f64) -> SurfaceAhead {
     const SAMPLES: usize = 8;
     let none = SurfaceAhead {
         zero: None,
@@ -347,6 +372,7 @@ pub(crate) fn surface_ahead<const D: usize>(
 
 /// The zero of `value` in `(lower, upper]`, where it changes sign (`positive_start`: the sign
 /// at `lower`), by bisection safeguarding Newton's method to the last bits.
+#[inline(always)]
 fn bisect_newton(
     value: impl Fn(f64) -> f64,
     slope: impl Fn(f64) -> f64,

@@ -98,8 +98,29 @@ impl TaylorSeries {
         self.coefficients[..self.dim].copy_from_slice(values);
     }
 
-    /// `y(s)` into `out` (its leading `out.len() <= dim` components), by Horner's rule.
+    /// `y(s)` into `out` (its leading `out.len() <= dim` components), by Horner's rule,
+    /// compiled for the CPU's AVX where it has it (wider lanes, the same operations in the same
+    /// order: the same bits).
     pub fn evaluate(&self, s: f64, out: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX, checked just above.
+            unsafe { self.evaluate_avx(s, out) };
+            return;
+        }
+        self.evaluate_dims(s, out);
+    }
+
+    /// [`TaylorSeries::evaluate_dims`] compiled with AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn evaluate_avx(&self, s: f64, out: &mut [f64]) {
+        self.evaluate_dims(s, out);
+    }
+
+    /// [`TaylorSeries::evaluate`] for any CPU.
+    #[inline(always)]
+    fn evaluate_dims(&self, s: f64, out: &mut [f64]) {
         // The common small dimensions as constants, so that the row loop unrolls into
         // registers (the state of one or two modes, their tangents with and without dx/dp).
         match self.dim {
@@ -122,8 +143,28 @@ impl TaylorSeries {
     /// `y(r_j - origin)` for every reading `r_j` of `readings` (a clock whose reading is
     /// `origin` where the series starts), into `out` (`dim` per reading, in order), by Horner's
     /// rule across the readings at once: each value is the one [`TaylorSeries::evaluate`] gives
-    /// at `r_j - origin`, for less work than one call per reading.
+    /// at `r_j - origin`, for less work than one call per reading (compiled for the CPU's AVX
+    /// where it has it, as [`TaylorSeries::evaluate`]).
     pub fn evaluate_many(&self, origin: f64, readings: &[f64], out: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX, checked just above.
+            unsafe { self.evaluate_many_avx(origin, readings, out) };
+            return;
+        }
+        self.evaluate_many_blocks(origin, readings, out);
+    }
+
+    /// [`TaylorSeries::evaluate_many_blocks`] compiled with AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn evaluate_many_avx(&self, origin: f64, readings: &[f64], out: &mut [f64]) {
+        self.evaluate_many_blocks(origin, readings, out);
+    }
+
+    /// [`TaylorSeries::evaluate_many`] for any CPU.
+    #[inline(always)]
+    fn evaluate_many_blocks(&self, origin: f64, readings: &[f64], out: &mut [f64]) {
         const BLOCK: usize = 8;
         let dim = self.dim;
         for (readings, values) in readings.chunks(BLOCK).zip(out.chunks_mut(BLOCK * dim)) {
@@ -141,7 +182,7 @@ impl TaylorSeries {
                 (4, _) => self.evaluate_block::<4, BLOCK>(&offsets, values),
                 _ => {
                     for (&s, value) in offsets.iter().zip(values.chunks_exact_mut(dim)) {
-                        self.evaluate(s, value);
+                        self.evaluate_dims(s, value);
                     }
                 }
             }

@@ -341,6 +341,7 @@ impl TaylorExpansion for TappingModel {
         mode: Mode,
         clock: &ClockPolynomial,
         series: &mut TaylorSeries,
+        shared: &mut Vec<f64>,
     ) -> bool {
         if let Some(sls) = self.relaxing_contact(mode) {
             return relaxing_series::relaxing_state_series(
@@ -360,6 +361,7 @@ impl TaylorExpansion for TappingModel {
                 &self.separation,
                 clock,
                 series,
+                shared,
             )
         })
     }
@@ -371,6 +373,7 @@ impl TaylorExpansion for TappingModel {
         mode: Mode,
         clock: &ClockPolynomial,
         state: &TaylorSeries,
+        shared: &mut Vec<f64>,
         tangents: &mut TaylorSeries,
         parameter_column: bool,
         scratch: &mut Vec<f64>,
@@ -395,6 +398,7 @@ impl TaylorExpansion for TappingModel {
                 &self.separation,
                 clock,
                 state,
+                shared,
                 tangents,
                 parameter_column,
                 scratch,

@@ -40,6 +40,60 @@ use crate::model::separation::Separation;
 /// intermediate series on the stack).
 pub const MAX_ORDER: usize = 40;
 
+/// The coefficients `0..=MAX_ORDER` of one series.
+const LEN: usize = MAX_ORDER + 1;
+
+/// The series [`contact_state_series`] computes on its way and [`contact_tangent_series`]
+/// reuses along the same state series (module docs), held in the solver's `shared` vector (of
+/// [`hybrid::TaylorExpansion::taylor_series`]): the indentation `delta` and the force's
+/// auxiliary series `root`, the same numbers the tangents' recurrence would compute again from
+/// the same state series, and the state's other intermediate series, kept there rather than
+/// on the stack so that no step zeroes them.
+///
+/// After a state series of order `p` (clock rate `a`): `delta_0..delta_{p-1}`; `root` (Hertz:
+/// the indentation's square root, `r_0..r_{p-1}`, at an onset `r_0 = 0` and
+/// `r_1..r_{max(p, 3) - 3}`; van der Waals: `1/d`; JKR: `b`, `b^2`, `b^3` one after the other;
+/// hydration: `w`'s real then imaginary parts; each to `p - 1`); the drive phase's `cos` and
+/// `sin` to `p`.
+struct SharedSeries<'a> {
+    /// The indentation below the contact surface, nm.
+    delta: &'a mut [f64; LEN],
+    /// The force's auxiliary series (three series' room, for JKR).
+    root: &'a mut [f64; 3 * LEN],
+    /// `cos(w t(s))` and `sin(w t(s))` of the drive.
+    cos: &'a mut [f64; LEN],
+    sin: &'a mut [f64; LEN],
+    /// The tip-sample force, nN.
+    force: &'a mut [f64; LEN],
+    /// A bimodal drive's `cos(w_b t(s))` and `sin(w_b t(s))`.
+    second_cos: &'a mut [f64; LEN],
+    second_sin: &'a mut [f64; LEN],
+}
+
+impl<'a> SharedSeries<'a> {
+    /// The series laid out in `storage` (grown to their length the first time; what a state
+    /// series wrote there is kept).
+    fn in_storage(storage: &'a mut Vec<f64>) -> Self {
+        storage.resize(9 * LEN, 0.0);
+        let (delta, rest) = storage.split_at_mut(LEN);
+        let (root, rest) = rest.split_at_mut(3 * LEN);
+        let (cos, rest) = rest.split_at_mut(LEN);
+        let (sin, rest) = rest.split_at_mut(LEN);
+        let (force, rest) = rest.split_at_mut(LEN);
+        let (second_cos, second_sin) = rest.split_at_mut(LEN);
+        let fixed = "the storage was resized to the layout";
+        Self {
+            delta: delta.try_into().expect(fixed),
+            root: root.try_into().expect(fixed),
+            cos: cos.try_into().expect(fixed),
+            sin: sin.try_into().expect(fixed),
+            force: force.try_into().expect(fixed),
+            second_cos: (&mut second_cos[..LEN]).try_into().expect(fixed),
+            second_sin: (&mut second_sin[..LEN]).try_into().expect(fixed),
+        }
+    }
+}
+
 /// The tip-sample force a series expands Eq. 1 with (MODEL.md sections 1 and 9).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum SeriesForce {
@@ -290,7 +344,8 @@ pub(crate) fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset:
 /// `s`), or a coefficient is not finite. A clock whose rate is zero at the start (`tau(0) = 0`)
 /// is the square-root clock centred on the crossing that entered contact (the only place a step
 /// starts from one): the state there is taken to be on the surface (`delta_0 = 0`, whatever its
-/// rounding).
+/// rounding). `shared` keeps the intermediate series ([`SharedSeries`]) for
+/// [`contact_tangent_series`] along this series.
 pub(crate) fn contact_state_series(
     modes: &[ModalConstants],
     force: SeriesForce,
@@ -298,6 +353,7 @@ pub(crate) fn contact_state_series(
     separation: &Separation,
     clock: &ClockPolynomial,
     series: &mut TaylorSeries,
+    shared: &mut Vec<f64>,
 ) -> bool {
     if series.order() > MAX_ORDER || series.dim() != 2 * modes.len() {
         return false;
@@ -309,8 +365,46 @@ pub(crate) fn contact_state_series(
         return false;
     }
     let separation = shifted_separation(separation, clock, force);
-    // The common mode counts as constants, so that the loops over modes unroll.
-    let mut run = |modes| state_recurrence(modes, force, drive, &separation, clock, series);
+    let mut shared = SharedSeries::in_storage(shared);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the CPU has AVX, checked just above.
+        return unsafe {
+            state_series_avx(modes, force, drive, &separation, clock, series, &mut shared)
+        };
+    }
+    state_series_by_modes(modes, force, drive, &separation, clock, series, &mut shared)
+}
+
+/// [`state_series_by_modes`] compiled for AVX (its three-operand instructions and wider lanes;
+/// the same operations in the same order: the same bits).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn state_series_avx(
+    modes: &[ModalConstants],
+    force: SeriesForce,
+    drive: &SeriesDrive,
+    separation: &[f64; 3],
+    clock: &ClockPolynomial,
+    series: &mut TaylorSeries,
+    shared: &mut SharedSeries,
+) -> bool {
+    state_series_by_modes(modes, force, drive, separation, clock, series, shared)
+}
+
+/// [`state_recurrence`] with the common mode counts as constants, so that the loops over
+/// modes unroll.
+#[inline(always)]
+fn state_series_by_modes(
+    modes: &[ModalConstants],
+    force: SeriesForce,
+    drive: &SeriesDrive,
+    separation: &[f64; 3],
+    clock: &ClockPolynomial,
+    series: &mut TaylorSeries,
+    shared: &mut SharedSeries,
+) -> bool {
+    let mut run = |modes| state_recurrence(modes, force, drive, separation, clock, series, shared);
     match modes.len() {
         1 => run(&modes[..1]),
         2 => run(&modes[..2]),
@@ -344,6 +438,9 @@ fn force_coefficient(
                     indentation_root(root, delta, k - 2, true);
                     coefficient * convolution(&delta[2..k], &root[1..k - 1])
                 } else {
+                    if k == 0 {
+                        indentation_root(root, delta, 0, true);
+                    }
                     0.0
                 }
             } else {
@@ -408,26 +505,29 @@ fn state_recurrence(
     separation: &[f64; 3],
     clock: &ClockPolynomial,
     series: &mut TaylorSeries,
+    shared: &mut SharedSeries,
 ) -> bool {
     let p = series.order();
     let n = 2 * modes.len();
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
     let onset = a == 0.0;
-    let mut cos = [0.0; MAX_ORDER + 1];
-    let mut sin = [0.0; MAX_ORDER + 1];
-    let mut delta = [0.0; MAX_ORDER + 1];
-    // The auxiliary series; twice as long for the hydration force's complex exponential,
+    // The auxiliary series is twice as long for the hydration force's complex exponential,
     // three times for JKR's b, b^2, b^3.
-    let mut root = [0.0; 3 * (MAX_ORDER + 1)];
-    let mut force = [0.0; MAX_ORDER + 1];
+    let SharedSeries {
+        delta,
+        root,
+        cos,
+        sin,
+        force,
+        second_cos,
+        second_sin,
+    } = shared;
     let drive_frequency = drive.frequency;
     (sin[0], cos[0]) = phase::sin_cos(drive_frequency * clock.start);
     // A bimodal drive's second phase series (MODEL.md section 14).
     let (second_frequency, second_factor) = drive.second.unwrap_or((0.0, 0.0));
-    let mut second_cos = [0.0; MAX_ORDER + 1];
-    let mut second_sin = [0.0; MAX_ORDER + 1];
     if drive.second.is_some() {
-        phase_series(second_frequency, clock, p, &mut second_cos, &mut second_sin);
+        phase_series(second_frequency, clock, p, second_cos, second_sin);
     }
     let x = series.coefficients_mut();
     // The sum of every coefficient and force, finite only if each of them is (or rejecting
@@ -439,7 +539,7 @@ fn state_recurrence(
         let next = &mut rest[..n];
         // An acoustic drive's base motion `Y cos(w t)` is in the gap (MODEL.md section 14).
         delta[k] = indentation_coefficient(separation, row, k) - drive.base_amplitude * cos[k];
-        match force_coefficient(law, &mut root, &delta, k, onset) {
+        match force_coefficient(law, &mut root[..], &delta[..], k, onset) {
             Some(value) => force[k] = value,
             None => return false,
         }
@@ -484,12 +584,13 @@ fn state_recurrence(
 
 /// The Taylor coefficients of the tangent matrix `V` (`2N` rows: the transition matrix's
 /// columns, then, with `parameter_column`, `dx/dZ`) along the contact flow whose state series is
-/// `state` (from [`contact_state_series`] with the same arguments; the drives enter only
-/// through an acoustic drive's base motion in the gap): `dV/ds = tau J(t(s), x(s))
-/// V` (`+ tau df/dZ` on the parameter column), `J`'s contact part being `(w_i^2/k_i) F_ts'(d)`
-/// on every `q_j` with `F_ts' = -(3/2) c r` (Hertz) or `2 A / d^3` (van der Waals). Each coefficient of `tangents` is `V`'s row-major
-/// matrix (component `row * columns + column`); the constant terms hold `V` at the step start.
-/// `gaps` is scratch space (resized here).
+/// `state` (from [`contact_state_series`] with the same arguments, which left its intermediate
+/// series in `shared`; the drives enter only through an acoustic drive's base motion in the
+/// gap): `dV/ds = tau J(t(s), x(s)) V` (`+ tau df/dZ` on the parameter column), `J`'s contact
+/// part being `(w_i^2/k_i) F_ts'(d)` on every `q_j` with `F_ts' = -(3/2) c r` (Hertz) or `2 A /
+/// d^3` (van der Waals). Each coefficient of `tangents` is `V`'s row-major matrix (component
+/// `row * columns + column`); the constant terms hold `V` at the step start. `gaps` is scratch
+/// space (resized here).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn contact_tangent_series(
     modes: &[ModalConstants],
@@ -498,59 +599,69 @@ pub(crate) fn contact_tangent_series(
     separation: &Separation,
     clock: &ClockPolynomial,
     state: &TaylorSeries,
+    shared: &mut Vec<f64>,
     tangents: &mut TaylorSeries,
     parameter_column: bool,
     gaps: &mut Vec<f64>,
 ) {
-    let p = tangents.order().min(state.order());
+    let state_order = state.order();
+    let p = tangents.order().min(state_order);
     let n = state.dim();
     let (a, b2) = (clock.rate, 2.0 * clock.curvature);
-    let separation = shifted_separation(separation, clock, force);
+    let onset = a == 0.0;
+    let SharedSeries {
+        delta, root, cos, ..
+    } = SharedSeries::in_storage(shared);
+    debug_assert_eq!(
+        delta[0].to_bits(),
+        (indentation_coefficient(
+            &shifted_separation(separation, clock, force),
+            state.row(0),
+            0
+        ) - drive.base_amplitude * cos[0])
+            .to_bits(),
+        "the shared series come from another state series"
+    );
     // The series of F_ts'(d) / slope to order p - 1 (all the recurrence below uses; on an
-    // onset it needs the indentation to order p): the indentation's square root for Hertz
-    // (`F' = -(3/2) c r`), `u^3 = 1/d^3` for van der Waals (`F' = 2 A u^3`).
-    let mut delta = [0.0; MAX_ORDER + 1];
-    let mut root = [0.0; MAX_ORDER + 1];
-    // An acoustic drive's base motion `Y cos(w t)` in the gap (MODEL.md section 14).
-    let mut base = [0.0; MAX_ORDER + 1];
-    if drive.base_amplitude != 0.0 {
-        let mut sin = [0.0; MAX_ORDER + 1];
-        phase_series(drive.frequency, clock, p, &mut base, &mut sin);
-    }
-    for (k, (d, row)) in delta[..=p]
-        .iter_mut()
-        .zip(state.coefficients().chunks_exact(n))
-        .enumerate()
-    {
-        *d = indentation_coefficient(&separation, row, k) - drive.base_amplitude * base[k];
-    }
-    let slope = match force {
+    // onset it needs the indentation to order p), from the state recurrence's indentation and
+    // auxiliary series (`SharedSeries`), extended where the state's stopped short: the
+    // indentation's square root for Hertz (`F' = -(3/2) c r`), `u^3 = 1/d^3` for van der Waals
+    // (`F' = 2 A u^3`).
+    let mut derivative = [0.0; MAX_ORDER];
+    let (slope, series): (f64, &[f64]) = match force {
         SeriesForce::Hertz { coefficient, .. } => {
-            for m in 0..p {
-                indentation_root(&mut root, &delta, m, a == 0.0);
+            if onset && p + 2 > state_order {
+                // The state's recurrence stopped at `r_{max(p, 3) - 3}` and `delta_{p - 1}`
+                // (its order `p`); the root to `p - 1` needs the indentation to `p`.
+                let separation = shifted_separation(separation, clock, force);
+                for k in state_order..=p {
+                    delta[k] = indentation_coefficient(&separation, state.row(k), k)
+                        - drive.base_amplitude * cos[k];
+                }
+                for m in state_order.max(3) - 2..p {
+                    indentation_root(&mut root[..], &delta[..], m, true);
+                }
             }
-            -1.5 * coefficient
+            (-1.5 * coefficient, &root[..p])
         }
         SeriesForce::VanDerWaals { scale } => {
-            let mut reciprocal = [0.0; MAX_ORDER + 1];
-            let mut square = [0.0; MAX_ORDER + 1];
+            let reciprocal = &root[..p];
+            let mut square = [0.0; MAX_ORDER];
             for m in 0..p {
-                update_reciprocal_gap(&mut reciprocal, &delta, m);
                 square[m] = convolution(&reciprocal[..=m], &reciprocal[..=m]);
-                root[m] = convolution(&square[..=m], &reciprocal[..=m]);
+                derivative[m] = convolution(&square[..=m], &reciprocal[..=m]);
             }
-            2.0 * scale
+            (2.0 * scale, &derivative[..p])
         }
         SeriesForce::Jkr { law } => {
             // F' = -dF/ddelta = -2 E* p N / D, N = 4 c/R - 3 k, D = 4 c/R - k (module docs:
-            // dF/db = 2 E* b^2 (4 b^3/R - 3 k), d delta/db = 4 b^3/R - k); `root` gets p N / D.
-            let mut b = [0.0; MAX_ORDER + 1];
-            let mut square = [0.0; MAX_ORDER + 1];
-            let mut cube = [0.0; MAX_ORDER + 1];
-            let mut ratio = [0.0; MAX_ORDER + 1];
+            // dF/db = 2 E* b^2 (4 b^3/R - 3 k), d delta/db = 4 b^3/R - k); `derivative` gets
+            // p N / D, from the state recurrence's `p = b^2` and `c = b^3`.
+            let square = &root[LEN..LEN + p];
+            let cube = &root[2 * LEN..2 * LEN + p];
+            let mut ratio = [0.0; MAX_ORDER];
             let (r, k) = (law.tip_radius_nm, law.adhesion_root());
             for m in 0..p {
-                update_jkr_root(&law, &mut b, &mut square, &mut cube, &delta, m);
                 // D_m = N_m = 4 c_m / R for m >= 1.
                 ratio[m] = if m == 0 {
                     (4.0 * cube[0] / r - 3.0 * k) / (4.0 * cube[0] / r - k)
@@ -558,9 +669,9 @@ pub(crate) fn contact_tangent_series(
                     let below: f64 = (1..=m).map(|j| 4.0 * cube[j] / r * ratio[m - j]).sum();
                     (4.0 * cube[m] / r - below) / (4.0 * cube[0] / r - k)
                 };
-                root[m] = convolution(&square[..=m], &ratio[..=m]);
+                derivative[m] = convolution(&square[..=m], &ratio[..=m]);
             }
-            -2.0 * law.effective_modulus_gpa
+            (-2.0 * law.effective_modulus_gpa, &derivative[..p])
         }
         SeriesForce::Hydration {
             amplitude,
@@ -568,16 +679,15 @@ pub(crate) fn contact_tangent_series(
             decay_length,
         } => {
             // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w.
-            let mut im = [0.0; MAX_ORDER + 1];
-            for m in 0..p {
-                update_layer_exponential(&mut root, &mut im, &delta, m, wavenumber, decay_length);
-            }
-            -amplitude * (1.0 / decay_length + wavenumber * wavenumber * decay_length)
+            (
+                -amplitude * (1.0 / decay_length + wavenumber * wavenumber * decay_length),
+                &root[..p],
+            )
         }
     };
     // Highest power first, so that the convolutions below run forward through both series.
     let mut root_reversed = [0.0; MAX_ORDER];
-    for (reversed, r) in root_reversed.iter_mut().zip(root[..p].iter().rev()) {
+    for (reversed, r) in root_reversed.iter_mut().zip(series.iter().rev()) {
         *reversed = *r;
     }
     let columns = tangents.dim() / n;
@@ -589,16 +699,7 @@ pub(crate) fn contact_tangent_series(
         curvature: b2,
         parameter_column,
     };
-    let v = tangents.coefficients_mut();
-    // The common column counts (N = 1, 2 with and without dZ) as constants, so that the
-    // loops over columns unroll.
-    match columns {
-        2 => recurrence.run(2, v, gaps),
-        3 => recurrence.run(3, v, gaps),
-        4 => recurrence.run(4, v, gaps),
-        5 => recurrence.run(5, v, gaps),
-        _ => recurrence.run(columns, v, gaps),
-    }
+    recurrence.run_all(columns, tangents.coefficients_mut(), gaps);
 }
 
 /// The coefficients of the tangent recurrence of [`contact_tangent_series`].
@@ -616,40 +717,97 @@ struct TangentRecurrence<'a> {
 }
 
 impl TangentRecurrence<'_> {
-    /// Rows `1..=p` of `v` (row-major `2N x columns` matrices) from row 0: with the gap `g =
-    /// sum_j q_j` of each column (plus `dZ/dZ = 1` on the parameter column), `(k + 1) q_{i,k+1}
-    /// = (tau v_i)_k` and `(k + 1) v_{i,k+1} = (w_i^2/k_i) (-(3/2) c) (tau r g)_k - w_i^2 (tau
-    /// q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a convolution. The columns evolve
-    /// independently along the given state series, so the recurrence runs over them in blocks
-    /// of up to [`COLUMN_BLOCK`], each block's sums kept in registers.
+    /// Rows `1..=p` of every column of `v` ([`TangentRecurrence::run`]), compiled for the
+    /// CPU's AVX where it has it (four lanes where the baseline x86-64 has two; the same
+    /// arithmetic in the same order, so the same bits: the compiler never fuses or
+    /// reassociates floating-point operations).
+    fn run_all(&self, columns: usize, v: &mut [f64], gaps: &mut Vec<f64>) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX, checked just above.
+            unsafe { self.run_all_avx(columns, v, gaps) };
+            return;
+        }
+        self.run_columns(columns, v, gaps);
+    }
+
+    /// [`TangentRecurrence::run_columns`] compiled with AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn run_all_avx(&self, columns: usize, v: &mut [f64], gaps: &mut Vec<f64>) {
+        self.run_columns(columns, v, gaps);
+    }
+
+    /// The column counts of N = 1 to 3 modes, with and without dZ, as one block of constant
+    /// width (its loops unrolled, its values in registers); more columns in blocks of
+    /// [`COLUMN_BLOCK`], the rest one by one.
     #[inline(always)]
-    fn run(&self, columns: usize, v: &mut [f64], scratch: &mut Vec<f64>) {
+    fn run_columns(&self, columns: usize, v: &mut [f64], gaps: &mut Vec<f64>) {
+        match columns {
+            2 => self.run::<2>(2, 0, v, gaps),
+            3 => self.run::<3>(3, 0, v, gaps),
+            4 => self.run::<4>(4, 0, v, gaps),
+            5 => self.run::<5>(5, 0, v, gaps),
+            6 => self.run::<6>(6, 0, v, gaps),
+            7 => self.run::<7>(7, 0, v, gaps),
+            _ => {
+                let blocks = columns / COLUMN_BLOCK * COLUMN_BLOCK;
+                for start in (0..blocks).step_by(COLUMN_BLOCK) {
+                    self.run::<COLUMN_BLOCK>(columns, start, v, gaps);
+                }
+                for start in blocks..columns {
+                    self.run::<1>(columns, start, v, gaps);
+                }
+            }
+        }
+    }
+
+    /// Rows `1..=p` of columns `start..start + C` of `v` (row-major `2N x columns` matrices)
+    /// from row 0: with the gap `g = sum_j q_j` of each column (plus `dZ/dZ = 1` on the
+    /// parameter column), `(k + 1) q_{i,k+1} = (tau v_i)_k` and `(k + 1) v_{i,k+1} = (w_i^2/k_i)
+    /// (-(3/2) c) (tau r g)_k - w_i^2 (tau q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a
+    /// convolution. The columns evolve independently along the given state series, so the
+    /// recurrence runs over a block of them at once, its values in arrays of the constant width
+    /// `C`. `scratch` holds the gap's coefficients (resized here).
+    #[inline(always)]
+    fn run<const C: usize>(
+        &self,
+        columns: usize,
+        start: usize,
+        v: &mut [f64],
+        scratch: &mut Vec<f64>,
+    ) {
         let modes = self.modes;
         let p = self.root_reversed.len();
         let dim = 2 * modes.len() * columns;
         let (a, b2) = (self.rate, self.curvature);
-        // Rows of the gap's coefficients (one per power, the gap `sum_i q_i` plus, on the
-        // parameter column, `dZ/dZ = 1`) and the coupling `r gap` at the previous power.
-        scratch.resize((p + 2) * columns, 0.0);
-        let (gaps, previous_coupling) = scratch.split_at_mut((p + 1) * columns);
-        previous_coupling.fill(0.0);
-        let gap = &mut gaps[..columns];
-        gap.fill(0.0);
-        for q in v[..dim].chunks_exact(2 * columns) {
-            for (g, q) in gap.iter_mut().zip(&q[..columns]) {
+        // The block's `q` (half 0) or `v` (half 1) values of one mode's rows `qv`.
+        let block = |qv: &[f64], half: usize| -> [f64; C] {
+            qv[half * columns + start..][..C]
+                .try_into()
+                .expect("a block of C columns")
+        };
+        // Rows of the gap's coefficients, one per power: the gap `sum_i q_i` plus, on the
+        // parameter column, `dZ/dZ = 1`.
+        scratch.resize((p + 1) * C, 0.0);
+        let (gaps, _) = scratch.as_chunks_mut::<C>();
+        let mut gap = [0.0; C];
+        for qv in v[..dim].chunks_exact(2 * columns) {
+            for (g, q) in gap.iter_mut().zip(block(qv, 0)) {
                 *g += q;
             }
         }
-        if self.parameter_column {
-            gap[columns - 1] += 1.0;
+        if self.parameter_column && start + C == columns {
+            gap[C - 1] += 1.0;
         }
+        gaps[0] = gap;
+        // The coupling `r gap` at the previous power.
+        let mut previous_coupling = [0.0; C];
         let mut power = 0.0;
         for k in 0..p {
             let (done, after) = v.split_at_mut((k + 1) * dim);
             let (earlier, row) = done.split_at(k * dim);
             let next = &mut after[..dim];
-            let (gaps, next_gap) = gaps.split_at_mut((k + 1) * columns);
-            let next_gap = &mut next_gap[..columns];
             // y' = tau z: y_{k+1} = (a z_k + b2 z_{k-1}) / (k + 1), z_{-1} = 0 (the
             // coefficient below k is row k itself at k = 0, times zero).
             power += 1.0;
@@ -659,62 +817,49 @@ impl TangentRecurrence<'_> {
             } else {
                 (0.0, row)
             };
-            for start in (0..columns).step_by(COLUMN_BLOCK) {
-                let width = COLUMN_BLOCK.min(columns - start);
-                let block = start..start + width;
-                // The coupling's coefficient k, sum_{j=0}^{k} r_{k-j} gap_j, and tau times it.
-                let mut coupling = [0.0; COLUMN_BLOCK];
-                for (gap, r) in gaps
-                    .chunks_exact(columns)
-                    .zip(&self.root_reversed[p - 1 - k..])
-                {
-                    for (c, g) in coupling[..width].iter_mut().zip(&gap[block.clone()]) {
-                        *c += r * g;
-                    }
+            // The coupling's coefficient k, sum_{j=0}^{k} r_{k-j} gap_j, and tau times it.
+            let mut coupling = [0.0; C];
+            for (gap, r) in gaps[..=k].iter().zip(&self.root_reversed[p - 1 - k..]) {
+                for (c, g) in coupling.iter_mut().zip(gap) {
+                    *c += r * g;
                 }
-                let mut tau_coupling = [0.0; COLUMN_BLOCK];
-                for ((t, c), previous) in tau_coupling[..width]
-                    .iter_mut()
-                    .zip(&coupling[..width])
-                    .zip(&mut previous_coupling[block.clone()])
-                {
-                    *t = rate * c + curvature * *previous;
-                    *previous = *c;
-                }
-                // Every mode's new coefficients formed in registers, then stored, and the
-                // gap's next coefficient summed on the way.
-                let mut gap = [0.0; COLUMN_BLOCK];
-                for ((m, out), (qv, previous_qv)) in
-                    modes.iter().zip(next.chunks_exact_mut(2 * columns)).zip(
-                        row.chunks_exact(2 * columns)
-                            .zip(previous.chunks_exact(2 * columns)),
-                    )
-                {
-                    let coupling_gain = m.omega_squared_over_stiffness * self.slope;
-                    let (q, velocity) = qv.split_at(columns);
-                    let (previous_q, previous_velocity) = previous_qv.split_at(columns);
-                    let mut new_q = [0.0; COLUMN_BLOCK];
-                    let mut new_v = [0.0; COLUMN_BLOCK];
-                    for c in 0..width {
-                        let column = start + c;
-                        let tau_q = rate * q[column] + curvature * previous_q[column];
-                        let tau_v = rate * velocity[column] + curvature * previous_velocity[column];
-                        new_q[c] = tau_v;
-                        new_v[c] = coupling_gain * tau_coupling[c]
-                            - m.omega_squared * tau_q
-                            - m.damping * tau_v;
-                        gap[c] += tau_v;
-                    }
-                    let (next_q, next_v) = out.split_at_mut(columns);
-                    next_q[block.clone()].copy_from_slice(&new_q[..width]);
-                    next_v[block.clone()].copy_from_slice(&new_v[..width]);
-                }
-                next_gap[block].copy_from_slice(&gap[..width]);
             }
+            let mut tau_coupling = [0.0; C];
+            for c in 0..C {
+                tau_coupling[c] = rate * coupling[c] + curvature * previous_coupling[c];
+            }
+            previous_coupling = coupling;
+            // Every mode's new coefficients, and the gap's next coefficient summed on the way.
+            let mut gap = [0.0; C];
+            for ((m, out), (qv, previous_qv)) in
+                modes.iter().zip(next.chunks_exact_mut(2 * columns)).zip(
+                    row.chunks_exact(2 * columns)
+                        .zip(previous.chunks_exact(2 * columns)),
+                )
+            {
+                let coupling_gain = m.omega_squared_over_stiffness * self.slope;
+                let (q, velocity) = (block(qv, 0), block(qv, 1));
+                let (previous_q, previous_velocity) =
+                    (block(previous_qv, 0), block(previous_qv, 1));
+                let mut new_q = [0.0; C];
+                let mut new_v = [0.0; C];
+                for c in 0..C {
+                    let tau_q = rate * q[c] + curvature * previous_q[c];
+                    let tau_v = rate * velocity[c] + curvature * previous_velocity[c];
+                    new_q[c] = tau_v;
+                    new_v[c] = coupling_gain * tau_coupling[c]
+                        - m.omega_squared * tau_q
+                        - m.damping * tau_v;
+                    gap[c] += tau_v;
+                }
+                out[start..start + C].copy_from_slice(&new_q);
+                out[columns + start..][..C].copy_from_slice(&new_v);
+            }
+            gaps[k + 1] = gap;
         }
     }
 }
 
-/// The widest block of tangent columns [`TangentRecurrence::run`] handles at once (`2N + 1`
-/// columns for `N` up to 3 in one).
+/// The width of the blocks of tangent columns [`TangentRecurrence::run`] handles at once
+/// beyond 7 columns (`2N + 1` for `N` up to 3 take one block of their own width).
 const COLUMN_BLOCK: usize = 8;

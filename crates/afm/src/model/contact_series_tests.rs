@@ -62,10 +62,20 @@ fn advance(solver: &mut Solver<'_, TappingModel>, t: f64) {
 }
 
 fn state_series(model: &TappingModel, clock: &ClockPolynomial, x0: &[f64]) -> TaylorSeries {
+    state_series_shared(model, clock, x0).0
+}
+
+/// The state's series and what its recurrence leaves for the tangents' (`shared`).
+fn state_series_shared(
+    model: &TappingModel,
+    clock: &ClockPolynomial,
+    x0: &[f64],
+) -> (TaylorSeries, Vec<f64>) {
     let mut series = TaylorSeries::new(model.dim(), ORDER);
+    let mut shared = Vec::new();
     series.start_at(x0);
-    assert!(model.taylor_series(CONTACT, clock, &mut series));
-    series
+    assert!(model.taylor_series(CONTACT, clock, &mut series, &mut shared));
+    (series, shared)
 }
 
 fn max_difference(a: &[f64], b: &[f64]) -> f64 {
@@ -186,8 +196,7 @@ fn tangent_series_are_the_derivatives_of_the_flow() {
         rate: 0.0,
         curvature: 1.0,
     };
-    let series = state_series(&model, &onset_clock, &x_onset);
-    let tangents = tangent_series(&model, &onset_clock, &series, false);
+    let tangents = tangent_series(&model, &onset_clock, &x_onset, false);
     let mut v = vec![0.0; n * n];
     tangents.evaluate(sigma, &mut v);
     // Row-major series, column-major nalgebra.
@@ -224,8 +233,7 @@ fn tangent_series_are_the_derivatives_of_the_flow() {
             0.5 * sigma0,
         ),
     ] {
-        let series = state_series(&model, &clock, x0);
-        let tangents = tangent_series(&model, &clock, &series, true);
+        let tangents = tangent_series(&model, &clock, x0, true);
         let mut v = vec![0.0; n * (n + 1)];
         tangents.evaluate(s, &mut v);
         let step = 1e-6;
@@ -258,12 +266,15 @@ fn tangent_series_are_the_derivatives_of_the_flow() {
     }
 }
 
+/// The tangents' series (the identity at the start, with `dx/dZ = 0` when `parameter`) along
+/// the state's series from `x0`.
 fn tangent_series(
     model: &TappingModel,
     clock: &ClockPolynomial,
-    state: &TaylorSeries,
+    x0: &[f64],
     parameter: bool,
 ) -> TaylorSeries {
+    let (state, mut shared) = state_series_shared(model, clock, x0);
     let n = model.dim();
     let columns = n + usize::from(parameter);
     let mut tangents = TaylorSeries::new(n * columns, ORDER);
@@ -275,7 +286,8 @@ fn tangent_series(
     model.taylor_tangents(
         CONTACT,
         clock,
-        state,
+        &state,
+        &mut shared,
         &mut tangents,
         parameter,
         &mut Vec::new(),
