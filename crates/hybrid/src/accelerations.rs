@@ -221,7 +221,9 @@ pub trait TaylorExpansion {
     ///
     /// `shared` is space the implementation may resize and keep intermediate series in (its
     /// own layout) for [`TaylorExpansion::taylor_tangents`] along the same series: the solver
-    /// passes the same vector to both, the tangents' call (if any) right after this one.
+    /// passes the same vector to both, the tangents' call (if any) right after this one. Its
+    /// capacity is [`crate::SHARED_SERIES_CAPACITY`] values, so that an implementation needing
+    /// no more allocates nothing in a step.
     fn taylor_series(
         &self,
         mode: Mode,

@@ -142,6 +142,7 @@ pub use error::HybridError;
 pub use event::{Event, Extremum, ExtremumKind};
 pub use flow_map::{flow_map, flow_map_from_mode, flow_map_in, flow_map_observed, FlowMap};
 pub use sensitivity::{LinearisationBuffers, Sensitivity};
+pub use series_step::SHARED_SERIES_CAPACITY;
 pub use settings::{SensitivityMethod, Settings};
 pub use solver::{Solver, Statistics, StepOutcome};
 pub use system::{Direction, HybridSystem, Mode, SwitchingPartials, MAX_SURFACES};

@@ -49,6 +49,11 @@ pub(crate) const DECOUPLED_TANGENT_TOLERANCE: f64 = 1e-5;
 /// recurrence keeps one row per power up to the order, and one more).
 pub(crate) const TANGENT_SCRATCH_ROWS: usize = 2;
 
+/// The capacity (values) of the `shared` vector a [`TaylorStep`] passes to
+/// [`crate::TaylorExpansion::taylor_series`] and `taylor_tangents`: sixteen series of order 40,
+/// so that an implementation keeping no more there allocates nothing in a step.
+pub const SHARED_SERIES_CAPACITY: usize = 16 * 41;
+
 /// One Taylor-series step of the solver: the state's series (and the tangents' when
 /// sensitivities are carried) about the step start, in the step's clock offset.
 #[derive(Debug, Clone)]
@@ -91,7 +96,7 @@ impl TaylorStep {
             },
             length: 0.0,
             surface: None,
-            shared: Vec::new(),
+            shared: Vec::with_capacity(SHARED_SERIES_CAPACITY),
             scratch: Vec::with_capacity((order + TANGENT_SCRATCH_ROWS) * columns),
             rows: vec![0.0; n * columns],
         }

@@ -43,6 +43,11 @@ pub const MAX_ORDER: usize = 40;
 /// The coefficients `0..=MAX_ORDER` of one series.
 const LEN: usize = MAX_ORDER + 1;
 
+/// The values [`SharedSeries`] lays out in the solver's `shared` vector: within its capacity,
+/// so that no step allocates.
+const SHARED_LEN: usize = 9 * LEN;
+const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
+
 /// The series [`contact_state_series`] computes on its way and [`contact_tangent_series`]
 /// reuses along the same state series (module docs), held in the solver's `shared` vector (of
 /// [`hybrid::TaylorExpansion::taylor_series`]): the indentation `delta` and the force's
@@ -74,7 +79,7 @@ impl<'a> SharedSeries<'a> {
     /// The series laid out in `storage` (grown to their length the first time; what a state
     /// series wrote there is kept).
     fn in_storage(storage: &'a mut Vec<f64>) -> Self {
-        storage.resize(9 * LEN, 0.0);
+        storage.resize(SHARED_LEN, 0.0);
         let (delta, rest) = storage.split_at_mut(LEN);
         let (root, rest) = rest.split_at_mut(3 * LEN);
         let (cos, rest) = rest.split_at_mut(LEN);
