@@ -238,6 +238,36 @@ fn indentation_coefficient(separation: &[f64; 3], row: &[f64], k: usize) -> f64 
 /// located `pull-off` (its release maxima, approached by ever shorter series steps).
 const JKR_MARGIN: f64 = 1.0;
 
+/// `sum_{j=1}^{m-1} x_j x_{m-j}` (`m >= 1`), the sum's terms paired by its symmetry `j <-> m -
+/// j`: twice `sum_{j=1}^{h} x_j x_{m-j}` (`h = floor((m - 1)/2)`), plus `x_{m/2}^2` for even `m`
+/// (as in [`update_root`]).
+#[inline]
+fn inner_square_sum(x: &[f64], m: usize) -> f64 {
+    let h = (m - 1) / 2;
+    let mut sum = 2.0 * convolution(&x[1..=h], &x[m - h..m]);
+    if m.is_multiple_of(2) {
+        sum += x[m / 2] * x[m / 2];
+    }
+    sum
+}
+
+/// Coefficient `k` of the square of a series, `sum_{j=0}^{k} x_j x_{k-j}`, its terms paired by
+/// symmetry: twice `sum_{j=0}^{h} x_j x_{k-j}` (`h = floor((k - 1)/2)`, none at `k = 0`), plus
+/// `x_{k/2}^2` for even `k`.
+#[inline]
+fn square_coefficient(x: &[f64], k: usize) -> f64 {
+    let mut sum = if k == 0 {
+        0.0
+    } else {
+        let h = (k - 1) / 2;
+        2.0 * convolution(&x[..=h], &x[k - h..=k])
+    };
+    if k.is_multiple_of(2) {
+        sum += x[k / 2] * x[k / 2];
+    }
+    sum
+}
+
 /// Coefficient `m` of JKR's `b = sqrt(a)`, `p = b^2` and `c = b^3` (into `b`, `p`, `c`) from
 /// the indentation's coefficients to `m` and theirs below `m`, by series reversion of `b^4/R -
 /// k b = delta` (module docs); at `m = 0` also the divisor `d delta/db = 4 b_0^3/R - k` (into
@@ -262,8 +292,8 @@ fn update_jkr_root(
         return slope > JKR_MARGIN * law.adhesion_root() && b0.is_finite();
     }
     let divisor = *divisor;
-    let root_sum = convolution(&b[1..m], &b[1..m]);
-    let square_sum = convolution(&p[1..m], &p[1..m]);
+    let root_sum = inner_square_sum(b, m);
+    let square_sum = inner_square_sum(p, m);
     b[m] = (delta[m] - (2.0 * p[0] * root_sum + square_sum) / r) / divisor;
     p[m] = 2.0 * b[0] * b[m] + root_sum;
     c[m] = convolution(&p[..=m], &b[..=m]);
@@ -383,7 +413,7 @@ fn force_coefficient(
             }
             let e = law.effective_modulus_gpa;
             Some(
-                4.0 * e / (3.0 * law.tip_radius_nm) * convolution(&c[..=k], &c[..=k])
+                4.0 * e / (3.0 * law.tip_radius_nm) * square_coefficient(c, k)
                     - 2.0 * e * law.adhesion_root() * c[k],
             )
         }
