@@ -9,7 +9,7 @@ use super::Continuation;
 use crate::error::ContinuationError;
 use crate::location::{Sample, Segment};
 use crate::problem::PeriodicProblem;
-use crate::shooting::{shoot_checked, NewtonSettings, StallCheck};
+use crate::shooting::{shoot_checked, NewtonSettings, NEWTON_STALL};
 use crate::special_point::SpecialPoint;
 use crate::test_function::{structure_changes, StructureTest};
 
@@ -36,17 +36,6 @@ pub(super) struct Jump {
 
 /// Consecutive corrector failures at one point after which a corner jump is tried.
 pub(super) const CORNER_FAILURES: usize = 6;
-
-/// The progress a corner jump's shot must make to go on: its residual halved between the 3rd
-/// and the 6th Newton update. From a guess in its basin Newton's method converges
-/// quadratically (the jumps that land converge in 3 updates), while a shot with no orbit near
-/// its guess wanders at a residual that barely moves: on JKR's hysteretic grazings
-/// (`biolever-adhesive`'s approach) 13 of 18 shots spent all their 48 updates at residuals of
-/// 0.05 to 0.15 nm, 20% of the diagram's instructions.
-const CORNER_STALL: StallCheck = StallCheck {
-    updates: 3,
-    reduction: 0.5,
-};
 
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// Jump over a corner of the branch at a structure change (the square-root singularity
@@ -77,7 +66,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 guess.as_slice(),
                 p,
                 &shooting,
-                Some(CORNER_STALL),
+                Some(NEWTON_STALL),
             ) {
                 Ok(result) => result,
                 Err(ContinuationError::DimensionMismatch { .. }) => {
