@@ -97,36 +97,39 @@ pub fn shoot<P: PeriodicProblem + ?Sized>(
     shoot_checked(problem, x0, p, settings, None)
 }
 
-/// A check of Newton's progress: after `updates` updates, and again `updates` updates later,
-/// the residual must have fallen by `reduction` between the two, else the iteration stops (not
-/// converged).
+/// A check of Newton's progress: from `updates` updates on, every further `updates` updates
+/// must reduce the residual by `reduction`, else the iteration stops (not converged).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct StallCheck {
-    /// The updates between the two residuals compared (and before the first).
+    /// The updates between two residuals compared (and before the first).
     pub(crate) updates: usize,
-    /// The factor the residual must fall by between them, in (0, 1).
+    /// The factor the residual must fall by over each of those windows, in (0, 1).
     pub(crate) reduction: f64,
 }
 
 impl StallCheck {
-    /// Whether the iteration stops at update `iterations` with `residual`, the residual after
-    /// `updates` updates having been recorded in `checkpoint` (kept across calls).
+    /// Whether the iteration stops at update `iterations` with `residual`: at every multiple
+    /// of `updates` from the second on, the residual is compared with the one `updates`
+    /// updates earlier, recorded in `checkpoint` (kept across calls; start it at infinity).
     pub(crate) fn stalled(&self, iterations: usize, residual: f64, checkpoint: &mut f64) -> bool {
-        if iterations == self.updates {
-            *checkpoint = residual;
+        if iterations == 0 || !iterations.is_multiple_of(self.updates) {
+            return false;
         }
-        iterations == 2 * self.updates && residual > self.reduction * *checkpoint
+        let stalled = residual > self.reduction * *checkpoint;
+        *checkpoint = residual;
+        stalled
     }
 }
 
 /// The progress a Newton iteration that may start outside its basin must make to go on: its
-/// residual halved between the 3rd and the 6th update. From a guess in its basin Newton's
+/// residual halved over every 3 updates from the 3rd on. From a guess in its basin Newton's
 /// method converges quadratically (corrections and corner jumps that land converge in 1 to 5
 /// updates), while an iteration with no orbit near its guess wanders at a residual that barely
-/// moves: on JKR's hysteretic grazings (`biolever-adhesive`'s approach) the 72 failed
+/// moves, or cycles: on JKR's hysteretic grazings (`biolever-adhesive`'s approach) the 72 failed
 /// corrections and 13 of the 18 corner-jump shots each spent all their 12 (48) updates at
-/// residuals of 0.05 to 0.15 nm, 40% of the diagram's period maps. Used by the continuation's
-/// corrector and its corner jumps.
+/// residuals of 0.05 to 0.15 nm, 40% of the diagram's period maps; on `biolever-sticky` 4 shots
+/// halved their residual between the 3rd and 6th update and ran on to 48 at 0.7 to 1.2 nm.
+/// Used by the continuation's corrector and its corner jumps.
 pub(crate) const NEWTON_STALL: StallCheck = StallCheck {
     updates: 3,
     reduction: 0.5,
