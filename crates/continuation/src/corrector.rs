@@ -10,7 +10,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::error::ContinuationError;
 use crate::problem::{check_period_map, PeriodMap, PeriodicProblem};
-use crate::shooting::NewtonSettings;
+use crate::shooting::{NewtonSettings, NEWTON_STALL};
 
 /// A corrected point `u = (x, p)` and the period map there.
 #[derive(Debug, Clone)]
@@ -102,7 +102,9 @@ fn recoverable(error: &ContinuationError) -> bool {
 /// Newton's method on `[P(x; p) - x; tau . (u - anchor)] = 0` from `guess`.
 ///
 /// A failed evaluation of the period map or a singular matrix at a trial point ends the
-/// iteration as not converged (the caller cuts its step); dimension errors propagate.
+/// iteration as not converged (the caller cuts its step), as does an iteration that has not
+/// halved its residual between its 3rd and 6th update ([`NEWTON_STALL`]: a guess with no orbit
+/// near it); dimension errors propagate.
 pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
     problem: &P,
     guess: DVector<f64>,
@@ -114,6 +116,7 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
     let mut u = guess;
     let mut iterations = 0;
     let mut previous_residual = f64::INFINITY;
+    let mut checkpoint = f64::INFINITY;
     let failed = |u: DVector<f64>, iterations, map: Option<PeriodMap>, residual| Corrected {
         u,
         map,
@@ -156,6 +159,7 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
         }
         if iterations >= settings.max_iterations
             || residual > settings.divergence_factor * previous_residual
+            || NEWTON_STALL.stalled(iterations, residual, &mut checkpoint)
         {
             return Ok(failed(u, iterations, Some(map), residual));
         }

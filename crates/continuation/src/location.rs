@@ -24,8 +24,7 @@ use crate::corrector::{correct, tangent};
 use crate::error::ContinuationError;
 use crate::floquet::floquet_multipliers;
 use crate::problem::{PeriodMap, PeriodicProblem};
-use crate::shooting::shoot;
-use crate::shooting::NewtonSettings;
+use crate::shooting::{shoot_checked, NewtonSettings, NEWTON_STALL};
 
 /// A corrected orbit on the segment, with what the test functions need.
 #[derive(Debug, Clone)]
@@ -237,7 +236,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     }
 
     /// Shooting at the fixed parameter of `sigma`, from the states extrapolated along the
-    /// tangents at `A`, then at `B`.
+    /// tangents at `A`, then at `B` (each shot given up when it stalls, [`NEWTON_STALL`]: a
+    /// trial past the structure change, with no orbit near its guess).
     fn shoot_at(&self, sigma: f64) -> Result<Option<(DVector<f64>, PeriodMap)>, ContinuationError> {
         let n = self.u_a.len() - 1;
         let p = self.parameter_at(sigma);
@@ -254,7 +254,13 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
                 0.0
             };
             let guess = end.u.rows(0, n) + slope * end.tangent.rows(0, n);
-            let result = match shoot(self.problem, guess.as_slice(), p, &settings) {
+            let result = match shoot_checked(
+                self.problem,
+                guess.as_slice(),
+                p,
+                &settings,
+                Some(NEWTON_STALL),
+            ) {
                 Ok(result) => result,
                 Err(ContinuationError::DimensionMismatch {
                     what,

@@ -149,6 +149,23 @@ impl JkrContact {
         halley(halley(start))
     }
 
+    /// `b = sqrt(a)` (nm^{1/2}) at indentation `delta` (nm) with the indentation's slope
+    /// `d delta/db = 4 b^3/R - k` (nm^{1/2}), the latter as `k e (e^2 + 3 e + 3)` from the
+    /// offset `e` of [`Self::pull_off_offset`] (no cancellation next to pull-off, where it
+    /// vanishes; MODEL.md section 9, JKR). `(b_c, 0)` past pull-off; for `W = 0`, `(R
+    /// delta)^{1/4}` and `4 b^3/R`.
+    pub fn root_and_slope(&self, indentation_nm: f64) -> (f64, f64) {
+        if self.adhesion_root == 0.0 {
+            let b = self.contact_root(indentation_nm);
+            return (b, 4.0 * b * b * b / self.tip_radius_nm);
+        }
+        let e = self.pull_off_offset(indentation_nm);
+        (
+            self.critical_root * (1.0 + e),
+            self.adhesion_root * e * (e * e + 3.0 * e + 3.0),
+        )
+    }
+
     /// The coefficient `K` (nN/nm^{1/2}) of the force's square-root singularity at pull-off,
     /// `F = F_po + K sqrt(d_po - d) + O(d_po - d)`: with `delta - delta_c = (1/2) delta''(a_c)
     /// (a - a_c)^2`, `K = F'(a_c) sqrt(2 / delta''(a_c))`, `F'(a_c) = -2 sqrt(2 pi W E* a_c)`,

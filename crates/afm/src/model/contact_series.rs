@@ -26,7 +26,10 @@
 //! relation by series reversion, one linear equation per coefficient: with `p = b^2`,
 //! `(b^4)_m = 4 b_0^3 b_m + 2 p_0 sum_{j=1}^{m-1} b_j b_{m-j} + sum_{j=1}^{m-1} p_j p_{m-j}`, so
 //! `b_m (4 b_0^3/R - k) = delta_m - (the sums)/R`; `b_0` is the law's own root. The divisor
-//! `d delta/db` vanishes at pull-off: a step starting near it ([`JKR_MARGIN`]) has no series.
+//! `d delta/db` (from the law's offset from pull-off, without cancellation) vanishes at
+//! pull-off, where `b(t)` has a square-root branch point: a series expanded next to it has a
+//! radius as short as the time to pull-off, which the solver's reach keeps the step inside; a
+//! step starting nearer than [`JKR_MARGIN`] has no series.
 
 use hybrid::{ClockPolynomial, TaylorSeries};
 
@@ -45,7 +48,11 @@ const LEN: usize = MAX_ORDER + 1;
 
 /// The values [`SharedSeries`] lays out in the solver's `shared` vector: within its capacity,
 /// so that no step allocates.
-const SHARED_LEN: usize = 9 * LEN;
+const SHARED_LEN: usize = 8 * LEN + ROOT_LEN;
+
+/// The values of the force's auxiliary series in [`SharedSeries`]: three series and one value
+/// (JKR's `b`, `b^2`, `b^3` and `d delta/db` at the start).
+const ROOT_LEN: usize = 3 * LEN + 1;
 const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 
 /// The series [`contact_state_series`] computes on its way and [`contact_tangent_series`]
@@ -63,8 +70,9 @@ const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 struct SharedSeries<'a> {
     /// The indentation below the contact surface, nm.
     delta: &'a mut [f64; LEN],
-    /// The force's auxiliary series (three series' room, for JKR).
-    root: &'a mut [f64; 3 * LEN],
+    /// The force's auxiliary series (three series' room and one value, for JKR's `b`, `b^2`,
+    /// `b^3` and `d delta/db` at the start).
+    root: &'a mut [f64; ROOT_LEN],
     /// `cos(w t(s))` and `sin(w t(s))` of the drive.
     cos: &'a mut [f64; LEN],
     sin: &'a mut [f64; LEN],
@@ -81,7 +89,7 @@ impl<'a> SharedSeries<'a> {
     fn in_storage(storage: &'a mut Vec<f64>) -> Self {
         storage.resize(SHARED_LEN, 0.0);
         let (delta, rest) = storage.split_at_mut(LEN);
-        let (root, rest) = rest.split_at_mut(3 * LEN);
+        let (root, rest) = rest.split_at_mut(ROOT_LEN);
         let (cos, rest) = rest.split_at_mut(LEN);
         let (sin, rest) = rest.split_at_mut(LEN);
         let (force, rest) = rest.split_at_mut(LEN);
@@ -287,37 +295,69 @@ pub(crate) fn indentation_coefficient(separation: &[f64; 3], row: &[f64], k: usi
 }
 
 /// How far from pull-off a JKR series starts, in `(d delta/db) / k = (b_0/b_c)^3 - 1` (`b_0 >
-/// 1.82 b_c`): the slope `dF/dd` has a pole at pull-off, and series steps that start nearer run
-/// their tangents' truncated series toward it. Measured (`crates/afm/tests/jkr_series.rs`): the
-/// transition matrix within 2.5e-7 of DOP853's at 5, 4.7e-5 at 0 to 3 (DOP853's own distance
-/// from finite differences of its flow is 2e-5 to 6e-5).
-const JKR_MARGIN: f64 = 5.0;
+/// 2^{1/3} b_c`). Nearer, the series' radius (the time to pull-off) shrinks with each step and
+/// DOP853 takes over. Measured on `biolever-adhesive` and `biolever-sticky`
+/// (docs/guide/performance.md): 5 (the previous margin) kept 72 000 attached starts per diagram
+/// on DOP853; 1 gives the same series steps as 0 there, while 0 loses the sticky approach's
+/// located `pull-off` (its release maxima, approached by ever shorter series steps).
+const JKR_MARGIN: f64 = 1.0;
+
+/// `sum_{j=1}^{m-1} x_j x_{m-j}` (`m >= 1`), the sum's terms paired by its symmetry `j <-> m -
+/// j`: twice `sum_{j=1}^{h} x_j x_{m-j}` (`h = floor((m - 1)/2)`), plus `x_{m/2}^2` for even `m`
+/// (as in [`update_root`]).
+#[inline]
+fn inner_square_sum(x: &[f64], m: usize) -> f64 {
+    let h = (m - 1) / 2;
+    let mut sum = 2.0 * convolution(&x[1..=h], &x[m - h..m]);
+    if m.is_multiple_of(2) {
+        sum += x[m / 2] * x[m / 2];
+    }
+    sum
+}
+
+/// Coefficient `k` of the square of a series, `sum_{j=0}^{k} x_j x_{k-j}`, its terms paired by
+/// symmetry: twice `sum_{j=0}^{h} x_j x_{k-j}` (`h = floor((k - 1)/2)`, none at `k = 0`), plus
+/// `x_{k/2}^2` for even `k`.
+#[inline]
+fn square_coefficient(x: &[f64], k: usize) -> f64 {
+    let mut sum = if k == 0 {
+        0.0
+    } else {
+        let h = (k - 1) / 2;
+        2.0 * convolution(&x[..=h], &x[k - h..=k])
+    };
+    if k.is_multiple_of(2) {
+        sum += x[k / 2] * x[k / 2];
+    }
+    sum
+}
 
 /// Coefficient `m` of JKR's `b = sqrt(a)`, `p = b^2` and `c = b^3` (into `b`, `p`, `c`) from
 /// the indentation's coefficients to `m` and theirs below `m`, by series reversion of `b^4/R -
-/// k b = delta` (module docs); `false` where `d delta/db = 4 b_0^3/R - k` is below
-/// [`JKR_MARGIN`] `k` (next to or past pull-off) or the root is not finite.
+/// k b = delta` (module docs); at `m = 0` also the divisor `d delta/db = 4 b_0^3/R - k` (into
+/// `divisor`, from [`JkrContact::root_and_slope`]), which the later coefficients divide by.
+/// `false` where the divisor is below [`JKR_MARGIN`] `k` (next to, on or past pull-off) or the
+/// root is not finite.
 #[inline]
 fn update_jkr_root(
     law: &JkrContact,
-    b: &mut [f64],
-    p: &mut [f64],
-    c: &mut [f64],
+    [b, p, c]: [&mut [f64]; 3],
+    divisor: &mut f64,
     delta: &[f64],
     m: usize,
 ) -> bool {
     let r = law.tip_radius_nm;
     if m == 0 {
-        let b0 = law.contact_root(delta[0]);
+        let (b0, slope) = law.root_and_slope(delta[0]);
         b[0] = b0;
         p[0] = b0 * b0;
         c[0] = p[0] * b0;
-        return 4.0 * c[0] / r - law.adhesion_root() > JKR_MARGIN * law.adhesion_root()
-            && b0.is_finite();
+        *divisor = slope;
+        return slope > JKR_MARGIN * law.adhesion_root() && b0.is_finite();
     }
-    let divisor = 4.0 * c[0] / r - law.adhesion_root();
-    let root_sum = convolution(&b[1..m], &b[1..m]);
-    let square_sum = convolution(&p[1..m], &p[1..m]);
+    let divisor = *divisor;
+    let root_sum = inner_square_sum(b, m);
+    let square_sum = inner_square_sum(p, m);
     b[m] = (delta[m] - (2.0 * p[0] * root_sum + square_sum) / r) / divisor;
     p[m] = 2.0 * b[0] * b[m] + root_sum;
     c[m] = convolution(&p[..=m], &b[..=m]);
@@ -467,19 +507,20 @@ fn force_coefficient(
         }
         SeriesForce::Jkr { law } => {
             // Not at an onset (the attached mode is entered at d = 0 with a jump of the
-            // force, on the time clock); `root` holds b, then p = b^2, then c = b^3.
+            // force, on the time clock); `root` holds b, then p = b^2, then c = b^3, then
+            // d delta/db at the start.
             if onset {
                 return None;
             }
             let (b, rest) = root.split_at_mut(MAX_ORDER + 1);
             let (p, rest) = rest.split_at_mut(MAX_ORDER + 1);
-            let c = &mut rest[..MAX_ORDER + 1];
-            if !update_jkr_root(&law, b, p, c, delta, k) {
+            let (c, rest) = rest.split_at_mut(MAX_ORDER + 1);
+            if !update_jkr_root(&law, [b, p, c], &mut rest[0], delta, k) {
                 return None;
             }
             let e = law.effective_modulus_gpa;
             Some(
-                4.0 * e / (3.0 * law.tip_radius_nm) * convolution(&c[..=k], &c[..=k])
+                4.0 * e / (3.0 * law.tip_radius_nm) * square_coefficient(c, k)
                     - 2.0 * e * law.adhesion_root() * c[k],
             )
         }
@@ -661,18 +702,20 @@ pub(crate) fn contact_tangent_series(
         SeriesForce::Jkr { law } => {
             // F' = -dF/ddelta = -2 E* p N / D, N = 4 c/R - 3 k, D = 4 c/R - k (module docs:
             // dF/db = 2 E* b^2 (4 b^3/R - 3 k), d delta/db = 4 b^3/R - k); `derivative` gets
-            // p N / D, from the state recurrence's `p = b^2` and `c = b^3`.
+            // p N / D, from the state recurrence's `p = b^2`, `c = b^3` and `d delta/db` at the
+            // start.
             let square = &root[LEN..LEN + p];
             let cube = &root[2 * LEN..2 * LEN + p];
+            let divisor = root[3 * LEN];
             let mut ratio = [0.0; MAX_ORDER];
             let (r, k) = (law.tip_radius_nm, law.adhesion_root());
             for m in 0..p {
-                // D_m = N_m = 4 c_m / R for m >= 1.
+                // D_0 = d delta/db, N_0 = D_0 - 2 k; D_m = N_m = 4 c_m / R for m >= 1.
                 ratio[m] = if m == 0 {
-                    (4.0 * cube[0] / r - 3.0 * k) / (4.0 * cube[0] / r - k)
+                    (divisor - 2.0 * k) / divisor
                 } else {
                     let below: f64 = (1..=m).map(|j| 4.0 * cube[j] / r * ratio[m - j]).sum();
-                    (4.0 * cube[m] / r - below) / (4.0 * cube[0] / r - k)
+                    (4.0 * cube[m] / r - below) / divisor
                 };
                 derivative[m] = convolution(&square[..=m], &ratio[..=m]);
             }

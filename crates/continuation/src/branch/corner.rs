@@ -9,7 +9,7 @@ use super::Continuation;
 use crate::error::ContinuationError;
 use crate::location::{Sample, Segment};
 use crate::problem::PeriodicProblem;
-use crate::shooting::{shoot, NewtonSettings};
+use crate::shooting::{shoot_checked, NewtonSettings, NEWTON_STALL};
 use crate::special_point::SpecialPoint;
 use crate::test_function::{structure_changes, StructureTest};
 
@@ -61,7 +61,13 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             }
             let slope = if tp.abs() > 1e-12 { 1.0 / tp } else { 0.0 };
             let guess = a.u.rows(0, n) + (direction * dp * slope) * a.tangent.rows(0, n);
-            let result = match shoot(self.problem, guess.as_slice(), p, &shooting) {
+            let result = match shoot_checked(
+                self.problem,
+                guess.as_slice(),
+                p,
+                &shooting,
+                Some(NEWTON_STALL),
+            ) {
                 Ok(result) => result,
                 Err(ContinuationError::DimensionMismatch { .. }) => {
                     return Err(ContinuationError::DimensionMismatch {
