@@ -5,8 +5,11 @@
 //! 0.5 mJ/m^2) at Z = 3 nm (two attached contacts per period) from the steady orbit, with the
 //! transition matrix and `dx/dZ`.
 
+mod series_reference;
+
 use afm::{builtin_case, steady_orbit, OrbitStart, Separation, SteadyOrbitSettings, TappingModel};
-use hybrid::{flow_map, FlowMap, Sensitivity, Settings};
+use hybrid::{FlowMap, Sensitivity};
+use series_reference::{compare, periods, relative_difference, tight, FlowDifference};
 
 fn model(z: f64) -> TappingModel {
     // (A separation of a few nm: the orbit's gap stays far from the finite-difference steps.)
@@ -18,39 +21,14 @@ fn model(z: f64) -> TappingModel {
     model
 }
 
-fn tight(series: bool) -> Settings {
-    Settings {
-        relative_tolerance: 1e-13,
-        absolute_tolerance: 1e-13,
-        taylor_series: series,
-        ..Settings::default()
-    }
-}
-
+/// Three drive periods from `x0`, by series in contact when `series`, at tolerance 1e-13.
 fn three_periods(
     model: &TappingModel,
     x0: &[f64],
     sensitivity: Sensitivity,
     series: bool,
 ) -> FlowMap {
-    flow_map(
-        model,
-        0.0,
-        x0,
-        3.0 * model.period_us(),
-        sensitivity,
-        &tight(series),
-    )
-    .expect("flow")
-}
-
-/// Largest entry of `a - b` relative to the largest entry of `b`.
-fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
-    let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
-        / scale
+    periods(model, x0, 3.0, sensitivity, &tight(series))
 }
 
 /// Central differences of the DOP853 flow's state in each initial coordinate (step `h`, nm and
@@ -118,25 +96,11 @@ fn attached_series_steps_match_runge_kutta_and_finite_differences() {
         "{:?}",
         series.statistics
     );
-    assert_eq!(series.events.len(), reference.events.len());
-    for (a, b) in series.events.iter().zip(&reference.events) {
-        assert_eq!((a.surface, a.direction), (b.surface, b.direction));
-        assert!(
-            (a.t - b.t).abs() < 1e-10 * model.period_us(),
-            "{} vs {}",
-            a.t,
-            b.t
-        );
-    }
-    let state = relative_difference(&series.state, &reference.state);
-    let transition = relative_difference(
-        series.transition.as_slice(),
-        reference.transition.as_slice(),
-    );
-    let parameter = relative_difference(
-        &series.parameter_sensitivity,
-        &reference.parameter_sensitivity,
-    );
+    let FlowDifference {
+        state,
+        transition,
+        parameter,
+    } = compare(&model, &series, &reference, 1e-10);
     let differences = state_differences(&model, &x0, 1e-4);
     let coarse = state_differences(&model, &x0, 1e-3);
     let resolved = relative_difference(&coarse, &differences);

@@ -13,7 +13,10 @@ use afm::{
     approach_diagram, builtin_case, steady_orbit, DiagramSettings, OrbitStart, Separation,
     SteadyOrbitSettings, TappingModel,
 };
-use hybrid::{flow_map, FlowMap, Sensitivity, Settings};
+use hybrid::{FlowMap, Sensitivity};
+use series_reference::{compare, periods, relative_difference, tight, FlowDifference};
+
+mod series_reference;
 
 fn model(z: f64) -> TappingModel {
     model_driven(z, DriveSpec::Direct)
@@ -30,39 +33,14 @@ fn model_driven(z: f64, drive: DriveSpec) -> TappingModel {
     model
 }
 
-fn tight(series: bool) -> Settings {
-    Settings {
-        relative_tolerance: 1e-13,
-        absolute_tolerance: 1e-13,
-        taylor_series: series,
-        ..Settings::default()
-    }
-}
-
+/// Three drive periods from `x0`, by series in contact when `series`, at tolerance 1e-13.
 fn three_periods(
     model: &TappingModel,
     x0: &[f64],
     sensitivity: Sensitivity,
     series: bool,
 ) -> FlowMap {
-    flow_map(
-        model,
-        0.0,
-        x0,
-        3.0 * model.period_us(),
-        sensitivity,
-        &tight(series),
-    )
-    .expect("flow")
-}
-
-/// Largest entry of `a - b` relative to the largest entry of `b`.
-fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
-    let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
-        / scale
+    periods(model, x0, 3.0, sensitivity, &tight(series))
 }
 
 /// From `x0`: the series steps give DOP853's flow (the state to 1e-10 relative, the same events
@@ -88,25 +66,11 @@ fn check_from(model: &TappingModel, x0: &[f64]) {
         "{:?}",
         series.statistics
     );
-    assert_eq!(series.events.len(), reference.events.len());
-    for (a, b) in series.events.iter().zip(&reference.events) {
-        assert_eq!((a.surface, a.direction), (b.surface, b.direction));
-        assert!(
-            (a.t - b.t).abs() < 1e-10 * model.period_us(),
-            "{} vs {}",
-            a.t,
-            b.t
-        );
-    }
-    let state = relative_difference(&series.state, &reference.state);
-    let transition = relative_difference(
-        series.transition.as_slice(),
-        reference.transition.as_slice(),
-    );
-    let parameter = relative_difference(
-        &series.parameter_sensitivity,
-        &reference.parameter_sensitivity,
-    );
+    let FlowDifference {
+        state,
+        transition,
+        parameter,
+    } = compare(model, &series, &reference, 1e-10);
     let n = x0.len();
     let h = 1e-5;
     let mut differences = vec![0.0; n * n];
@@ -223,20 +187,12 @@ fn series_steps_match_runge_kutta_under_acoustic_and_bimodal_drives() {
         let series = three_periods(&model, &x0, Sensitivity::TransitionAndParameter, true);
         let reference = three_periods(&model, &x0, Sensitivity::TransitionAndParameter, false);
         assert!(series.statistics.series_steps > 0, "{drive:?}");
-        assert_eq!(series.events.len(), reference.events.len(), "{drive:?}");
-        for (a, b) in series.events.iter().zip(&reference.events) {
-            assert_eq!((a.surface, a.direction), (b.surface, b.direction));
-            assert!((a.t - b.t).abs() < 1e-10 * model.period_us(), "{drive:?}");
-        }
-        let state = relative_difference(&series.state, &reference.state);
-        let transition = relative_difference(
-            series.transition.as_slice(),
-            reference.transition.as_slice(),
-        );
-        let parameter = relative_difference(
-            &series.parameter_sensitivity,
-            &reference.parameter_sensitivity,
-        );
+        println!("{drive:?}");
+        let FlowDifference {
+            state,
+            transition,
+            parameter,
+        } = compare(&model, &series, &reference, 1e-10);
         println!(
             "{drive:?}: state {state:.1e}, transition {transition:.1e}, dx/dZ {parameter:.1e}"
         );

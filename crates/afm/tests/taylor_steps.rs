@@ -8,12 +8,13 @@
 //! their largest entries.
 
 mod common;
+mod series_reference;
 
 use afm::{builtin_case, Separation, TappingModel};
 use hybrid::{
-    flow_map, Clock, Direction, FlowMap, Sensitivity, SensitivityMethod, Settings, Solver,
-    StepOutcome,
+    Clock, Direction, FlowMap, Sensitivity, SensitivityMethod, Settings, Solver, StepOutcome,
 };
+use series_reference::{compare, periods, relative_difference, tight, FlowDifference};
 
 /// The separation of the Fig. 1 point A/A0 = 0.5 on the approach branch (nm).
 const Z_HALF_AMPLITUDE: f64 = 2.733_156_827_672_611;
@@ -27,55 +28,21 @@ fn model() -> TappingModel {
     model
 }
 
-fn periods(
-    model: &TappingModel,
-    count: f64,
-    sensitivity: Sensitivity,
-    settings: &Settings,
-) -> FlowMap {
-    flow_map(
+/// Three drive periods from the free orbit with the transition matrix.
+fn three_periods(model: &TappingModel, settings: &Settings) -> FlowMap {
+    periods(
         model,
-        0.0,
         &model.free_state(),
-        count * model.period_us(),
-        sensitivity,
+        3.0,
+        Sensitivity::Transition,
         settings,
     )
-    .expect("periods")
-}
-
-fn three_periods(model: &TappingModel, settings: &Settings) -> FlowMap {
-    periods(model, 3.0, Sensitivity::Transition, settings)
-}
-
-fn tight() -> Settings {
-    Settings {
-        relative_tolerance: 1e-13,
-        absolute_tolerance: 1e-13,
-        ..Settings::default()
-    }
-}
-
-/// Largest entry of `a - b` relative to the largest entry of `b`.
-fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
-    let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
-        / scale
 }
 
 #[test]
 fn series_steps_reproduce_the_runge_kutta_flow_events_and_transition() {
     let model = model();
-    let tight = tight();
-    let reference = three_periods(
-        &model,
-        &Settings {
-            taylor_series: false,
-            ..tight.clone()
-        },
-    );
+    let reference = three_periods(&model, &tight(false));
     assert_eq!(reference.statistics.series_steps, 0);
     for (method, transition_tolerance) in [
         (SensitivityMethod::Coupled, 5e-8),
@@ -85,7 +52,7 @@ fn series_steps_reproduce_the_runge_kutta_flow_events_and_transition() {
             &model,
             &Settings {
                 sensitivity_method: method,
-                ..tight.clone()
+                ..tight(true)
             },
         );
         // Every contact stepped by series (several steps per contact), none by DOP853.
@@ -96,22 +63,10 @@ fn series_steps_reproduce_the_runge_kutta_flow_events_and_transition() {
             .count();
         assert!(contacts >= 9, "{contacts} contacts in three periods");
         assert!(series.statistics.series_steps >= 2 * contacts);
-        assert_eq!(series.events.len(), reference.events.len());
-        for (a, b) in series.events.iter().zip(&reference.events) {
-            assert_eq!(a.direction, b.direction);
-            assert!(
-                (a.t - b.t).abs() < 1e-12 * model.period_us(),
-                "{} vs {}",
-                a.t,
-                b.t
-            );
-        }
-        let state = relative_difference(&series.state, &reference.state);
+        let FlowDifference {
+            state, transition, ..
+        } = compare(&model, &series, &reference, 1e-12);
         assert!(state < 2e-11, "{method:?}: state {state:.2e}");
-        let transition = relative_difference(
-            series.transition.as_slice(),
-            reference.transition.as_slice(),
-        );
         assert!(
             transition < transition_tolerance,
             "{method:?}: transition {transition:.2e}"
@@ -149,38 +104,18 @@ fn series_steps_match_runge_kutta_for_one_three_and_four_modes() {
             .set_separation(Separation::Constant(z))
             .expect("finite");
         let sensitivity = Sensitivity::TransitionAndParameter;
-        let reference = periods(
-            &model,
-            2.0,
-            sensitivity,
-            &Settings {
-                taylor_series: false,
-                ..tight()
-            },
-        );
-        let series = periods(&model, 2.0, sensitivity, &tight());
+        let x0 = model.free_state();
+        let reference = periods(&model, &x0, 2.0, sensitivity, &tight(false));
+        let series = periods(&model, &x0, 2.0, sensitivity, &tight(true));
         // At least two series steps per contact (two events each).
         assert!(series.statistics.series_steps >= series.events.len());
         assert!(series.events.len() >= 4, "{} events", series.events.len());
-        assert_eq!(series.events.len(), reference.events.len());
-        for (a, b) in series.events.iter().zip(&reference.events) {
-            assert!(
-                (a.t - b.t).abs() < 1e-12 * model.period_us(),
-                "{} vs {}",
-                a.t,
-                b.t
-            );
-        }
         let n = modes.len();
-        let state = relative_difference(&series.state, &reference.state);
-        let transition = relative_difference(
-            series.transition.as_slice(),
-            reference.transition.as_slice(),
-        );
-        let parameter = relative_difference(
-            &series.parameter_sensitivity,
-            &reference.parameter_sensitivity,
-        );
+        let FlowDifference {
+            state,
+            transition,
+            parameter,
+        } = compare(&model, &series, &reference, 1e-12);
         eprintln!(
             "{n} modes: state {state:.3e} transition {transition:.3e} parameter {parameter:.3e}"
         );
