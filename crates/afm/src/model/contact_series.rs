@@ -611,21 +611,49 @@ fn state_recurrence(
         } else {
             tau_cos
         };
-        for ((m, out), (qv, previous_qv)) in modes
-            .iter()
-            .zip(next.chunks_exact_mut(2))
-            .zip(row.chunks_exact(2).zip(previous.chunks_exact(2)))
-        {
-            let tau_q = rate * qv[0] + curvature * previous_qv[0];
-            let tau_v = rate * qv[1] + curvature * previous_qv[1];
-            out[0] = tau_v;
-            out[1] = m.drive_acceleration * tau_drive + m.omega_squared_over_stiffness * tau_force
-                - m.omega_squared * tau_q
-                - m.damping * tau_v;
-            total += out[0] + out[1];
-        }
+        total += modal_coefficients(
+            modes,
+            (rate, curvature),
+            (tau_drive, tau_force),
+            row,
+            previous,
+            next,
+        );
     }
     total.is_finite()
+}
+
+/// Coefficient `k + 1` of each mode's `[q_i, q_i']` (Eq. 1 on the clock `t(s)`, MODEL.md
+/// section 1: `q' = tau v`, `v' = tau ((w_i^2/k_i) (F_i D(t) + F_ts) - w_i^2 q - (w_i/Q_i) v)`),
+/// into `next`'s pairs, from the state's coefficients `k` (`row`) and `k - 1` (`previous`) and
+/// `clock = (a / (k + 1), 2 b / (k + 1))` (zero curvature at `k = 0`), with `forcing` the
+/// coefficient `k` of `tau` times the drive factor `D` and of `tau F_ts` (nN). Returns the sum
+/// of the new coefficients (for the recurrence's finiteness check). Pairs beyond the modes (a
+/// sample's state) are left to the caller.
+#[inline(always)]
+pub(crate) fn modal_coefficients(
+    modes: &[ModalConstants],
+    (rate, curvature): (f64, f64),
+    (tau_drive, tau_force): (f64, f64),
+    row: &[f64],
+    previous: &[f64],
+    next: &mut [f64],
+) -> f64 {
+    let mut total = 0.0;
+    for ((m, out), (qv, previous_qv)) in modes
+        .iter()
+        .zip(next.chunks_exact_mut(2))
+        .zip(row.chunks_exact(2).zip(previous.chunks_exact(2)))
+    {
+        let tau_q = rate * qv[0] + curvature * previous_qv[0];
+        let tau_v = rate * qv[1] + curvature * previous_qv[1];
+        out[0] = tau_v;
+        out[1] = m.drive_acceleration * tau_drive + m.omega_squared_over_stiffness * tau_force
+            - m.omega_squared * tau_q
+            - m.damping * tau_v;
+        total += out[0] + out[1];
+    }
+    total
 }
 
 /// The Taylor coefficients of the tangent matrix `V` (`2N` rows: the transition matrix's

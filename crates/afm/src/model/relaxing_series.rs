@@ -21,8 +21,8 @@ use hybrid::{ClockPolynomial, TaylorSeries};
 
 use crate::contact::standard_linear_solid::StandardLinearSolid;
 use crate::model::contact_series::{
-    convolution, indentation_coefficient, indentation_root, phase_series, separation_coefficients,
-    SeriesDrive, MAX_ORDER,
+    convolution, indentation_coefficient, indentation_root, modal_coefficients, phase_series,
+    separation_coefficients, SeriesDrive, MAX_ORDER,
 };
 use crate::model::modal_constants::ModalConstants;
 use crate::model::separation::Separation;
@@ -115,19 +115,14 @@ pub(crate) fn relaxing_state_series(
         if drive.second.is_some() {
             tau_drive += second_factor * (rate * second_cos[k] + curvature * second_cos[below]);
         }
-        for ((m, out), (qv, previous_qv)) in modes
-            .iter()
-            .zip(next.chunks_exact_mut(2))
-            .zip(row.chunks_exact(2).zip(previous.chunks_exact(2)))
-        {
-            let tau_q = rate * qv[0] + curvature * previous_qv[0];
-            let tau_v = rate * qv[1] + curvature * previous_qv[1];
-            out[0] = tau_v;
-            out[1] = m.drive_acceleration * tau_drive + m.omega_squared_over_stiffness * tau_force
-                - m.omega_squared * tau_q
-                - m.damping * tau_v;
-            total += out[0] + out[1];
-        }
+        total += modal_coefficients(
+            modes,
+            (rate, curvature),
+            (tau_drive, tau_force),
+            row,
+            previous,
+            next,
+        );
         next[last] = rate * relaxation[k] + curvature * relaxation[below];
         total += next[last];
     }
