@@ -31,6 +31,10 @@ use crate::model::TappingModel;
 /// which the two-exponential form loses accuracy: [`FreeFlightFourier::new`] declines them.
 pub(crate) const CRITICAL_DAMPING_MARGIN: f64 = 1e-3;
 
+/// The harmonics [`FreeFlightFourier::add_harmonics`] integrates in one pass (more are taken
+/// in further passes): the room of its stack tables.
+pub const HARMONICS_PER_PASS: usize = 20;
+
 /// One mode's free flight split for the closed forms: the steady part
 /// `p(t) = alpha cos(w t) + beta sin(w t)` and the characteristic roots of the homogeneous
 /// part (shared with [`crate::model::free_flight_energy`]).
@@ -80,8 +84,19 @@ impl FreeFlightMode {
     /// (nm, nm/us) at time `a` under the drive `w` (rad/us): `y(s) = c_1 e^{lambda_1 s} +
     /// c_2 e^{lambda_2 s}`, `s = t - a`, with `y = q - p`.
     pub(crate) fn homogeneous(&self, w: f64, a: f64, q: f64, velocity: f64) -> [Complex<f64>; 2] {
+        self.homogeneous_at_phase(w, (w * a).sin_cos(), q, velocity)
+    }
+
+    /// [`FreeFlightMode::homogeneous`] with the drive phase at `a` given, `(sin w a, cos w a)`
+    /// (shared by every mode of a flight).
+    pub(crate) fn homogeneous_at_phase(
+        &self,
+        w: f64,
+        (sin_a, cos_a): (f64, f64),
+        q: f64,
+        velocity: f64,
+    ) -> [Complex<f64>; 2] {
         let [alpha, beta] = self.steady;
-        let (sin_a, cos_a) = (w * a).sin_cos();
         let p = alpha * cos_a + beta * sin_a;
         let dp = w * (beta * cos_a - alpha * sin_a);
         let y = q - p;
@@ -191,14 +206,15 @@ impl FreeFlightFourier {
         if self.second.is_some() {
             return self.integrate_frequency(k as f64 * self.angular_frequency, a, x_a, b);
         }
-        let coefficients = self.homogeneous_coefficients(a, x_a);
-        self.integrate_harmonic_from(k, a, &coefficients, b)
+        let mut integral = [Complex::new(0.0, 0.0)];
+        self.harmonic_integrals(k, a, x_a, b, &mut integral);
+        [integral[0].re, -integral[0].im]
     }
 
     /// Add [`FreeFlightFourier::integrate_harmonic`] for every harmonic `k = 1..=totals.len()`
     /// to `totals[k - 1]` (nm us), for free flight from state `x_a` at time `a` (us) to time
-    /// `b >= a`. The homogeneous parts' coefficients, which do not depend on `k`, are
-    /// computed once for all harmonics (the same numbers as harmonic by harmonic).
+    /// `b >= a`: the same numbers as harmonic by harmonic, with what does not depend on `k`
+    /// computed once for all of them ([`FreeFlightFourier::harmonic_integrals`]).
     pub fn add_harmonics(&self, a: f64, x_a: &[f64], b: f64, totals: &mut [[f64; 2]]) {
         if self.second.is_some() {
             for (k, total) in totals.iter_mut().enumerate() {
@@ -209,59 +225,87 @@ impl FreeFlightFourier {
             }
             return;
         }
-        let coefficients = self.homogeneous_coefficients(a, x_a);
-        for (k, total) in totals.iter_mut().enumerate() {
-            let [cosine, sine] = self.integrate_harmonic_from(k + 1, a, &coefficients, b);
-            total[0] += cosine;
-            total[1] += sine;
-        }
-    }
-
-    /// Each mode's homogeneous coefficients `[c_1, c_2]` (nm) of the single-drive flight from
-    /// `x_a` at `a` ([`FreeFlightMode::homogeneous`]).
-    fn homogeneous_coefficients(&self, a: f64, x_a: &[f64]) -> Vec<[Complex<f64>; 2]> {
-        let w = self.angular_frequency;
-        self.modes
-            .iter()
-            .enumerate()
-            .map(|(i, mode)| mode.homogeneous(w, a, x_a[2 * i], x_a[2 * i + 1]))
-            .collect()
-    }
-
-    /// [`FreeFlightFourier::integrate_harmonic`] of a single drive, from the modes' homogeneous
-    /// coefficients at `a` (one `[c_1, c_2]` per mode).
-    fn integrate_harmonic_from(
-        &self,
-        k: usize,
-        a: f64,
-        homogeneous_coefficients: &[[Complex<f64>; 2]],
-        b: f64,
-    ) -> [f64; 2] {
-        let w = self.angular_frequency;
-        let kw = k as f64 * w;
-        let length = b - a;
-        let (sin_ka, cos_ka) = (kw * a).sin_cos();
-        // e^{-ikwa}, by which the homogeneous part is rotated.
-        let rotation_a = Complex::new(cos_ka, -sin_ka);
-        // The steady part's two exponentials against e^{-ikwt}: frequencies (1 - k) w and
-        // -(1 + k) w, each integrated over [a, b] without cancellation for short L.
-        let co_rotating = exponential_integral((1.0 - k as f64) * w, a, length);
-        let counter_rotating = exponential_integral(-(1.0 + k as f64) * w, a, length);
-        let minus_ikw = Complex::new(0.0, -kw);
-        let mut total = Complex::new(0.0, 0.0);
-        for (mode, coefficients) in self.modes.iter().zip(homogeneous_coefficients) {
-            let [alpha, beta] = mode.steady;
-            // The steady part.
-            let steady = Complex::new(alpha, -beta) * 0.5 * co_rotating
-                + Complex::new(alpha, beta) * 0.5 * counter_rotating;
-            let mut homogeneous = Complex::new(0.0, 0.0);
-            for (&c, l) in coefficients.iter().zip(mode.roots) {
-                let z = l + minus_ikw;
-                homogeneous += c * ((z * length).exp() - 1.0) / z;
+        let mut integrals = [Complex::new(0.0, 0.0); HARMONICS_PER_PASS];
+        for (pass, chunk) in totals.chunks_mut(HARMONICS_PER_PASS).enumerate() {
+            let integrals = &mut integrals[..chunk.len()];
+            self.harmonic_integrals(pass * HARMONICS_PER_PASS + 1, a, x_a, b, integrals);
+            for (total, integral) in chunk.iter_mut().zip(integrals.iter()) {
+                total[0] += integral.re;
+                total[1] += -integral.im;
             }
-            total += (steady + rotation_a * homogeneous) * mode.optical_sensitivity;
         }
-        [total.re, -total.im]
+    }
+
+    /// `J_k = int_a^b u e^{-ikwt} dt` (nm us; `int u cos = Re J_k`, `int u sin = -Im J_k`) of a
+    /// single drive for the harmonics `k = first, first + 1, ...` (one per element of
+    /// `integrals`, at most [`HARMONICS_PER_PASS`]), for free flight from `x_a` at `a` to `b`:
+    /// the closed form of [`FreeFlightFourier::integrate_harmonic`]. What does not depend on
+    /// `k` is computed once: each mode's homogeneous coefficients (with the drive phase at `a`
+    /// once for all modes), each root's decay `exp(Re(lambda) L)` (the modulus of
+    /// `e^{(lambda - ikw) L}`, num-complex's `exp` being `from_polar(exp(re), im)`), and the
+    /// steady part's integrals of `e^{-imwt}`, `m = k - 1` (co-rotating) and `m = k + 1`
+    /// (counter-rotating), each shared by two harmonics. Every number is the same operation on
+    /// the same operands as harmonic by harmonic, so the integrals are the same bits.
+    fn harmonic_integrals(
+        &self,
+        first: usize,
+        a: f64,
+        x_a: &[f64],
+        b: f64,
+        integrals: &mut [Complex<f64>],
+    ) {
+        let count = integrals.len();
+        debug_assert!(first >= 1 && count <= HARMONICS_PER_PASS);
+        let w = self.angular_frequency;
+        let length = b - a;
+        // `int_a^b e^{-imwt} dt` for m = first - 1 ..= first + count: `(1 - k) w` and
+        // `-(1 + k) w` are the double `-m w` (exact small integers; at m = 0 a zero).
+        let mut steady_integrals = [Complex::new(0.0, 0.0); HARMONICS_PER_PASS + 2];
+        for (j, integral) in steady_integrals[..count + 2].iter_mut().enumerate() {
+            let m = first - 1 + j;
+            *integral = exponential_integral(-(m as f64) * w, a, length);
+        }
+        // e^{-ikwa}, by which the homogeneous part is rotated (at k = 1 the phase the modes'
+        // coefficients need, `k w` being `w` there).
+        let phase_a = (w * a).sin_cos();
+        let mut rotations = [Complex::new(0.0, 0.0); HARMONICS_PER_PASS];
+        for (j, rotation) in rotations[..count].iter_mut().enumerate() {
+            let kw = (first + j) as f64 * w;
+            let (sin_ka, cos_ka) = (kw * a).sin_cos();
+            *rotation = Complex::new(cos_ka, -sin_ka);
+        }
+        integrals.fill(Complex::new(0.0, 0.0));
+        for (i, mode) in self.modes.iter().enumerate() {
+            let coefficients = mode.homogeneous_at_phase(w, phase_a, x_a[2 * i], x_a[2 * i + 1]);
+            // `(lambda + 0) L`: the real part of `(lambda - ikw) L`, whatever `k`.
+            let decays = mode.roots.map(|l| {
+                let exponent = (l.re + 0.0) * length;
+                exponent.is_finite().then(|| exponent.exp())
+            });
+            let [alpha, beta] = mode.steady;
+            for (j, integral) in integrals.iter_mut().enumerate() {
+                let kw = (first + j) as f64 * w;
+                let minus_ikw = Complex::new(0.0, -kw);
+                // The steady part.
+                let steady = Complex::new(alpha, -beta) * 0.5 * steady_integrals[j]
+                    + Complex::new(alpha, beta) * 0.5 * steady_integrals[j + 2];
+                let mut homogeneous = Complex::new(0.0, 0.0);
+                for ((&c, l), decay) in coefficients.iter().zip(mode.roots).zip(decays) {
+                    let z = l + minus_ikw;
+                    // `(z L).exp()` (num-complex: `from_polar(exp(re), im)`, its corner cases
+                    // of an infinite or NaN real part left to it).
+                    let growth = match decay {
+                        Some(modulus) => {
+                            let (sin, cos) = (z.im * length).sin_cos();
+                            Complex::new(modulus * cos, modulus * sin)
+                        }
+                        None => (z * length).exp(),
+                    };
+                    homogeneous += c * (growth - 1.0) / z;
+                }
+                *integral += (steady + rotations[j] * homogeneous) * mode.optical_sensitivity;
+            }
+        }
     }
 }
 
