@@ -260,12 +260,28 @@ fn update_reciprocal_gap(reciprocal: &mut [f64], delta: &[f64], k: usize) {
 
 /// Coefficient `m` of the product of two series from their coefficients `0..=m`, `a` and `b`
 /// (`b` at least as long as `a`, of length `m + 1`): `sum_{j=0}^{m} a_j b_{m-j}`.
-#[inline]
+///
+/// The products are formed four at a time (independent of each other) and added one by one in
+/// the order `j = 0, 1, ..., m` from `-0.0`, as `Iterator::sum` adds them: the same bits as
+/// the plain loop, in fewer instructions (no loop test per term, the four products in one
+/// vector multiplication where the CPU has one).
+#[inline(always)]
 pub(crate) fn convolution(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b[..a.len()].iter().rev())
-        .map(|(x, y)| x * y)
-        .sum()
+    let b = &b[..a.len()];
+    let mut sum = -0.0;
+    let (a_blocks, b_blocks) = (a.chunks_exact(4), b.rchunks_exact(4));
+    let (a_rest, b_rest) = (a_blocks.remainder(), b_blocks.remainder());
+    for (x, y) in a_blocks.zip(b_blocks) {
+        let products = [x[0] * y[3], x[1] * y[2], x[2] * y[1], x[3] * y[0]];
+        sum += products[0];
+        sum += products[1];
+        sum += products[2];
+        sum += products[3];
+    }
+    for (x, y) in a_rest.iter().zip(b_rest.iter().rev()) {
+        sum += x * y;
+    }
+    sum
 }
 
 /// Coefficient `k` of `r = sqrt(y)` from `y`'s coefficients to `k` and `r`'s to `k - 1`
