@@ -294,3 +294,45 @@ fn tangent_series(
     );
     tangents
 }
+
+/// The blocked [`crate::model::contact_series::convolution`] is the plain sum
+/// `sum_{j=0}^{m} a_j b_{m-j}` of `Iterator::sum` (written here) bit for bit, for every length
+/// of the series (0 to 41 terms, the remainders of the blocks of four included) on values
+/// spread over 40 orders of magnitude and both signs, where any other order of the additions
+/// would round differently; and an empty sum is `-0.0`, as `Iterator::sum`'s.
+#[test]
+fn blocked_convolution_adds_in_the_plain_order() {
+    use crate::model::contact_series::convolution;
+    let plain = |a: &[f64], b: &[f64]| -> f64 {
+        a.iter()
+            .zip(b[..a.len()].iter().rev())
+            .map(|(x, y)| x * y)
+            .sum()
+    };
+    // A deterministic spread of magnitudes and signs (a linear congruential sequence).
+    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let unit = (seed >> 11) as f64 / (1u64 << 53) as f64;
+        let exponent = ((seed >> 3) % 40) as i32 - 20;
+        (unit - 0.5) * 10f64.powi(exponent)
+    };
+    let a: Vec<f64> = (0..42).map(|_| next()).collect();
+    let b: Vec<f64> = (0..42).map(|_| next()).collect();
+    let mut differs_from_reversed_order = 0;
+    for m in 0..=41 {
+        let (x, y) = (&a[..m], &b[..m]);
+        let blocked = convolution(x, y);
+        assert_eq!(blocked.to_bits(), plain(x, y).to_bits(), "{m} terms");
+        let reversed: f64 = x.iter().zip(y.iter().rev()).map(|(p, q)| p * q).rev().sum();
+        differs_from_reversed_order += usize::from(reversed.to_bits() != blocked.to_bits());
+    }
+    // The data do tell the orders of summation apart (else the test could not fail).
+    assert!(
+        differs_from_reversed_order > 10,
+        "{differs_from_reversed_order}"
+    );
+    assert!(convolution(&[], &[]).is_sign_negative());
+}
