@@ -384,7 +384,7 @@ fn update_jkr_root(
 /// an onset, `delta_0 > 0` and [`update_root`] applies (it needs `delta` to `m`). On an onset
 /// (`delta = s^2 g`, `g_j = delta_{j+2}`), `r = s sqrt(g)`: `r_0 = 0` and `r_m = sqrt(g)_{m-1}`
 /// (it needs `delta` to `m + 1`).
-#[inline]
+#[inline(always)]
 pub(crate) fn indentation_root(root: &mut [f64], delta: &[f64], m: usize, onset: bool) {
     if !onset {
         update_root(root, delta, m);
