@@ -599,15 +599,16 @@ impl SwitchingStructure for TappingModel {
                     let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
                     let [pb, dpb] = self.second_steady_state(i, t0);
                     let (y, dy) = (x0[2 * i] - p - pb, x0[2 * i + 1] - dp - dpb);
-                    let [alpha, beta] = m.oscillator.steady_coefficients();
                     // A bimodal drive's second steady response adds `w_b^2 P_bi`.
                     let second = self.second.as_ref().map_or(0.0, |second| {
                         let [a, b] = second.oscillators[i].steady_coefficients();
                         second.angular_frequency * second.angular_frequency * a.hypot(b)
                     });
-                    let steady = w * w * alpha.hypot(beta) + second;
-                    let homogeneous = (m.omega_squared.sqrt() + m.damping)
-                        * (dy * dy + m.omega_squared * y * y).sqrt();
+                    // `w^2 hypot(alpha_i, beta_i)` and `sqrt(w_i^2) + w_i/Q_i`, kept with the
+                    // mode's constants.
+                    let steady = m.steady_curvature + second;
+                    let homogeneous =
+                        m.homogeneous_rate * (dy * dy + m.omega_squared * y * y).sqrt();
                     steady + homogeneous
                 })
                 .sum::<f64>();

@@ -129,6 +129,7 @@ impl HybridSystem for TappingModel {
     /// `h_0 = d + sigma`, `sigma = rho^{2/3}` its unrecovered depth); a clipped Kelvin-Voigt
     /// law's `h_1 = -d - tau d'`, nm; a hysteretic law's `h_1 = d - d_r`, nm (MODEL.md
     /// sections 9 and 14).
+    #[inline]
     fn switching(&self, k: usize, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
             self.gap(t, x) - self.contact_gap_nm()
@@ -144,6 +145,7 @@ impl HybridSystem for TappingModel {
     /// `rho'` for a standard linear solid), nm/us;
     /// `dh_1/dt = -d' - tau d''` with `d'' = sum_i q_i''` of mode `mode` (`Z'' = 0`).
     /// A hysteretic law's `dh_1/dt = d'`.
+    #[inline]
     fn switching_rate(&self, k: usize, mode: Mode, t: f64, x: &[f64]) -> f64 {
         if k == GAP_SURFACE {
             self.gap_rate_at(t, x) + self.surface_depth_rate(mode, t, x)

@@ -25,6 +25,13 @@ pub(crate) struct ModalConstants {
     /// `exact_step_limit / c`): computed once, the same numbers the oscillator gives per call.
     pub(crate) step_transition: [[f64; 2]; 2],
     pub(crate) grid_transitions: [[[f64; 2]; 2]; KEPT_GRIDS],
+    /// `w^2 P_i = w^2 hypot(alpha_i, beta_i)`, nm/us^2: the bound on the steady free
+    /// response's `|q_p''|` under the drive `w` (of `TappingModel::switching_curvature_bound`,
+    /// computed once, the same number).
+    pub(crate) steady_curvature: f64,
+    /// `sqrt(w_i^2) + w_i/Q_i`, 1/us: the rate that bounds the homogeneous part's `|y''|` from
+    /// its energy (of `TappingModel::switching_curvature_bound`, computed once).
+    pub(crate) homogeneous_rate: f64,
 }
 
 impl ModalConstants {
@@ -40,10 +47,16 @@ impl ModalConstants {
             static_deflection,
             drive.angular_frequency,
         );
+        let w = drive.angular_frequency;
+        let [alpha, beta] = oscillator.steady_coefficients();
+        let omega_squared = omega * omega;
+        let damping = omega / mode.quality_factor;
         Self {
-            omega_squared: omega * omega,
+            omega_squared,
             omega_squared_over_stiffness: omega * omega / mode.stiffness_n_per_m,
-            damping: omega / mode.quality_factor,
+            damping,
+            steady_curvature: w * w * alpha.hypot(beta),
+            homogeneous_rate: omega_squared.sqrt() + damping,
             drive_acceleration: omega * omega * static_deflection,
             optical_sensitivity: mode.optical_sensitivity,
             step_transition: oscillator.homogeneous_transition(exact_step_limit),
