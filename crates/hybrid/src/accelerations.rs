@@ -45,6 +45,7 @@ impl<'a> Accelerations<'a> {
 
     /// Whether mode `mode` has a closed-form flow ([`ExactFlow::has_exact_flow`]; `false`
     /// without one).
+    #[inline]
     pub fn has_exact_flow(&self, mode: Mode) -> bool {
         self.exact_flow
             .is_some_and(|flow| flow.has_exact_flow(mode))

@@ -270,8 +270,12 @@ impl FreeFlightFourier {
         let phase_a = (w * a).sin_cos();
         let mut rotations = [Complex::new(0.0, 0.0); HARMONICS_PER_PASS];
         for (j, rotation) in rotations[..count].iter_mut().enumerate() {
-            let kw = (first + j) as f64 * w;
-            let (sin_ka, cos_ka) = (kw * a).sin_cos();
+            let k = first + j;
+            let (sin_ka, cos_ka) = if k == 1 {
+                phase_a
+            } else {
+                (k as f64 * w * a).sin_cos()
+            };
             *rotation = Complex::new(cos_ka, -sin_ka);
         }
         integrals.fill(Complex::new(0.0, 0.0));
