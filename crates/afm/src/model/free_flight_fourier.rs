@@ -33,7 +33,7 @@ pub(crate) const CRITICAL_DAMPING_MARGIN: f64 = 1e-3;
 
 /// The harmonics [`FreeFlightFourier::add_harmonics`] integrates in one pass (more are taken
 /// in further passes): the room of its stack tables.
-pub const HARMONICS_PER_PASS: usize = 20;
+pub(crate) const HARMONICS_PER_PASS: usize = 20;
 
 /// One mode's free flight split for the closed forms: the steady part
 /// `p(t) = alpha cos(w t) + beta sin(w t)` and the characteristic roots of the homogeneous
