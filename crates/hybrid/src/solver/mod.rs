@@ -186,6 +186,10 @@ pub struct Statistics {
     pub events: usize,
     /// Accepted Taylor-series steps (included in `steps`).
     pub series_steps: usize,
+    /// Runge-Kutta steps redone onto a crossing of a half-power surface at which the mode's
+    /// Jacobian diverges, ending exactly on it (not counted in `steps`; see the module docs,
+    /// "Half-power surfaces").
+    pub redone_steps: usize,
     /// Steps sampled inside (at `samples_per_step` interior points) for extrema and brief
     /// dips; the others were proven clear of the surfaces or settled on their interpolant and
     /// sampled at their ends only (see the module docs).
