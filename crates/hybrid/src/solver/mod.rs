@@ -107,6 +107,16 @@
 //!   locates it on its own dense output when the kink makes it fail. A rejected trial that
 //!   passed a crossing of the surface is likewise located on its dense output and the clock
 //!   re-centred there.
+//! * where the field has a `|h_k|^{1/2}` term, so that its Jacobian grows as `|h_k|^{-1/2}`
+//!   ([`crate::SwitchingStructure::jacobian_diverges_at_crossing`]: JKR's force at pull-off, a
+//!   viscous contact at release), the clock centred `ROOT_OVERSHOOT` past the predicted crossing
+//!   leaves `(dt/dsigma) J` a branch point inside the landing step, and the tangents an error of
+//!   about `sqrt(ROOT_OVERSHOOT)` of the step's share that no tolerance removes. The
+//!   Runge-Kutta step in which such a crossing fires is therefore redone from its start on the
+//!   clock centred on the crossing located in it, ending there (`Solver::redo_onto_crossing`;
+//!   one more attempt of 12 stages and the dense output per crossing; the event then fires at
+//!   the redone step's end, and the redone step is the one observers see). A Taylor step does
+//!   not land on such a crossing: it leaves that to the Runge-Kutta step.
 //!
 //! # Taylor-series steps
 //!

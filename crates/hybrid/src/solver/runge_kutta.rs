@@ -473,7 +473,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         };
         {
             let mut rhs = clocked_field(&mut buffers.field, system, mode, clock, true);
-            buffers.rk.derivative_at_end(&mut rhs, sigma0, &buffers.z_new);
+            buffers
+                .rk
+                .derivative_at_end(&mut rhs, sigma0, &buffers.z_new);
         }
         {
             let mut rhs = clocked_field(&mut buffers.field, system, mode, clock, false);
