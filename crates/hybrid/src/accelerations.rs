@@ -389,8 +389,11 @@ pub trait SwitchingStructure {
     /// with a relative error of about `sqrt(eps / step)` that no control of the state's error
     /// sees. The solver therefore redoes a Runge-Kutta step in which a crossing of this mode's
     /// half-power surface fires on the square-root clock centred on the located crossing,
-    /// ending there (see [`crate::solver`], "Half-power surfaces"). The default is `false`
-    /// (a Jacobian bounded next to the surface, as Hertz's `~ |h|^{1/2}`).
+    /// ending there (see [`crate::solver`], "Half-power surfaces"); a Taylor step landing on
+    /// the crossing is not redone, so a system declaring the divergence gives no series on a
+    /// square-root clock centred ahead of a crossing in that mode
+    /// ([`TaylorExpansion::taylor_series`] returns `false` there). The default is `false` (a
+    /// Jacobian bounded next to the surface, as Hertz's `~ |h|^{1/2}`).
     fn jacobian_diverges_at_crossing(&self, mode: Mode) -> bool {
         let _ = mode;
         false

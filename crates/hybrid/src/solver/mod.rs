@@ -115,8 +115,10 @@
 //!   Runge-Kutta step in which such a crossing fires is therefore redone from its start on the
 //!   clock centred on the crossing located in it, ending there (`Solver::redo_onto_crossing`;
 //!   one more attempt of 12 stages and the dense output per crossing; the event then fires at
-//!   the redone step's end, and the redone step is the one observers see). A Taylor step does
-//!   not land on such a crossing: it leaves that to the Runge-Kutta step.
+//!   the redone step's end, and the redone step is the one observers see). A system that
+//!   declares the divergence gives no Taylor series on a square-root clock centred ahead
+//!   (afm's JKR series run on the time clock only), whose tangents would be summed at the
+//!   branch point.
 //!
 //! # Taylor-series steps
 //!

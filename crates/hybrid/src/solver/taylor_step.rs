@@ -116,12 +116,6 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 // to the Runge-Kutta step's own landing.
                 return Ok(None);
             }
-            if landing && accelerations.jacobian_diverges_at_crossing(mode) {
-                // The tangents' series would be summed at the crossing, a branch point of
-                // theirs `ROOT_OVERSHOOT` before the reference: the Runge-Kutta step lands and
-                // is redone ending on the crossing (`Solver::redo_onto_crossing`).
-                return Ok(None);
-            }
             self.predicted_crossing = crossing;
             break self.series_step_length(clock, sigma0, reach, t_end);
         };
