@@ -494,13 +494,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// [`crate::SensitivityMethod::Decoupled`] (as [`Solver::finish_runge_kutta_step`] does for
     /// an accepted step, which keeps its own copy: sharing this one changed the inlining of the
     /// stepping loop, and Hertz's diagrams took 0.4% more instructions).
-    fn complete_redone_step(
-        &mut self,
-        mode: Mode,
-        clock: Clock,
-        sigma0: f64,
-        dsigma: f64,
-    ) {
+    fn complete_redone_step(&mut self, mode: Mode, clock: Clock, sigma0: f64, dsigma: f64) {
         let (system, n) = (self.system, self.n);
         let buffers = &mut self.buffers;
         let z0 = &buffers.z_start;
