@@ -111,6 +111,13 @@ impl<'a> Accelerations<'a> {
             .and_then(|switching| switching.half_power_surface(mode))
     }
 
+    /// [`SwitchingStructure::jacobian_diverges_at_crossing`] of mode `mode`; `false` when
+    /// unknown.
+    pub fn jacobian_diverges_at_crossing(&self, mode: Mode) -> bool {
+        self.switching
+            .is_some_and(|switching| switching.jacobian_diverges_at_crossing(mode))
+    }
+
     /// [`SwitchingStructure::switching_curvature_bound`]; `None` when unknown.
     pub fn switching_curvature_bound(
         &self,
@@ -372,6 +379,25 @@ pub trait SwitchingStructure {
     fn half_power_surface(&self, mode: Mode) -> Option<usize> {
         let _ = mode;
         None
+    }
+
+    /// Whether the Jacobian of mode `mode`'s field grows without bound at its
+    /// [`SwitchingStructure::half_power_surface`] (as `|h|^{-1/2}`: a field with a `|h|^{1/2}`
+    /// term, for which [`SwitchingStructure::crossing_tangent_limit`] gives the limit at the
+    /// crossing). The variational equations on a square-root clock are then smooth only on the
+    /// clock centred exactly on the crossing: on one centred `eps` past it, `(dt/dsigma) J`
+    /// has a branch point `sqrt(eps)` from the step's end, which a Runge-Kutta step integrates
+    /// with a relative error of about `sqrt(eps / step)` that no control of the state's error
+    /// sees. The solver therefore redoes a Runge-Kutta step in which a crossing of this mode's
+    /// half-power surface fires on the square-root clock centred on the located crossing,
+    /// ending there (see [`crate::solver`], "Half-power surfaces"); a Taylor step landing on
+    /// the crossing is not redone, so a system declaring the divergence gives no series on a
+    /// square-root clock centred ahead of a crossing in that mode
+    /// ([`TaylorExpansion::taylor_series`] returns `false` there). The default is `false` (a
+    /// Jacobian bounded next to the surface, as Hertz's `~ |h|^{1/2}`).
+    fn jacobian_diverges_at_crossing(&self, mode: Mode) -> bool {
+        let _ = mode;
+        false
     }
 
     /// For a field that grows as `|h|^{1/2}` from its half-power surface (a viscous contact

@@ -102,6 +102,7 @@ impl Samples {
     /// # Errors
     /// [`HybridError::NonFiniteSwitching`] if a sample is NaN or infinite.
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     pub fn sample<S: HybridSystem + ?Sized>(
         &mut self,
         system: &S,
@@ -165,6 +166,7 @@ impl Samples {
     /// # Errors
     /// [`HybridError::NonFiniteSwitching`] if a sample is NaN or infinite.
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     pub fn sample_ends<S: HybridSystem + ?Sized>(
         &mut self,
         system: &S,
@@ -208,6 +210,7 @@ impl Samples {
     /// the surface is not searched (its extremum, if any, is neither located nor reported:
     /// it cannot hide a crossing).
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     pub fn locate_extrema<S: HybridSystem + ?Sized>(
         &mut self,
         system: &S,

@@ -39,6 +39,7 @@ fn hertz_contact_statistics_are_pinned() {
             rhs_evaluations: 2935,
             events: 5,
             series_steps: 0,
+            redone_steps: 0,
             sampled_steps: 180,
         }
     );
@@ -99,6 +100,7 @@ fn bouncing_ball_statistics_are_pinned() {
             rhs_evaluations: 382,
             events: 20,
             series_steps: 0,
+            redone_steps: 0,
             sampled_steps: 24,
         }
     );

@@ -423,6 +423,18 @@ impl SwitchingStructure for TappingModel {
             .then_some(GAP_SURFACE)
     }
 
+    /// Kelvin-Voigt in contact (unclipped side) and JKR while attached: the laws whose
+    /// [`SwitchingStructure::crossing_tangent_limit`] is given below (`dF/dd ~ s^{-1/2}` at the
+    /// half-power surface), so that a Runge-Kutta step through a release or a pull-off is
+    /// redone on the square-root clock centred exactly on the crossing.
+    fn jacobian_diverges_at_crossing(&self, mode: Mode) -> bool {
+        match self.force.law {
+            ContactLaw::KelvinVoigt(_) => Self::in_contact(mode) && !self.is_clipped(mode),
+            ContactLaw::Jkr(_) => Self::is_attached(mode),
+            _ => false,
+        }
+    }
+
     /// Kelvin-Voigt in contact (unclipped side): `F = c s^{1/2} (s + tau s')` has
     /// `dF/dd = -c s^{-1/2} (1.5 s + 0.5 tau s')`, whose part `-0.5 c tau s' s^{-1/2}` is
     /// unbounded at the crossing; there `s = |s'| sigma^2` on the square-root clock, so

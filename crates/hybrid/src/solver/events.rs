@@ -134,6 +134,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
         let reset = system.has_reset(k, direction);
         let mut t_event = bracket.far;
+        if !reset {
+            self.redo_onto_crossing(k, t_event)?;
+        }
         self.augmented_at(t_event);
         if reset {
             // Does the reset send the state back to the side it came from (a bounce)? Then

@@ -107,6 +107,18 @@
 //!   locates it on its own dense output when the kink makes it fail. A rejected trial that
 //!   passed a crossing of the surface is likewise located on its dense output and the clock
 //!   re-centred there.
+//! * where the field has a `|h_k|^{1/2}` term, so that its Jacobian grows as `|h_k|^{-1/2}`
+//!   ([`crate::SwitchingStructure::jacobian_diverges_at_crossing`]: JKR's force at pull-off, a
+//!   viscous contact at release), the clock centred `ROOT_OVERSHOOT` past the predicted crossing
+//!   leaves `(dt/dsigma) J` a branch point inside the landing step, and the tangents an error of
+//!   about `sqrt(ROOT_OVERSHOOT)` of the step's share that no tolerance removes. The
+//!   Runge-Kutta step in which such a crossing fires is therefore redone from its start on the
+//!   clock centred on the crossing located in it, ending there (`Solver::redo_onto_crossing`;
+//!   one more attempt of 12 stages and the dense output per crossing; the event then fires at
+//!   the redone step's end, and the redone step is the one observers see). A system that
+//!   declares the divergence gives no Taylor series on a square-root clock centred ahead
+//!   (afm's JKR series run on the time clock only), whose tangents would be summed at the
+//!   branch point.
 //!
 //! # Taylor-series steps
 //!
@@ -186,6 +198,10 @@ pub struct Statistics {
     pub events: usize,
     /// Accepted Taylor-series steps (included in `steps`).
     pub series_steps: usize,
+    /// Runge-Kutta steps redone onto a crossing of a half-power surface at which the mode's
+    /// Jacobian diverges, ending exactly on it (not counted in `steps`; see the module docs,
+    /// "Half-power surfaces").
+    pub redone_steps: usize,
     /// Steps sampled inside (at `samples_per_step` interior points) for extrema and brief
     /// dips; the others were proven clear of the surfaces or settled on their interpolant and
     /// sampled at their ends only (see the module docs).
