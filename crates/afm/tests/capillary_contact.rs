@@ -274,7 +274,8 @@ fn vanishing_meniscus_reproduces_hertz_grazing() {
 /// equality, its `A/A0` to 1e-5 of the root `A` of `A (A0 sin(phi) - A) = E_m Q / (pi k)` at
 /// its phase (the higher harmonics' share of the damping and the branch end's location to the
 /// continuation's smallest step; measured 7e-7), and the approach's first point past the jump
-/// lies below it.
+/// lies below it, within one step of the walk past the jump (`A0/100`: the walk skips no
+/// separation where a stable period-1 orbit exists).
 #[test]
 fn the_approach_jumps_over_the_band_of_intermittent_taps() {
     let model = humid_model(0.0);
@@ -336,5 +337,15 @@ fn the_approach_jumps_over_the_band_of_intermittent_taps() {
         first.amplitude_ratio < root + 1e-5,
         "{}",
         first.amplitude_ratio
+    );
+    // The walk past the jump (steps of A0/100 from half a largest step below G1) lands on the
+    // first of its separations below the retract's branch end, where the stable period-1
+    // orbit exists: it skips none.
+    let walk_step = a0 / 100.0;
+    assert!(
+        first.z_nm < end.z_nm && first.z_nm > end.z_nm - walk_step,
+        "landed at {} nm, branch end at {} nm",
+        first.z_nm,
+        end.z_nm
     );
 }

@@ -101,6 +101,16 @@ impl ContactLaw {
         }
     }
 
+    /// The energy (nN nm) a hysteretic law takes from the cantilever per attachment, where it
+    /// is one number: the meniscus's loop area `F_m d_r` (MODEL.md section 9). `None` for
+    /// every other law (JKR's loop area is not formed here).
+    pub fn formation_loss_nn_nm(&self) -> Option<f64> {
+        match self {
+            Self::Capillary(capillary) => Some(capillary.loop_area_nn_nm()),
+            _ => None,
+        }
+    }
+
     /// A hysteretic law's force and slopes while attached, inside contact (`inside`, `d < d_c`)
     /// or in the band `d_c <= d < d_r`: JKR's `F(a(-d))` on both sides, Hertz minus the
     /// meniscus force for the capillary law; [`ContactLaw::inside`] or zero for the others.

@@ -54,7 +54,7 @@ impl ExactFlow for TappingModel {
         states: &mut [f64],
     ) {
         let n = self.dim();
-        let force = self.flight_force_nn(mode).unwrap_or(0.0);
+        let force = self.constant_flight_force_nn(mode);
         let spacing = grid_spacing(dt, count);
         let w = self.drive.angular_frequency;
         // The index of the kept spacing, for a grid over the standard step.
@@ -98,14 +98,10 @@ impl ExactFlow for TappingModel {
             } else {
                 self.second_steady_state(i, t0)
             };
-            let offset = m.static_offset(force);
             let mut y = [
                 x0[2 * i] - start[0] - second[0],
                 x0[2 * i + 1] - start[1] - second[1],
             ];
-            if force != 0.0 {
-                y[0] -= offset;
-            }
             let (mut sin, mut cos) = (sin0, cos0);
             for j in 0..count {
                 y = [
@@ -124,10 +120,10 @@ impl ExactFlow for TappingModel {
                 };
                 states[j * n + 2 * i] = steady[0] + second[0] + y[0];
                 states[j * n + 2 * i + 1] = steady[1] + second[1] + y[1];
-                if force != 0.0 {
-                    states[j * n + 2 * i] += offset;
-                }
             }
+        }
+        if force != 0.0 {
+            self.add_constant_force_response(force, dt, count, states);
         }
         if let Some(sls) = self.force.law.standard_linear_solid() {
             // The unloaded surface's recovery `rho(t) = rho_0 exp(-(1 - beta) (t - t_0) / tau)`.
@@ -160,7 +156,7 @@ impl ExactFlow for TappingModel {
         let start_phase = phase::sin_cos(self.drive.angular_frequency * t0);
         let end_phase = phase::sin_cos(self.drive.angular_frequency * (t0 + dt));
         let standard = dt == self.exact_step_limit;
-        let force = self.flight_force_nn(mode).unwrap_or(0.0);
+        let force = self.constant_flight_force_nn(mode);
         // A bimodal drive's second phase at both ends, shared by the modes.
         let second_phases = self.second.as_ref().map(|second| {
             (
@@ -183,19 +179,14 @@ impl ExactFlow for TappingModel {
                 ),
                 None => ([0.0, 0.0], [0.0, 0.0]),
             };
-            let mut from = [x0[2 * i] - start[0], x0[2 * i + 1] - start[1]];
-            let offset = m.static_offset(force);
-            if force != 0.0 {
-                from[0] -= offset;
-            }
-            let state = m
-                .oscillator
-                .flow_with_transition(start_phase, end_phase, from, &phi);
+            let state = m.oscillator.flow_with_transition(
+                start_phase,
+                end_phase,
+                [x0[2 * i] - start[0], x0[2 * i + 1] - start[1]],
+                &phi,
+            );
             x[2 * i] = state[0] + end[0];
             x[2 * i + 1] = state[1] + end[1];
-            if force != 0.0 {
-                x[2 * i] += offset;
-            }
             if let Some(matrix) = transition.as_deref_mut() {
                 for r in 0..2 {
                     for c in 0..2 {
@@ -203,6 +194,9 @@ impl ExactFlow for TappingModel {
                     }
                 }
             }
+        }
+        if force != 0.0 {
+            self.add_constant_force_response(force, dt, 1, x);
         }
         if let Some(sls) = self.force.law.standard_linear_solid() {
             let last = 2 * self.modes.len();
@@ -233,6 +227,51 @@ impl TappingModel {
             return Some(0.0);
         }
         self.force.constant_outside(Self::is_attached(mode))
+    }
+
+    /// The constant force of a mode with an exact flow ([`TappingModel::flight_force_nn`]), nN:
+    /// zero unless the mode is attached (a law's force outside contact while detached is zero
+    /// or depends on the gap), so that the force-free flight pays one bit test for it.
+    #[inline(always)]
+    fn constant_flight_force_nn(&self, mode: Mode) -> f64 {
+        if Self::is_attached(mode) {
+            self.flight_force_nn(mode).unwrap_or(0.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Adds the response to a constant force `F` (nN) outside contact to the force-free flows
+    /// of [`ExactFlow::exact_flow_grid`] (`count` states `n` apart in `states`, the grid over
+    /// `dt`) or of [`ExactFlow::exact_flow`] (`count` = 1): the flow about the rest position
+    /// shifted by `s_i = F / k_i` is `s + phi(t) (x0 - s)`, the force-free flow plus
+    /// `(I - phi(t)) s`, with `phi(t) s` advanced over the grid by the transition over one
+    /// spacing. The transition matrix is the force-free one. Apart from the force-free path
+    /// (cold): only an attached meniscus has such a force.
+    #[cold]
+    #[inline(never)]
+    fn add_constant_force_response(&self, force: f64, dt: f64, count: usize, states: &mut [f64]) {
+        let n = self.dim();
+        let spacing = grid_spacing(dt, count);
+        let kept = dt == self.exact_step_limit && (1..=KEPT_GRIDS).contains(&count);
+        for (i, m) in self.modes.iter().enumerate() {
+            let phi = if kept {
+                m.grid_transitions[count - 1]
+            } else {
+                m.oscillator.homogeneous_transition(spacing)
+            };
+            let offset = m.static_offset(force);
+            // `phi(j spacing) s`, from `s = [offset, 0]`.
+            let mut shifted = [offset, 0.0];
+            for j in 0..count {
+                shifted = [
+                    phi[0][0] * shifted[0] + phi[0][1] * shifted[1],
+                    phi[1][0] * shifted[0] + phi[1][1] * shifted[1],
+                ];
+                states[j * n + 2 * i] += offset - shifted[0];
+                states[j * n + 2 * i + 1] -= shifted[1];
+            }
+        }
     }
 
     /// Whether mode `mode` is force-free flight with an exact flow (no force at all): the
@@ -646,10 +685,17 @@ impl SwitchingStructure for TappingModel {
         x0: &[f64],
         _dt: f64,
     ) -> Option<f64> {
-        if k != GAP_SURFACE && self.force.release_gap_nm().is_none() {
+        if Self::in_contact(mode)
+            || (k != GAP_SURFACE && self.force.release_gap_nm().is_none())
+            || self.force.acts_outside_contact()
+        {
             return None;
         }
-        let force = self.flight_force_nn(mode)?;
+        let force = if Self::is_attached(mode) {
+            self.flight_force_nn(mode)?
+        } else {
+            0.0
+        };
         let w = self.drive.angular_frequency;
         let (sin, cos) = phase::sin_cos(w * t0);
         // The base's `|y_base''| <= w^2 |Y|` (acoustic drive, MODEL.md section 14).
