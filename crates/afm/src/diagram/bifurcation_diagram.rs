@@ -404,7 +404,7 @@ const WALK_RECURRENCE_PERIODS: usize = 400;
 /// walk goes on in steps of `A0 / 100` in the direction of `sign`, each from the state the
 /// previous step reported (its recurrence search cut to [`WALK_RECURRENCE_PERIODS`]), until a
 /// stable period-1 orbit converges, `Z` passes `z_limit_nm`, or [`MAX_WALK_STEPS`] steps.
-/// Past the first step, where the energy budget of a period rules a period-1 orbit out
+/// Where the energy budget of a period rules a period-1 orbit out
 /// ([`admits_period_one`]: a formation's loss more than one period's drive can replace), the
 /// step skips the recurrence search, whose period-k attractors would serve only as the next
 /// step's start: it takes the transients and Newton on the period-1 map (a stable period-1
@@ -436,7 +436,7 @@ fn settle_on_period_one(
         }
         system.set_parameter(z);
         let orbit_settings = if first { &settings.orbit } else { &walking };
-        let search = first || admits_period_one(system, z);
+        let search = admits_period_one(system, z);
         first = false;
         if !search {
             let (orbit, after) =

@@ -247,7 +247,7 @@ impl TappingModel {
     /// shifted by `s_i = F / k_i` is `s + phi(t) (x0 - s)`, the force-free flow plus
     /// `(I - phi(t)) s`, with `phi(t) s` advanced over the grid by the transition over one
     /// spacing. The transition matrix is the force-free one. Apart from the force-free path
-    /// (cold): only an attached meniscus has such a force.
+    /// (cold, its transitions computed again): only an attached meniscus has such a force.
     #[cold]
     #[inline(never)]
     fn add_constant_force_response(&self, force: f64, dt: f64, count: usize, states: &mut [f64]) {
