@@ -4,12 +4,14 @@
 //! linear solid (E0 = 1 GPa, Einf = 0.4 GPa, tau = 5 us), Hertz with the hydration force
 //! (10 MPa, 0.25 nm, 0.3 nm) and JKR (W = 0.5 mJ/m^2, the `adhesive-soft` sample; W = 2 mJ/m^2,
 //! `sticky-soft`, whose approach meets the pull-off grazing), against the Hertz diagram of the
-//! same case. Target: each within 3 times the Hertz time.
+//! same case; and the capillary meniscus in air, the built-in `rectangular-air-mica-humid`
+//! against the same case on dry `mica`. Target: each within 3 times the Hertz time.
 //!
 //! Run with `cargo bench -p afm --bench contact_laws`; `-- --repetitions N` (default 5) sets
 //! the repetitions of each diagram, whose median thread CPU time is reported.
 
 use afm::{approach_diagram, builtin_cantilever, fixtures::parse_sample, DiagramSettings};
+use afm::{builtin_case, builtin_sample};
 use afm::{Separation, TappingModel};
 
 /// The calling thread's CPU time so far, seconds (Linux `/proc/thread-self/schedstat`), else
@@ -110,4 +112,26 @@ fn main() {
             );
         }
     }
+    // The capillary meniscus needs a cantilever in air: the built-in humid case against the
+    // same case on dry mica (Hertz).
+    let humid = builtin_case("rectangular-air-mica-humid").expect("case");
+    let dry = afm::Case {
+        sample: builtin_sample("mica").expect("sample"),
+        ..humid.clone()
+    };
+    let (hertz_seconds, hertz_points) =
+        time_diagram(&TappingModel::from_case(&dry).expect("model"), repetitions);
+    let (seconds, points) = time_diagram(
+        &TappingModel::from_case(&humid).expect("model"),
+        repetitions,
+    );
+    println!(
+        "rectangular-air-mica    hertz: {:8.1} ms ({hertz_points} points)",
+        1e3 * hertz_seconds
+    );
+    println!(
+        "rectangular-air-mica capillary: {:8.1} ms ({points} points), {:.2} x Hertz",
+        1e3 * seconds,
+        seconds / hertz_seconds
+    );
 }

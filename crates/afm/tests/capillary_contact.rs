@@ -274,7 +274,8 @@ fn vanishing_meniscus_reproduces_hertz_grazing() {
 /// equality, its `A/A0` to 1e-5 of the root `A` of `A (A0 sin(phi) - A) = E_m Q / (pi k)` at
 /// its phase (the higher harmonics' share of the damping and the branch end's location to the
 /// continuation's smallest step; measured 7e-7), and the approach's first point past the jump
-/// lies below it.
+/// lies below it, within one step of the walk past the jump (`A0/100`: the walk skips no
+/// separation where a stable period-1 orbit exists).
 #[test]
 fn the_approach_jumps_over_the_band_of_intermittent_taps() {
     let model = humid_model(0.0);
@@ -337,4 +338,48 @@ fn the_approach_jumps_over_the_band_of_intermittent_taps() {
         "{}",
         first.amplitude_ratio
     );
+    // The walk past the jump (steps of A0/100 from half a largest step below G1) lands on the
+    // first of its separations below the retract's branch end, where the stable period-1
+    // orbit exists: it skips none.
+    let walk_step = a0 / 100.0;
+    assert!(
+        first.z_nm < end.z_nm && first.z_nm > end.z_nm - walk_step,
+        "landed at {} nm, branch end at {} nm",
+        first.z_nm,
+        end.z_nm
+    );
+}
+
+/// The energy budget that lets the diagram's walk skip its recurrence search (MODEL.md section
+/// 9, "Capillary meniscus") rules a period-1 orbit out exactly between the root of
+/// `Z (A0 - Z) = E_m Q / (pi k)` (the meniscus's loss `E_m = F_m d_r` from the reference's own
+/// constants; one mode driven at resonance, `F_1 = k A0 / Q`) and first contact: admitted
+/// 1e-6 nm below the root, ruled out 1e-6 nm above it and just below `Z_G1`, admitted above
+/// `Z_G1` (no tap needed) and below the budget's peak `A0 / 2` (a larger amplitude than `Z`
+/// gains there); never ruled out for JKR (no
+/// fixed loss per formation: its walk is unchanged).
+#[test]
+fn energy_budget_rules_out_the_band_above_its_root() {
+    use afm::diagram::period_one_budget::admits_period_one;
+    let model = humid_model(0.0);
+    let m = Meniscus::water();
+    let mode = &model.cantilever().modes[0];
+    let a0 = model.free_amplitude_nm();
+    let bound =
+        m.force * m.rupture * mode.quality_factor / (std::f64::consts::PI * mode.stiffness_n_per_m);
+    let root = 0.5 * (a0 + (a0 * a0 - 4.0 * bound).sqrt());
+    let g1 = model.grazing_separation_nm();
+    assert!(root > 0.5 * a0 && root < g1, "root {root} nm");
+    assert!(admits_period_one(&model, root - 1e-6));
+    assert!(!admits_period_one(&model, root + 1e-6));
+    assert!(!admits_period_one(&model, g1 - 1e-6));
+    assert!(admits_period_one(&model, g1 + 1e-6));
+    // At 1 nm, below the peak, `Z (A0 - Z)` = 19 nm^2 is short of the bound (50.7 nm^2), but an
+    // amplitude nearer the peak would meet it: admitted.
+    assert!(1.0 * (a0 - 1.0) < bound);
+    assert!(admits_period_one(&model, 1.0));
+    let sticky = TappingModel::from_case(&builtin_case("biolever-sticky").unwrap()).unwrap();
+    for z in [1.0, 5.0, 9.0, 9.99] {
+        assert!(admits_period_one(&sticky, z));
+    }
 }

@@ -55,6 +55,13 @@ impl CapillaryContact {
         }
     }
 
+    /// The energy the meniscus takes from the cantilever per formation, `E_m = F_m d_r` (nN nm):
+    /// the area of its force loop, `-F_m` from `d = 0` to `d_r` on the way out only (MODEL.md
+    /// section 9, "Capillary meniscus").
+    pub fn loop_area_nn_nm(&self) -> f64 {
+        self.meniscus_force_nn * self.rupture_gap_nm
+    }
+
     /// The force and slope while the meniscus exists: Hertz inside contact (`inside`, `d < 0`)
     /// minus `F_m`; outside contact `-F_m` with zero slope.
     pub fn attached(&self, inside: bool, gap_nm: f64) -> ForceSlopes {

@@ -101,6 +101,16 @@ impl ContactLaw {
         }
     }
 
+    /// The energy (nN nm) a hysteretic law takes from the cantilever per attachment, where it
+    /// is one number: the meniscus's loop area `F_m d_r` (MODEL.md section 9). `None` for
+    /// every other law (JKR's loop area is not formed here).
+    pub fn formation_loss_nn_nm(&self) -> Option<f64> {
+        match self {
+            Self::Capillary(capillary) => Some(capillary.loop_area_nn_nm()),
+            _ => None,
+        }
+    }
+
     /// A hysteretic law's force and slopes while attached, inside contact (`inside`, `d < d_c`)
     /// or in the band `d_c <= d < d_r`: JKR's `F(a(-d))` on both sides, Hertz minus the
     /// meniscus force for the capillary law; [`ContactLaw::inside`] or zero for the others.
@@ -142,6 +152,21 @@ impl ContactLaw {
     /// Whether the law exerts a force outside contact (then free flight is not force-free).
     pub fn acts_outside_contact(&self) -> bool {
         matches!(self, Self::Dmt(dmt) if dmt.hamaker_constant_j != 0.0)
+    }
+
+    /// The law's force outside contact (`d >= d_c`) while `attached` (a hysteretic law's
+    /// attachment, MODEL.md section 9) when it is a constant, nN: the attached meniscus's
+    /// `-F_m`, zero wherever the law exerts no force outside contact; `None` where it depends
+    /// on the gap (DMT's van der Waals attraction, JKR while attached). A constant force leaves
+    /// each mode of Eq. 1 a driven linear oscillator about a shifted rest position, with an
+    /// exact flow.
+    pub fn constant_outside(&self, attached: bool) -> Option<f64> {
+        match self {
+            Self::Capillary(capillary) if attached => Some(-capillary.meniscus_force_nn),
+            Self::Jkr(_) if attached => None,
+            _ if self.acts_outside_contact() => None,
+            _ => Some(0.0),
+        }
     }
 
     /// The release time constant `tau = 1.5 eta*/E*` (us) of a clipped Kelvin-Voigt law with
@@ -244,6 +269,16 @@ impl TipSampleForce {
     /// hydration force).
     pub fn acts_outside_contact(&self) -> bool {
         self.law.acts_outside_contact() || self.double_layer.is_some() || self.hydration.is_some()
+    }
+
+    /// The force outside contact while `attached` when it is a constant, nN
+    /// ([`ContactLaw::constant_outside`]); `None` with a double layer or a hydration force,
+    /// which depend on the gap.
+    pub fn constant_outside(&self, attached: bool) -> Option<f64> {
+        if self.double_layer.is_some() || self.hydration.is_some() {
+            return None;
+        }
+        self.law.constant_outside(attached)
     }
 
     /// The force and slopes on one side: inside contact (`inside`), with the contact law

@@ -12,11 +12,14 @@ use nalgebra::Complex;
 use serde::Serialize;
 
 use crate::diagram::observed_problem::ObservedPeriodProblem;
+use crate::diagram::period_one_budget::admits_period_one;
 use crate::error::AfmError;
 use crate::model::separation::Separation;
 use crate::model::TappingModel;
 use crate::orbit::observables::{orbit_observables, GapMinimum, Harmonic, OrbitObservables};
-use crate::orbit::steady_orbit::{steady_orbit, OrbitStart, SteadyOrbit, SteadyOrbitSettings};
+use crate::orbit::steady_orbit::{
+    period_one_after_transients, steady_orbit, OrbitStart, SteadyOrbit, SteadyOrbitSettings,
+};
 
 /// How a diagram is computed. [`DiagramSettings::approach`] and [`DiagramSettings::retract`]
 /// give the defaults; every field is checked by [`DiagramSettings::validate`].
@@ -399,8 +402,14 @@ const WALK_RECURRENCE_PERIODS: usize = 400;
 /// dissipative attachment in a high-Q cantilever taps only every few periods just below
 /// `G1`: each tap's loss, the loop's area, exceeds what one period's drive can replace) the
 /// walk goes on in steps of `A0 / 100` in the direction of `sign`, each from the state the
-/// previous step reported (its recurrence search cut to [`WALK_RECURRENCE_PERIODS`]), until a stable period-1 orbit converges, `Z` passes `z_limit_nm`, or
-/// [`MAX_WALK_STEPS`] steps. Returns the `Z` and the orbit.
+/// previous step reported (its recurrence search cut to [`WALK_RECURRENCE_PERIODS`]), until a
+/// stable period-1 orbit converges, `Z` passes `z_limit_nm`, or [`MAX_WALK_STEPS`] steps.
+/// Where the energy budget of a period rules a period-1 orbit out
+/// ([`admits_period_one`]: a formation's loss more than one period's drive can replace), the
+/// step skips the recurrence search, whose period-k attractors would serve only as the next
+/// step's start: it takes the transients and Newton on the period-1 map (a stable period-1
+/// orbit Newton finds still ends the walk) and goes on from the state the transients reached.
+/// Returns the `Z` and the orbit.
 fn settle_on_period_one(
     system: &mut TappingModel,
     state: &[f64],
@@ -427,7 +436,18 @@ fn settle_on_period_one(
         }
         system.set_parameter(z);
         let orbit_settings = if first { &settings.orbit } else { &walking };
+        let search = admits_period_one(system, z);
         first = false;
+        if !search {
+            let (orbit, after) =
+                period_one_after_transients(system, z, &from, orbit_settings).ok()?;
+            if let Some(orbit) = orbit {
+                return Some((z, orbit));
+            }
+            from = after;
+            z += sign * step;
+            continue;
+        }
         let orbit = steady_orbit(
             system,
             z,

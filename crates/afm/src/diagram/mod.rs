@@ -3,4 +3,5 @@
 //! brute-force grid (a sweep by transients at fixed `Z`s).
 pub mod bifurcation_diagram;
 pub mod observed_problem;
+pub mod period_one_budget;
 pub mod quasi_static;

@@ -20,12 +20,14 @@ use crate::model::relaxing_series;
 /// phase once for every mode (the solver's grids have 8).
 const SHARED_SECOND_PHASES: usize = 33;
 
-/// Offered only when no force acts outside contact ([`HybridSystem::accelerations`]): then
-/// every mode outside contact (`FREE_FLIGHT`, and a clipped Kelvin-Voigt law's free mode on
-/// the clipped side of its release surface) is the force-free Eq. 1.
+/// Every mode outside contact whose force is a constant `F_c` ([`TappingModel::flight_force_nn`]:
+/// zero in free flight, `-F_m` while a meniscus is attached) is Eq. 1 about a shifted rest
+/// position: mode `i`'s particular solution gains the static deflection `F_c / k_i`, so the
+/// flow is the force-free one of `x - s` plus `s` (`s` the offsets; the transition matrix is the
+/// force-free one, and `F_c` does not depend on `Z`; MODEL.md section 9, "Capillary meniscus").
 impl ExactFlow for TappingModel {
     fn has_exact_flow(&self, mode: Mode) -> bool {
-        mode & CONTACT == FREE_FLIGHT && !Self::is_attached(mode)
+        self.flight_force_nn(mode).is_some()
     }
 
     /// A quarter of the shortest of the drive period and the modal periods `2 pi / w_i`, us.
@@ -44,7 +46,7 @@ impl ExactFlow for TappingModel {
     /// with `count` (a few ulps for the solver's 9 points; tested).
     fn exact_flow_grid(
         &self,
-        _mode: Mode,
+        mode: Mode,
         t0: f64,
         x0: &[f64],
         dt: f64,
@@ -52,6 +54,7 @@ impl ExactFlow for TappingModel {
         states: &mut [f64],
     ) {
         let n = self.dim();
+        let force = self.constant_flight_force_nn(mode);
         let spacing = grid_spacing(dt, count);
         let w = self.drive.angular_frequency;
         // The index of the kept spacing, for a grid over the standard step.
@@ -119,6 +122,9 @@ impl ExactFlow for TappingModel {
                 states[j * n + 2 * i + 1] = steady[1] + second[1] + y[1];
             }
         }
+        if force != 0.0 {
+            self.add_constant_force_response(force, dt, count, states);
+        }
         if let Some(sls) = self.force.law.standard_linear_solid() {
             // The unloaded surface's recovery `rho(t) = rho_0 exp(-(1 - beta) (t - t_0) / tau)`.
             let last = 2 * self.modes.len();
@@ -131,11 +137,12 @@ impl ExactFlow for TappingModel {
         }
     }
 
-    /// The free flight's closed-form flow (block diagonal, one [`DrivenOscillator`] per mode);
-    /// it does not depend on `Z`, so `dx/dZ = 0`.
+    /// The free flight's closed-form flow (block diagonal, one [`DrivenOscillator`] per mode,
+    /// about the rest position shifted by a constant force); it does not depend on `Z`, so
+    /// `dx/dZ = 0`.
     fn exact_flow(
         &self,
-        _mode: Mode,
+        mode: Mode,
         t0: f64,
         x0: &[f64],
         dt: f64,
@@ -149,6 +156,7 @@ impl ExactFlow for TappingModel {
         let start_phase = phase::sin_cos(self.drive.angular_frequency * t0);
         let end_phase = phase::sin_cos(self.drive.angular_frequency * (t0 + dt));
         let standard = dt == self.exact_step_limit;
+        let force = self.constant_flight_force_nn(mode);
         // A bimodal drive's second phase at both ends, shared by the modes.
         let second_phases = self.second.as_ref().map(|second| {
             (
@@ -187,6 +195,9 @@ impl ExactFlow for TappingModel {
                 }
             }
         }
+        if force != 0.0 {
+            self.add_constant_force_response(force, dt, 1, x);
+        }
         if let Some(sls) = self.force.law.standard_linear_solid() {
             let last = 2 * self.modes.len();
             let decay = (-sls.recovery_rate_per_us() * dt).exp();
@@ -202,6 +213,77 @@ impl ExactFlow for TappingModel {
 }
 
 impl TappingModel {
+    /// The force outside contact in mode `mode` when it is a constant, nN: 0 in free flight
+    /// where no force acts outside contact, `-F_m` while a capillary meniscus is attached
+    /// ([`crate::contact::TipSampleForce::constant_outside`]); `None` in contact and wherever
+    /// the force outside contact depends on the gap. Where it is `Some`, the mode has the exact
+    /// flow of [`ExactFlow`].
+    #[inline]
+    pub(crate) fn flight_force_nn(&self, mode: Mode) -> Option<f64> {
+        if mode & CONTACT != FREE_FLIGHT {
+            return None;
+        }
+        if self.plain_hertz {
+            return Some(0.0);
+        }
+        self.force.constant_outside(Self::is_attached(mode))
+    }
+
+    /// The constant force of a mode with an exact flow ([`TappingModel::flight_force_nn`]), nN:
+    /// zero unless the mode is attached (a law's force outside contact while detached is zero
+    /// or depends on the gap), so that the force-free flight pays one bit test for it.
+    #[inline(always)]
+    fn constant_flight_force_nn(&self, mode: Mode) -> f64 {
+        if Self::is_attached(mode) {
+            self.flight_force_nn(mode).unwrap_or(0.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Adds the response to a constant force `F` (nN) outside contact to the force-free flows
+    /// of [`ExactFlow::exact_flow_grid`] (`count` states `n` apart in `states`, the grid over
+    /// `dt`) or of [`ExactFlow::exact_flow`] (`count` = 1): the flow about the rest position
+    /// shifted by `s_i = F / k_i` is `s + phi(t) (x0 - s)`, the force-free flow plus
+    /// `(I - phi(t)) s`, with `phi(t) s` advanced over the grid by the transition over one
+    /// spacing. The transition matrix is the force-free one. Apart from the force-free path
+    /// (cold, its transitions computed again): only an attached meniscus has such a force.
+    #[cold]
+    #[inline(never)]
+    fn add_constant_force_response(&self, force: f64, dt: f64, count: usize, states: &mut [f64]) {
+        let n = self.dim();
+        let spacing = grid_spacing(dt, count);
+        let kept = dt == self.exact_step_limit && (1..=KEPT_GRIDS).contains(&count);
+        for (i, m) in self.modes.iter().enumerate() {
+            let phi = if kept {
+                m.grid_transitions[count - 1]
+            } else {
+                m.oscillator.homogeneous_transition(spacing)
+            };
+            let offset = m.static_offset(force);
+            // `phi(j spacing) s`, from `s = [offset, 0]`.
+            let mut shifted = [offset, 0.0];
+            for j in 0..count {
+                shifted = [
+                    phi[0][0] * shifted[0] + phi[0][1] * shifted[1],
+                    phi[1][0] * shifted[0] + phi[1][1] * shifted[1],
+                ];
+                states[j * n + 2 * i] += offset - shifted[0];
+                states[j * n + 2 * i + 1] -= shifted[1];
+            }
+        }
+    }
+
+    /// Whether mode `mode` is force-free flight with an exact flow (no force at all): the
+    /// modes where the observers' closed-form free-flight integrals hold
+    /// ([`crate::model::free_flight_fourier`], [`crate::model::free_flight_energy`]); a
+    /// flight under a constant force (the attached meniscus) is integrated by quadrature on
+    /// its exact flow.
+    #[inline]
+    pub(crate) fn has_force_free_flight(&self, mode: Mode) -> bool {
+        self.flight_force_nn(mode) == Some(0.0)
+    }
+
     /// Mode `i`'s steady response to a bimodal drive's second drive at a time whose second
     /// phase `w_b t` has sine `sin` and cosine `cos`, `[q, q']` (nm, nm/us); zero for another
     /// drive.
@@ -249,7 +331,8 @@ impl TappingModel {
     /// The force whose Taylor series (module `contact_series`) mode `mode` has: the Hertz
     /// sphere in contact, DMT in contact (Hertz shifted to `a0` minus the adhesion) and
     /// outside it (van der Waals, when `H > 0`), the Hertz sphere with a hydration force (in
-    /// contact plus `F_h(0)`, outside `F_h(d)`), JKR while attached (its series in `sqrt(a)`);
+    /// contact plus `F_h(0)`, outside `F_h(d)`), JKR while attached (its series in `sqrt(a)`),
+    /// the capillary meniscus inside contact (the Hertz sphere minus `F_m`);
     /// `None` for every other law, mode, or with a double layer (those integrate by the adaptive Runge-Kutta path; MODEL.md section 9).
     pub(crate) fn series_force(&self, mode: Mode) -> Option<SeriesForce> {
         if self.plain_hertz {
@@ -287,6 +370,30 @@ impl TappingModel {
                 }
             });
         }
+        if let (ContactLaw::Capillary(capillary), None, None) = (
+            self.force.law,
+            self.force.double_layer,
+            self.force.hydration,
+        ) {
+            // Inside contact the meniscus is attached (it forms at the `Down` crossing of
+            // `d = 0`): the Hertz sphere minus `F_m`. Outside contact the force is a constant
+            // (`-F_m` attached, 0 detached): the exact flow.
+            let HertzShape {
+                effective_modulus_gpa,
+                tip: HertzTip::Sphere { radius_nm },
+            } = capillary.hertz
+            else {
+                return None;
+            };
+            return (Self::in_contact(mode) && Self::is_attached(mode)).then_some(
+                SeriesForce::Hertz {
+                    // `(4/3) E* sqrt(R)`, as `HertzShape::force_slopes` forms it.
+                    coefficient: 4.0 / 3.0 * effective_modulus_gpa * radius_nm.sqrt(),
+                    contact_gap: 0.0,
+                    constant: capillary.meniscus_force_nn,
+                },
+            );
+        }
         if let (ContactLaw::Jkr(law), None, None) = (
             self.force.law,
             self.force.double_layer,
@@ -318,7 +425,7 @@ impl TappingModel {
 }
 
 /// Offered for the plain Hertz sphere (its contact), DMT (its contact and, with `H > 0`, its
-/// free flight), the hydration force and attached JKR ([`HybridSystem::accelerations`]): the
+/// free flight), the hydration force, attached JKR and the meniscus inside contact ([`HybridSystem::accelerations`]): the
 /// series of module `contact_series`.
 /// Every other law integrates by the adaptive Runge-Kutta path.
 impl TaylorExpansion for TappingModel {
@@ -575,11 +682,13 @@ impl SwitchingStructure for TappingModel {
     /// `y_i` (Eq. 1 with `F_ts = 0`), so `|q_i''| <= w^2 P_i + (w_i + w_i/Q_i) r_i` (plus a
     /// standard linear solid's `|sigma''|`, below) with
     /// `P_i = hypot(alpha_i, beta_i)` and `r_i = sqrt(y_i'^2 + w_i^2 y_i^2)`, which the damping
-    /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. In contact `None`
-    /// (extrema inside the sample, the gap's minima, are always wanted) or attached, and `None`
-    /// for Kelvin-Voigt's release surface (a hysteretic law's pull-off surface `d - d_r` has the
-    /// gap's curvature) and wherever a force acts outside contact (the bound assumes
-    /// `F_ts = 0`).
+    /// never lets grow (`d(r^2)/dt = -2 (w_i/Q_i) y_i'^2`), taken at `t0`. Under a constant
+    /// force `F_c` (an attached meniscus) `y_i` is measured from the shifted rest position
+    /// `F_c / k_i`, which adds nothing to `q_i''`. In contact `None` (extrema inside the
+    /// sample, the gap's minima, are always wanted), and `None` for Kelvin-Voigt's release
+    /// surface (a hysteretic law's pull-off surface `d - d_r` has the gap's curvature) and
+    /// wherever the force outside contact is not a constant (attached JKR, DMT's van der
+    /// Waals, a double layer, a hydration force: the bound assumes a constant `F_ts`).
     fn switching_curvature_bound(
         &self,
         k: usize,
@@ -589,12 +698,16 @@ impl SwitchingStructure for TappingModel {
         _dt: f64,
     ) -> Option<f64> {
         if Self::in_contact(mode)
-            || Self::is_attached(mode)
             || (k != GAP_SURFACE && self.force.release_gap_nm().is_none())
             || self.force.acts_outside_contact()
         {
             return None;
         }
+        let force = if Self::is_attached(mode) {
+            self.flight_force_nn(mode)?
+        } else {
+            0.0
+        };
         let w = self.drive.angular_frequency;
         let (sin, cos) = phase::sin_cos(w * t0);
         // The base's `|y_base''| <= w^2 |Y|` (acoustic drive, MODEL.md section 14).
@@ -610,7 +723,10 @@ impl SwitchingStructure for TappingModel {
                 .map(|(i, m)| {
                     let [p, dp] = m.oscillator.steady_state_at_phase(sin, cos);
                     let [pb, dpb] = self.second_steady_state(i, t0);
-                    let (y, dy) = (x0[2 * i] - p - pb, x0[2 * i + 1] - dp - dpb);
+                    let (mut y, dy) = (x0[2 * i] - p - pb, x0[2 * i + 1] - dp - dpb);
+                    if force != 0.0 {
+                        y -= m.static_offset(force);
+                    }
                     // A bimodal drive's second steady response adds `w_b^2 P_bi`.
                     let second = self.second.as_ref().map_or(0.0, |second| {
                         let [a, b] = second.oscillators[i].steady_coefficients();

@@ -233,12 +233,14 @@ impl HybridSystem for TappingModel {
         mode
     }
 
-    /// The free flight's closed-form flow (where no force acts outside contact), the Taylor
-    /// series of the plain Hertz contact and of DMT (`TappingModel::series_force`), and the surfaces' shape (affine; the gap's curvature
-    /// bounded in force-free flight; a half-power surface in contact).
+    /// The closed-form flow outside contact where the force there is a constant (zero, or an
+    /// attached meniscus's; `TappingModel::flight_force_nn`), the Taylor series of the plain
+    /// Hertz contact and of DMT (`TappingModel::series_force`), and the surfaces' shape
+    /// (affine; the gap's curvature bounded in flight under a constant force; a half-power
+    /// surface in contact).
     fn accelerations(&self) -> Accelerations<'_> {
         Accelerations {
-            exact_flow: (!self.force.acts_outside_contact()).then_some(self as _),
+            exact_flow: Some(self),
             taylor: Some(self),
             switching: Some(self),
         }

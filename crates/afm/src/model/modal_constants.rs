@@ -35,6 +35,14 @@ pub(crate) struct ModalConstants {
 }
 
 impl ModalConstants {
+    /// The static deflection `F / k_i` (nm) of this mode under a constant tip-sample force `F`
+    /// (nN): Eq. 1's particular solution for it, `(w_i^2 / k_i) F / w_i^2`, the offset of the
+    /// rest position about which an exact flow under a constant force runs.
+    #[inline]
+    pub(crate) fn static_offset(&self, force_nn: f64) -> f64 {
+        self.omega_squared_over_stiffness * force_nn / self.omega_squared
+    }
+
     /// The constants of `mode` under `drive` (`F_i = r_i F_1`, MODEL.md section 3), with its
     /// free flight's homogeneous transitions over the standard exact step `exact_step_limit`
     /// (us) and over that step's kept grid spacings.

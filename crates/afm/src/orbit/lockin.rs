@@ -139,8 +139,7 @@ impl CycleLockIn {
         let model = solver.system();
         let (a, b) = solver.last_step();
         if b > a && b > self.previous_end {
-            let closed_form =
-                self.free_flight.is_some() && model.accelerations().has_exact_flow(self.mode);
+            let closed_form = self.free_flight.is_some() && model.has_force_free_flight(self.mode);
             if closed_form {
                 if self.free_start.is_none() {
                     self.free_start = Some(a);

@@ -398,7 +398,7 @@ impl PeriodObserver {
         let a = step_start.max(self.start);
         let b = step_end.min(self.end);
         if b > a {
-            if self.free_flight.is_some() && model.accelerations().has_exact_flow(self.mode) {
+            if self.free_flight.is_some() && model.has_force_free_flight(self.mode) {
                 if self.free_start.is_none() {
                     self.free_start = Some(a);
                     solver.interpolate(a, &mut self.free_state);

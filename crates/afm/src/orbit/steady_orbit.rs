@@ -209,6 +209,45 @@ pub fn steady_orbit_in(
     settings: &SteadyOrbitSettings,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<SteadyOrbit, AfmError> {
+    let (model, initial, predicted) = prepared_start(model, z_nm, start, settings, workspace)?;
+    match shoot_period_one(&model, &initial, predicted, settings, workspace)? {
+        Ok(orbit) => Ok(orbit),
+        // Period-1 Newton failed or found a repelling orbit: look for the attractor by
+        // iteration.
+        Err(fallback) => recurrence_search(&model, &initial, fallback, settings, workspace),
+    }
+}
+
+/// [`steady_orbit`] from [`OrbitStart::AfterTransients`]`(state)` without its search for
+/// another attractor by recurrence: `transient_periods` periods from `state`, then Newton on
+/// the period-1 map. Returns the orbit when Newton converges on a stable one (the orbit
+/// [`steady_orbit`] returns then, to the bit), and the state the transients reached (the
+/// cantilever's state after them, to go on from). For a walk in `Z` that only stops at a
+/// stable period-1 orbit, where the energy budget rules one out beyond Newton's reach
+/// (MODEL.md section 9, "Capillary meniscus").
+pub fn period_one_after_transients(
+    model: &TappingModel,
+    z_nm: f64,
+    state: &[f64],
+    settings: &SteadyOrbitSettings,
+) -> Result<(Option<SteadyOrbit>, Vec<f64>), AfmError> {
+    let mut workspace = SteadyOrbitWorkspace::default();
+    let start = OrbitStart::AfterTransients(state);
+    let (model, initial, predicted) = prepared_start(model, z_nm, start, settings, &mut workspace)?;
+    let orbit = shoot_period_one(&model, &initial, predicted, settings, &mut workspace)?.ok();
+    Ok((orbit, initial))
+}
+
+/// The model at `z_nm` and the state Newton starts from (after the transients of `start`, if
+/// it has any), with whether that state is a prediction ([`OrbitStart::Predicted`]); every
+/// input checked.
+fn prepared_start(
+    model: &TappingModel,
+    z_nm: f64,
+    start: OrbitStart<'_>,
+    settings: &SteadyOrbitSettings,
+    workspace: &mut SteadyOrbitWorkspace,
+) -> Result<(TappingModel, Vec<f64>, bool), AfmError> {
     settings.validate()?;
     let lowest = -model.free_amplitude_nm();
     if !(lowest..=MAX_SEPARATION_NM).contains(&z_nm) {
@@ -256,10 +295,22 @@ pub fn steady_orbit_in(
     } else {
         given
     };
+    Ok((model, initial, predicted))
+}
 
+/// Newton on the period-1 map of `model` from `initial`: the orbit when it converges on a
+/// stable one, else the attempt (the fallback of the recurrence search).
+fn shoot_period_one(
+    model: &TappingModel,
+    initial: &[f64],
+    predicted: bool,
+    settings: &SteadyOrbitSettings,
+    workspace: &mut SteadyOrbitWorkspace,
+) -> Result<Result<SteadyOrbit, Attempt>, AfmError> {
+    let z_nm = model.parameter();
     let first = shoot_observed(
-        &model,
-        &initial,
+        model,
+        initial,
         predicted,
         &settings.newton,
         &settings.integration,
@@ -269,8 +320,8 @@ pub fn steady_orbit_in(
     let first_multipliers = floquet_multipliers(&first.sensitivities.monodromy);
     let first_tangent = first.sensitivities.tangent(z_nm);
     if first.converged && is_stable(&first_multipliers) {
-        return Ok(SteadyOrbit {
-            z_nm: model.parameter(),
+        return Ok(Ok(SteadyOrbit {
+            z_nm,
             multiplicity: 1,
             converged: true,
             iterations: first.iterations,
@@ -283,19 +334,16 @@ pub fn steady_orbit_in(
             whole_orbit: first.observables.clone(),
             periods: vec![first.observables],
             period_states: vec![first.state],
-        });
+        }));
     }
-
-    // Period-1 Newton failed or found a repelling orbit: look for the attractor by iteration.
-    let fallback = Attempt {
+    Ok(Err(Attempt {
         multiplicity: 1,
         state: first.state,
         iterations: first.iterations,
         residual: first.residual,
         multipliers: first_multipliers,
         tangent: first_tangent,
-    };
-    recurrence_search(&model, &initial, fallback, settings, workspace)
+    }))
 }
 
 /// The Euclidean distance between two states of the model, `[q_1, q_1', ..., q_N, q_N']` (nm
