@@ -109,13 +109,7 @@ pub(crate) fn walk_approach(
         let mut at_next = model.clone();
         at_next.set_separation(Separation::Constant(z_next))?;
         let prediction = predict(z_next, &last, before.as_ref());
-        // The orbit at `z_nm` ends the walk: its slope would predict nothing.
-        let slope = if z_next == z_nm {
-            Slope::Unused
-        } else {
-            Slope::Needed
-        };
-        if let Some(point) = corrected(&at_next, &prediction, amplitude, slope, workspace)? {
+        if let Some(point) = corrected(&at_next, &prediction, amplitude, workspace)? {
             step = (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude);
             // The free orbit's zero slope does not extend below the grazing at `Z_G1`: the
             // cubic needs two orbits below it.
@@ -177,37 +171,19 @@ fn predict(z_nm: f64, last: &WalkPoint, before: Option<&WalkPoint>) -> Vec<f64> 
     }
 }
 
-/// Whether a walk step needs its orbit's slope `dx/dZ` (to predict the next step's orbit) or
-/// not (the step to the requested `Z`, which ends the walk).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Slope {
-    /// The maps carry `dP/dZ` and the orbit's slope is computed.
-    Needed,
-    /// The maps carry the monodromy only (the state and monodromy are the same bits: the
-    /// tangent columns are integrated column by column, `dP/dZ` one more column); the
-    /// returned slope is empty.
-    Unused,
-}
-
 /// Newton from `prediction` on the period map of `model` (at its separation) to
 /// [`WALK_TOLERANCE`] `amplitude` (`A0`, nm), the maps integrated at
 /// [`WALK_INTEGRATION_TOLERANCE`]. Once two residuals measure Newton's constant `C`
 /// (`r_k = C r_{k-1}^2`), an iterate whose predicted residual `C r_k^2` is below the tolerance
 /// is taken without a map of its own; its slope and stability are those of the map before,
 /// which is as close to the orbit as a walk's prediction needs. The orbit with its slope, or
-/// `None` if Newton does not converge within [`WALK_ITERATIONS`] or the orbit repels. With
-/// [`Slope::Unused`] the maps skip `dP/dZ` and the point's slope is empty.
+/// `None` if Newton does not converge within [`WALK_ITERATIONS`] or the orbit repels.
 fn corrected(
     model: &TappingModel,
     prediction: &[f64],
     amplitude: f64,
-    slope: Slope,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<Option<WalkPoint>, AfmError> {
-    let sensitivity = match slope {
-        Slope::Needed => Sensitivity::TransitionAndParameter,
-        Slope::Unused => Sensitivity::Transition,
-    };
     let integration = newton_maps(&Settings {
         relative_tolerance: WALK_INTEGRATION_TOLERANCE,
         absolute_tolerance: WALK_INTEGRATION_TOLERANCE,
@@ -218,7 +194,13 @@ fn corrected(
     let mut x = prediction.to_vec();
     let mut previous_residual = f64::INFINITY;
     for _ in 0..=WALK_ITERATIONS {
-        let Ok(map) = period_map(model, &x, sensitivity, &integration, workspace) else {
+        let Ok(map) = period_map(
+            model,
+            &x,
+            Sensitivity::TransitionAndParameter,
+            &integration,
+            workspace,
+        ) else {
             return Ok(None);
         };
         let residual =
@@ -241,15 +223,15 @@ fn corrected(
             if !is_stable(&floquet_multipliers(&map.transition)) {
                 return Ok(None);
             }
-            let slope = match slope {
-                Slope::Needed => branch_tangent(&map.transition, &map.parameter_sensitivity, z_nm),
-                Slope::Unused => Some(Vec::new()),
-            };
-            return Ok(slope.map(|slope| WalkPoint {
-                z_nm,
-                state: x,
-                slope,
-            }));
+            return Ok(
+                branch_tangent(&map.transition, &map.parameter_sensitivity, z_nm).map(|slope| {
+                    WalkPoint {
+                        z_nm,
+                        state: x,
+                        slope,
+                    }
+                }),
+            );
         }
         previous_residual = size;
         let Ok(update) = newton_update(&map.transition, &residual, z_nm) else {
