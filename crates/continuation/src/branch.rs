@@ -36,6 +36,7 @@ use crate::special_point::SpecialPoint;
 
 mod corner;
 mod detection;
+mod hysteretic_break;
 mod step;
 
 /// One accepted point of a branch of periodic orbits.
@@ -234,6 +235,16 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             return false;
         }
         self.step = (self.step * self.settings.step_cut).max(self.settings.min_step);
+        true
+    }
+
+    /// Cut the step by `factor` (in `(0, 1)`), not below the minimum; `false` if it is already
+    /// at the minimum.
+    fn cut_by(&mut self, factor: f64) -> bool {
+        if self.step <= self.settings.min_step {
+            return false;
+        }
+        self.step = (self.step * factor).max(self.settings.min_step);
         true
     }
 

@@ -69,6 +69,13 @@ pub struct ContinuationSettings {
     /// Whether to test for period doubling and Neimark-Sacker (multiplier-based tests).
     /// Folds and structure changes (grazing) are always detected. Default `true`.
     pub detect_bifurcations: bool,
+    /// Whether the period map jumps at every grazing of the contact surface and of the
+    /// release surface (a hysteretic contact law, MODEL.md Sec. 9: the attachment's force sets
+    /// in at a finite value, and drops to zero at pull-off). Then a failed correction whose
+    /// tangent prediction lies past such a grazing ends the branch at the grazing, located from
+    /// the last point ([`crate::StopReason::HystereticGrazing`]), instead of cutting the step
+    /// towards it down to `min_step`. Default `false`.
+    pub hysteretic_grazing: bool,
 }
 
 impl Default for ContinuationSettings {
@@ -92,6 +99,7 @@ impl Default for ContinuationSettings {
             location_tolerance: 1e-9,
             location_max_iterations: 100,
             detect_bifurcations: true,
+            hysteretic_grazing: false,
         }
     }
 }

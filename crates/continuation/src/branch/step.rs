@@ -167,7 +167,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 at_bound: false,
             }));
         }
-        if self.cut() {
+        let cut = match self.grazing_fraction(&predicted)? {
+            Some(fraction) => self.cut_by(fraction),
+            None => self.cut(),
+        };
+        if cut {
             return Ok(None);
         }
         let terminal = self.terminal_location()?;
