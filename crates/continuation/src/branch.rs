@@ -110,6 +110,10 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// The point before `current` and its tangent, for the cubic predictor (`None` at the
     /// start and after a jump over a corner).
     previous: Option<(DVector<f64>, DVector<f64>)>,
+    /// The parameter and orbit structure of the point before `current` (`None` at the start
+    /// and after a jump over a corner): the step towards a hysteretic grazing extrapolates its
+    /// test function from it and the current point (`branch/hysteretic_break.rs`).
+    previous_structure: Option<(f64, OrbitStructure)>,
     start: Option<BranchPoint>,
     step: f64,
     produced: usize,
@@ -180,6 +184,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             stop_predicate: None,
             current,
             previous: None,
+            previous_structure: None,
             start: Some(first),
             produced: 0,
             special_points: Vec::new(),

@@ -4,7 +4,7 @@
 //! the grazing by cut steps until the minimum step (where it ends, locating the grazing,
 //! [`super::Continuation::terminal_location`]). Halving the step takes about twenty failed
 //! corrections from the largest step down; cutting it instead to just short of the grazing
-//! estimated from the failed step's prediction takes a few.
+//! extrapolated from the accepted side takes a few.
 
 use nalgebra::DVector;
 
@@ -13,10 +13,10 @@ use crate::error::ContinuationError;
 use crate::problem::PeriodicProblem;
 use crate::test_function::{structure_changes, ExtremumKind, StructureTest};
 
-/// The cut step's share of the way to the grazing estimated along the failed step: short of
-/// it, so that the next step is accepted on the near side (the estimate is linear in the test
-/// function along the tangent, off the branch by the step's curvature).
-const SHORT_OF_GRAZING: f64 = 0.9;
+/// The cut step's share of the way to the extrapolated grazing: short of it, so that the next
+/// step is accepted on the near side (the extrapolation is linear in the parameter, off by the
+/// test function's curvature along the branch).
+const SHORT_OF_GRAZING: f64 = 0.99;
 
 /// Whether a structure test is the grazing of a hysteretic contact's surface, where the period
 /// map jumps: a minimum of the contact switching function or a maximum of the release surface's
@@ -34,11 +34,16 @@ fn jumps_at(test: &StructureTest) -> bool {
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// After a failed correction of the step to `predicted` (the tangent prediction, `(x, p)`)
     /// on a branch whose period map jumps at its grazings
-    /// ([`crate::ContinuationSettings::hysteretic_grazing`]): the factor to cut the step by, when
+    /// ([`crate::ContinuationSettings::hysteretic_grazing`]): the factor to cut the step by when
     /// the trajectory from `predicted` has crossed a grazing of the contact or release surface
-    /// since the current point: [`SHORT_OF_GRAZING`] of the fraction of the step at the
-    /// linearly interpolated zero of the first such test function, where that cuts more than
-    /// `step_cut`. `None` (cut by `step_cut`) otherwise, or when the period map fails there.
+    /// since the current point. The grazing's parameter is extrapolated linearly from the test
+    /// function's values at the previous and the current point (secant in `p`, both on the
+    /// branch; the prediction's own value belongs to the other mode's flow), or, without a
+    /// previous point on that side, interpolated between the current point and the
+    /// prediction; the factor is [`SHORT_OF_GRAZING`] of the step's share up to the nearest
+    /// such grazing, used where it cuts more than `step_cut` (so that repeated failures still
+    /// shrink the step). `None` (cut by `step_cut`) otherwise, or when the period map fails
+    /// at the prediction.
     pub(super) fn grazing_fraction(
         &self,
         predicted: &DVector<f64>,
@@ -47,15 +52,42 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             return Ok(None);
         }
         let n = self.problem.dim();
-        let Ok(map) = self.problem.period_map(&predicted.as_slice()[..n], predicted[n]) else {
+        let (p_a, p_far) = (self.current.parameter(), predicted[n]);
+        if p_far == p_a {
+            return Ok(None);
+        }
+        let Ok(map) = self.problem.period_map(&predicted.as_slice()[..n], p_far) else {
             return Ok(None);
         };
-        let root = structure_changes(&self.current.map.structure, &map.structure)
+        let share = structure_changes(&self.current.map.structure, &map.structure)
             .iter()
             .filter(|t| jumps_at(t))
-            .map(StructureTest::linear_root)
+            .map(|test| self.share_to_grazing(test, p_a, p_far))
             .fold(f64::INFINITY, f64::min);
-        let fraction = SHORT_OF_GRAZING * root;
-        Ok((fraction.is_finite() && fraction < self.settings.step_cut).then_some(fraction))
+        let fraction = SHORT_OF_GRAZING * share;
+        Ok((fraction > 0.0 && fraction < self.settings.step_cut).then_some(fraction))
+    }
+
+    /// The share of the step from the current point (parameter `p_a`) to the prediction (`p_far`)
+    /// at which `test` is estimated to reach zero (see [`Continuation::grazing_fraction`]).
+    fn share_to_grazing(&self, test: &StructureTest, p_a: f64, p_far: f64) -> f64 {
+        let StructureTest::Extremum { value_a, .. } = *test else {
+            return test.linear_root();
+        };
+        let secant = self.previous_structure.as_ref().and_then(|(p_prev, previous)| {
+            let value_prev = test.value(0.0, previous);
+            let approaching = value_prev.is_finite()
+                && (value_prev < 0.0) == (value_a < 0.0)
+                && value_prev.abs() > value_a.abs()
+                && *p_prev != p_a;
+            approaching.then(|| {
+                let p_zero = p_a + value_a * (p_a - p_prev) / (value_prev - value_a);
+                (p_zero - p_a) / (p_far - p_a)
+            })
+        });
+        match secant {
+            Some(share) if share.is_finite() && share > 0.0 => share,
+            _ => test.linear_root(),
+        }
     }
 }

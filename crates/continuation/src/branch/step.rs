@@ -323,6 +323,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         };
         self.special_points.extend(special);
         let accepted = std::mem::replace(&mut self.current, b);
+        self.previous_structure = (!jumped && self.settings.hysteretic_grazing)
+            .then(|| (accepted.parameter(), accepted.map.structure.clone()));
         self.previous = if jumped {
             None
         } else {
