@@ -22,6 +22,12 @@
 //! orbit exists past the corner (no period-one impacting orbit near grazing) the branch ends
 //! there with [`StopReason::StepTooSmall`], after locating the grazing it ran into between the
 //! last orbit and the first parameter without one.
+//!
+//! **Hysteretic grazings.** Where the period map jumps at a grazing (a hysteretic contact,
+//! [`ContinuationSettings::hysteretic_grazing`]) the branch also ends there, and the step that
+//! fails across the grazing is cut to just short of it, extrapolated from the last two points,
+//! rather than halved (`branch/hysteretic_break.rs`), so that the minimum step is reached in a
+//! few failed corrections.
 
 use nalgebra::{Complex, DVector};
 

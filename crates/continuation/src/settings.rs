@@ -71,10 +71,12 @@ pub struct ContinuationSettings {
     pub detect_bifurcations: bool,
     /// Whether the period map jumps at every grazing of the contact surface and of the
     /// release surface (a hysteretic contact law, MODEL.md Sec. 9: the attachment's force sets
-    /// in at a finite value, and drops to zero at pull-off). Then a failed correction whose
-    /// tangent prediction lies past such a grazing ends the branch at the grazing, located from
-    /// the last point ([`crate::StopReason::HystereticGrazing`]), instead of cutting the step
-    /// towards it down to `min_step`. Default `false`.
+    /// in at a finite value, and drops to zero at pull-off), so that no orbit lies just past
+    /// such a grazing and the branch ends there. Then a failed correction whose tangent
+    /// prediction lies past such a grazing cuts the step to 0.99 of the way to the grazing
+    /// extrapolated from the last two points, instead of by `step_cut`
+    /// (`branch/hysteretic_break.rs`); the branch reaches the minimum step, where it ends, in a
+    /// few failed corrections instead of about twenty. Default `false`.
     pub hysteretic_grazing: bool,
 }
 

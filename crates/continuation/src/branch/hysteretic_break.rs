@@ -74,17 +74,20 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let StructureTest::Extremum { value_a, .. } = *test else {
             return test.linear_root();
         };
-        let secant = self.previous_structure.as_ref().and_then(|(p_prev, previous)| {
-            let value_prev = test.value(0.0, previous);
-            let approaching = value_prev.is_finite()
-                && (value_prev < 0.0) == (value_a < 0.0)
-                && value_prev.abs() > value_a.abs()
-                && *p_prev != p_a;
-            approaching.then(|| {
-                let p_zero = p_a + value_a * (p_a - p_prev) / (value_prev - value_a);
-                (p_zero - p_a) / (p_far - p_a)
-            })
-        });
+        let secant = self
+            .previous_structure
+            .as_ref()
+            .and_then(|(p_prev, previous)| {
+                let value_prev = test.value(0.0, previous);
+                let approaching = value_prev.is_finite()
+                    && (value_prev < 0.0) == (value_a < 0.0)
+                    && value_prev.abs() > value_a.abs()
+                    && *p_prev != p_a;
+                approaching.then(|| {
+                    let p_zero = p_a + value_a * (p_a - p_prev) / (value_prev - value_a);
+                    (p_zero - p_a) / (p_far - p_a)
+                })
+            });
         match secant {
             Some(share) if share.is_finite() && share > 0.0 => share,
             _ => test.linear_root(),
