@@ -39,6 +39,7 @@ use crate::problem::{OrbitStructure, PeriodicProblem};
 use crate::settings::ContinuationSettings;
 use crate::shooting::{shoot, NewtonSettings};
 use crate::special_point::SpecialPoint;
+use crate::test_function::StructureTest;
 
 mod corner;
 mod detection;
@@ -120,6 +121,9 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// and after a jump over a corner): the step towards a hysteretic grazing extrapolates its
     /// test function from it and the current point (`branch/hysteretic_break.rs`).
     previous_structure: Option<(f64, OrbitStructure)>,
+    /// The test function of the hysteretic grazing the step was last cut towards, at which the
+    /// steps after it are aimed (`branch/hysteretic_break.rs`); `None` otherwise.
+    grazing_test: Option<StructureTest>,
     start: Option<BranchPoint>,
     step: f64,
     produced: usize,
@@ -191,6 +195,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             current,
             previous: None,
             previous_structure: None,
+            grazing_test: None,
             start: Some(first),
             produced: 0,
             special_points: Vec::new(),

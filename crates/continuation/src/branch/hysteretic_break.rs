@@ -45,9 +45,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// shrink the step). `None` (cut by `step_cut`) otherwise, or when the period map fails
     /// at the prediction.
     pub(super) fn grazing_fraction(
-        &self,
+        &mut self,
         predicted: &DVector<f64>,
     ) -> Result<Option<f64>, ContinuationError> {
+        self.grazing_test = None;
         if !self.settings.hysteretic_grazing {
             return Ok(None);
         }
@@ -59,13 +60,56 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let Ok(map) = self.problem.period_map(&predicted.as_slice()[..n], p_far) else {
             return Ok(None);
         };
-        let share = structure_changes(&self.current.map.structure, &map.structure)
-            .iter()
-            .filter(|t| jumps_at(t))
-            .map(|test| self.share_to_grazing(test, p_a, p_far))
-            .fold(f64::INFINITY, f64::min);
+        let nearest = structure_changes(&self.current.map.structure, &map.structure)
+            .into_iter()
+            .filter(jumps_at)
+            .map(|test| (self.share_to_grazing(&test, p_a, p_far), test))
+            .min_by(|x, y| x.0.total_cmp(&y.0));
+        let Some((share, test)) = nearest else {
+            return Ok(None);
+        };
         let fraction = SHORT_OF_GRAZING * share;
-        Ok((fraction > 0.0 && fraction < self.settings.step_cut).then_some(fraction))
+        let cuts = fraction > 0.0 && fraction < self.settings.step_cut;
+        if cuts {
+            self.grazing_test = Some(test);
+        }
+        Ok(cuts.then_some(fraction))
+    }
+
+    /// After a point is accepted on a step cut towards a hysteretic grazing
+    /// ([`Continuation::grazing_fraction`]): set the next step to [`SHORT_OF_GRAZING`] of the
+    /// way to the grazing extrapolated again from the new point and the one before it (in
+    /// arclength along the current tangent), instead of growing it past the grazing into a
+    /// certain failure; not below the minimum step, where the next failure ends the branch.
+    /// Does nothing (and stops aiming) where the test function is not approaching zero.
+    pub(super) fn aim_at_grazing(&mut self) {
+        let Some(test) = self.grazing_test.take() else {
+            return;
+        };
+        let Some((p_prev, previous)) = self.previous_structure.as_ref() else {
+            return;
+        };
+        let n = self.problem.dim();
+        let p_a = self.current.parameter();
+        let value_a = test.value(0.0, &self.current.map.structure);
+        let value_prev = test.value(0.0, previous);
+        let tp = self.current.tangent[n];
+        let approaching = value_a.is_finite()
+            && value_prev.is_finite()
+            && (value_prev < 0.0) == (value_a < 0.0)
+            && value_prev.abs() > value_a.abs()
+            && *p_prev != p_a
+            && tp.is_finite()
+            && tp != 0.0;
+        if !approaching {
+            return;
+        }
+        let p_zero = p_a + value_a * (p_a - p_prev) / (value_prev - value_a);
+        let ds = SHORT_OF_GRAZING * (p_zero - p_a) / tp;
+        if ds.is_finite() && ds > 0.0 {
+            self.step = ds.clamp(self.settings.min_step, self.settings.max_step);
+            self.grazing_test = Some(test);
+        }
     }
 
     /// The share of the step from the current point (parameter `p_a`) to the prediction (`p_far`)

@@ -330,6 +330,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         } else {
             Some((accepted.u, accepted.tangent))
         };
+        self.aim_at_grazing();
         Ok(self.emit(point, at_bound))
     }
 }
