@@ -26,8 +26,8 @@
 //! **Hysteretic grazings.** Where the period map jumps at a grazing (a hysteretic contact,
 //! [`ContinuationSettings::hysteretic_grazing`]) the branch also ends there, and the step that
 //! fails across the grazing is cut to just short of it, extrapolated from the last two points,
-//! rather than halved (`branch/hysteretic_break.rs`), so that the minimum step is reached in a
-//! few failed corrections.
+//! rather than halved, and the steps after it are aimed the same way
+//! (`branch/hysteretic_break.rs`), so that the minimum step is reached in a few steps.
 
 use nalgebra::{Complex, DVector};
 

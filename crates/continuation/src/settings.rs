@@ -74,9 +74,10 @@ pub struct ContinuationSettings {
     /// in at a finite value, and drops to zero at pull-off), so that no orbit lies just past
     /// such a grazing and the branch ends there. Then a failed correction whose tangent
     /// prediction lies past such a grazing cuts the step to 0.99 of the way to the grazing
-    /// extrapolated from the last two points, instead of by `step_cut`
-    /// (`branch/hysteretic_break.rs`); the branch reaches the minimum step, where it ends, in a
-    /// few failed corrections instead of about twenty. Default `false`.
+    /// extrapolated from the last two points, instead of by `step_cut`, and the steps after it
+    /// are aimed the same way (`branch/hysteretic_break.rs`); the branch reaches the minimum
+    /// step, where it ends, in a few steps instead of about twenty failed corrections.
+    /// Default `false`.
     pub hysteretic_grazing: bool,
 }
 

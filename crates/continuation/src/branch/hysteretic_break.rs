@@ -4,7 +4,8 @@
 //! the grazing by cut steps until the minimum step (where it ends, locating the grazing,
 //! [`super::Continuation::terminal_location`]). Halving the step takes about twenty failed
 //! corrections from the largest step down; cutting it instead to just short of the grazing
-//! extrapolated from the accepted side takes a few.
+//! extrapolated from the accepted side, and aiming the steps after it the same way, takes a
+//! few steps.
 
 use nalgebra::DVector;
 
