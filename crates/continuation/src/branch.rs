@@ -22,6 +22,12 @@
 //! orbit exists past the corner (no period-one impacting orbit near grazing) the branch ends
 //! there with [`StopReason::StepTooSmall`], after locating the grazing it ran into between the
 //! last orbit and the first parameter without one.
+//!
+//! **Hysteretic grazings.** Where the period map jumps at a grazing (a hysteretic contact,
+//! [`ContinuationSettings::hysteretic_grazing`]) the branch also ends there, and the step that
+//! fails across the grazing is cut to just short of it, extrapolated from the last two points,
+//! rather than halved, and the steps after it are aimed the same way
+//! (`branch/hysteretic_break.rs`), so that the minimum step is reached in a few steps.
 
 use nalgebra::{Complex, DVector};
 
@@ -33,9 +39,11 @@ use crate::problem::{OrbitStructure, PeriodicProblem};
 use crate::settings::ContinuationSettings;
 use crate::shooting::{shoot, NewtonSettings};
 use crate::special_point::SpecialPoint;
+use crate::test_function::StructureTest;
 
 mod corner;
 mod detection;
+mod hysteretic_break;
 mod step;
 
 /// One accepted point of a branch of periodic orbits.
@@ -109,6 +117,13 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// The point before `current` and its tangent, for the cubic predictor (`None` at the
     /// start and after a jump over a corner).
     previous: Option<(DVector<f64>, DVector<f64>)>,
+    /// The parameter and orbit structure of the point before `current` (`None` at the start
+    /// and after a jump over a corner): the step towards a hysteretic grazing extrapolates its
+    /// test function from it and the current point (`branch/hysteretic_break.rs`).
+    previous_structure: Option<(f64, OrbitStructure)>,
+    /// The test function of the hysteretic grazing the step was last cut towards, at which the
+    /// steps after it are aimed (`branch/hysteretic_break.rs`); `None` otherwise.
+    grazing_test: Option<StructureTest>,
     start: Option<BranchPoint>,
     step: f64,
     produced: usize,
@@ -179,6 +194,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             stop_predicate: None,
             current,
             previous: None,
+            previous_structure: None,
+            grazing_test: None,
             start: Some(first),
             produced: 0,
             special_points: Vec::new(),
@@ -234,6 +251,16 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             return false;
         }
         self.step = (self.step * self.settings.step_cut).max(self.settings.min_step);
+        true
+    }
+
+    /// Cut the step by `factor` (in `(0, 1)`), not below the minimum; `false` if it is already
+    /// at the minimum.
+    fn cut_by(&mut self, factor: f64) -> bool {
+        if self.step <= self.settings.min_step {
+            return false;
+        }
+        self.step = (self.step * factor).max(self.settings.min_step);
         true
     }
 

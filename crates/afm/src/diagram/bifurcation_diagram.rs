@@ -528,6 +528,7 @@ fn branch_until(
         parameter_max,
         max_points: settings.max_points,
         corrector: settings.orbit.newton.clone(),
+        hysteretic_grazing: hysteretic,
         ..ContinuationSettings::default()
     };
     let a0 = model.free_amplitude_nm();

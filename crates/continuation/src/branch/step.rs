@@ -167,7 +167,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 at_bound: false,
             }));
         }
-        if self.cut() {
+        let cut = match self.grazing_fraction(&predicted)? {
+            Some(fraction) => self.cut_by(fraction),
+            None => self.cut(),
+        };
+        if cut {
             return Ok(None);
         }
         let terminal = self.terminal_location()?;
@@ -319,11 +323,14 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         };
         self.special_points.extend(special);
         let accepted = std::mem::replace(&mut self.current, b);
+        self.previous_structure = (!jumped && self.settings.hysteretic_grazing)
+            .then(|| (accepted.parameter(), accepted.map.structure.clone()));
         self.previous = if jumped {
             None
         } else {
             Some((accepted.u, accepted.tangent))
         };
+        self.aim_at_grazing();
         Ok(self.emit(point, at_bound))
     }
 }
