@@ -99,7 +99,26 @@ fn recoverable(error: &ContinuationError) -> bool {
     )
 }
 
-/// Newton's method on `[P(x; p) - x; tau . (u - anchor)] = 0` from `guess`.
+/// What a corrected point is for: whether it may become a branch point, so that its likely
+/// converged evaluations go through [`PeriodicProblem::period_map_likely_accepted`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Purpose {
+    /// A trial point of a continuation step, accepted as the next branch point if it converges
+    /// (and passes the step's checks).
+    BranchPoint,
+    /// A point inside a step, sampled to locate a special point: never a branch point.
+    Location,
+}
+
+/// Whether the evaluation after a Newton update from residual `residual` is likely to be the
+/// converged one: Newton's quadratic convergence, `r_next ~ K r^2`, reaches `tolerance` from
+/// `r^2 <= tolerance` when `K` is at most about one per state unit. Only the cost depends on
+/// it (a point accepted from an evaluation not flagged is observed once more afterwards).
+fn likely_converges(residual: f64, tolerance: f64) -> bool {
+    residual * residual <= tolerance
+}
+
+/// Newton's method on `[P(x; p) - x; tau . (u - anchor)] = 0` from `guess`, for `purpose`.
 ///
 /// A failed evaluation of the period map or a singular matrix at a trial point ends the
 /// iteration as not converged (the caller cuts its step), as does an iteration that has not
@@ -111,11 +130,13 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
     anchor: &DVector<f64>,
     tau: &DVector<f64>,
     settings: &NewtonSettings,
+    purpose: Purpose,
 ) -> Result<Corrected, ContinuationError> {
     let n = problem.dim();
     let mut u = guess;
     let mut iterations = 0;
     let mut previous_residual = f64::INFINITY;
+    let mut likely_accepted = false;
     let mut checkpoint = f64::INFINITY;
     let failed = |u: DVector<f64>, iterations, map: Option<PeriodMap>, residual| Corrected {
         u,
@@ -126,8 +147,7 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
     };
     loop {
         let p = u[n];
-        // After a Newton update the evaluation is usually the converged one.
-        let evaluated = if iterations > 0 {
+        let evaluated = if likely_accepted {
             problem.period_map_likely_accepted(&u.as_slice()[..n], p)
         } else {
             problem.period_map(&u.as_slice()[..n], p)
@@ -170,8 +190,97 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
         };
         u -= update;
         iterations += 1;
+        likely_accepted =
+            purpose == Purpose::BranchPoint && likely_converges(residual, settings.tolerance);
         if !u.iter().all(|v| v.is_finite()) {
             return Ok(failed(u, iterations, None, f64::INFINITY));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::RefCell;
+
+    use nalgebra::{DMatrix, DVector};
+
+    use super::{correct, Purpose};
+    use crate::error::ContinuationError;
+    use crate::problem::{OrbitStructure, PeriodMap, PeriodicProblem};
+    use crate::shooting::NewtonSettings;
+
+    /// `P(x; p) = x + x^2 - p`, fixed points `x = +-sqrt(p)`, recording the states of its
+    /// evaluations `(x, likely accepted)`.
+    #[derive(Default)]
+    struct Recording {
+        calls: RefCell<Vec<(f64, bool)>>,
+    }
+
+    impl Recording {
+        fn map(&self, x: f64, p: f64, likely: bool) -> PeriodMap {
+            self.calls.borrow_mut().push((x, likely));
+            PeriodMap {
+                image: DVector::from_element(1, x + x * x - p),
+                monodromy: DMatrix::from_element(1, 1, 1.0 + 2.0 * x),
+                parameter_derivative: DVector::from_element(1, -1.0),
+                structure: OrbitStructure::default(),
+            }
+        }
+    }
+
+    impl PeriodicProblem for Recording {
+        fn dim(&self) -> usize {
+            1
+        }
+
+        fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError> {
+            Ok(self.map(x[0], p, false))
+        }
+
+        fn period_map_likely_accepted(
+            &self,
+            x: &[f64],
+            p: f64,
+        ) -> Result<PeriodMap, ContinuationError> {
+            Ok(self.map(x[0], p, true))
+        }
+    }
+
+    /// Newton on `x^2 - 4 = 0` at `p = 4` (the hyperplane `p = 4`) from `x = 2.5`,
+    /// `x_{k+1} = (x_k + 4 / x_k) / 2`, has residuals `x_k^2 - 4` of 2.25, 0.2025, 2.4e-3,
+    /// 3.7e-7, then below 1e-14 (recomputed in the test): only the update from 3.7e-7
+    /// (squared 1.4e-13, below the tolerance 1e-10) is followed by a likely-accepted
+    /// evaluation, the converged one; a location's corrections never are.
+    #[test]
+    fn only_the_evaluation_after_a_small_residual_is_likely_accepted() {
+        let settings = NewtonSettings {
+            max_iterations: 6,
+            ..NewtonSettings::default()
+        };
+        let anchor = DVector::from_vec(vec![2.5, 4.0]);
+        let tau = DVector::from_vec(vec![0.0, 1.0]);
+        let mut residuals = Vec::new();
+        let mut x: f64 = 2.5;
+        while (x * x - 4.0).abs() > settings.tolerance {
+            residuals.push((x * x - 4.0).abs());
+            x = 0.5 * (x + 4.0 / x);
+        }
+        assert_eq!(residuals.len(), 4);
+        for (purpose, likely_calls) in [(Purpose::BranchPoint, 1), (Purpose::Location, 0)] {
+            let problem = Recording::default();
+            let corrected = correct(&problem, anchor.clone(), &anchor, &tau, &settings, purpose)
+                .expect("corrected");
+            assert!(corrected.converged);
+            assert_eq!(corrected.iterations, 4);
+            assert!((corrected.u[0] - 2.0).abs() < 1e-12);
+            let calls = problem.calls.borrow();
+            assert_eq!(calls.len(), 5);
+            let likely: Vec<f64> = calls.iter().filter(|c| c.1).map(|c| c.0).collect();
+            assert_eq!(likely.len(), likely_calls);
+            if let Some(&x_likely) = likely.first() {
+                assert_eq!(x_likely, corrected.u[0], "the converged evaluation");
+                assert_eq!(calls.last().map(|c| c.1), Some(true));
+            }
         }
     }
 }

@@ -20,7 +20,7 @@ use std::cell::{Cell, RefCell};
 use nalgebra::{Complex, DVector};
 use roots::{find_root_regula_falsi, Convergency};
 
-use crate::corrector::{correct, tangent};
+use crate::corrector::{correct, tangent, Purpose};
 use crate::error::ContinuationError;
 use crate::floquet::floquet_multipliers;
 use crate::problem::{PeriodMap, PeriodicProblem};
@@ -228,7 +228,14 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             };
             (guess, anchor)
         };
-        let corrected = correct(self.problem, guess, &anchor, &self.tau, &self.settings)?;
+        let corrected = correct(
+            self.problem,
+            guess,
+            &anchor,
+            &self.tau,
+            &self.settings,
+            Purpose::Location,
+        )?;
         Ok(match (corrected.converged, corrected.map) {
             (true, Some(map)) => Some((corrected.u, map)),
             _ => None,

@@ -76,10 +76,12 @@ pub trait PeriodicProblem {
     fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError>;
 
     /// As [`PeriodicProblem::period_map`], at a point the corrector expects to accept: an
-    /// evaluation after a Newton update, which converges there unless Newton needs more
-    /// iterations. A problem may do more here that only an accepted point needs (the AFM
-    /// diagram records the orbit's observables during the same integration); the map itself
-    /// must be the same as `period_map`'s. Default: `period_map`.
+    /// evaluation of a branch's trial point after a Newton update from a residual `r` with
+    /// `r^2 <= tolerance` (quadratic convergence: usually the converged evaluation; the
+    /// points sampled to locate special points never are). A problem may do more here that
+    /// only an accepted point needs (the AFM diagram records the orbit's observables during
+    /// the same integration); the map itself must be the same as `period_map`'s. Default:
+    /// `period_map`.
     ///
     /// # Errors
     /// As [`PeriodicProblem::period_map`].

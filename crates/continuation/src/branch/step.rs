@@ -7,7 +7,7 @@ use nalgebra::DVector;
 
 use super::corner::CORNER_FAILURES;
 use super::{BranchPoint, Continuation, StopReason};
-use crate::corrector::correct;
+use crate::corrector::{correct, Purpose};
 use crate::error::ContinuationError;
 use crate::floquet::is_stable;
 use crate::hermite::hermite_basis;
@@ -137,6 +137,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             &predicted,
             t_a,
             &self.settings.corrector,
+            Purpose::BranchPoint,
         )?;
         // A corrector that wandered further than the step itself has probably left the
         // branch: treat it as a failure.
