@@ -119,10 +119,10 @@ fn likely_converges(residual: f64, tolerance: f64) -> bool {
 }
 
 /// The residual, in multiples of Newton's tolerance, below which the corrector does not
-/// judge its progress from the guess: down there the residual is close to the period map's
-/// integration error (the tolerance is set a little above it, [`NewtonSettings::tolerance`])
-/// and Newton's updates need not reduce it (on `biolever-adhesive`'s retract, corrections
-/// from 1.5e-10 to 1.5e-9 stayed there for 3 to 7 updates before converging).
+/// judge its progress (from the guess, or against its smallest residual): down there the
+/// residual is close to the period map's integration error (the tolerance is set a little
+/// above it, [`NewtonSettings::tolerance`]) and Newton's updates need not reduce it before
+/// one lands below the tolerance (as next to a JKR diagram's breaks).
 const NOISE_FLOOR: f64 = 100.0;
 
 /// Newton's method on `[P(x; p) - x; tau . (u - anchor)] = 0` from `guess`, for `purpose`.
