@@ -262,6 +262,9 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// bounds the step taken inside it, so the step's search reuses them.
     span_bounds: [f64; MAX_SURFACES],
     span_bounded: bool,
+    /// `(surface, t)` of the state in `x_far`: the earliest point on the far side of that
+    /// surface the crossing search of the last step evaluated, `None` if none.
+    far_evaluated: Option<(usize, f64)>,
     /// Whether every switching function is affine (gradients and drifts in the buffers), so
     /// that a Runge-Kutta step may be proven settled on its interpolant.
     affine_switching: bool,
@@ -399,6 +402,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             proven_clear: false,
             span_bounds: [0.0; MAX_SURFACES],
             span_bounded: false,
+            far_evaluated: None,
             affine_switching,
             series_switching,
             given_series,
