@@ -95,6 +95,31 @@ fn blocks_average_single_cycle_readings_and_every_decimates() {
     assert_eq!(decimated, expected);
 }
 
+/// The cycles of blocks that `every` drops are integrated without the lock-in: the records
+/// kept are, bit for bit, every N-th record of the sweep that reads every cycle, in both legs
+/// (blocks of 2 cycles, every 3rd, approach and retract).
+#[test]
+fn dropped_blocks_leave_the_kept_records_unchanged() {
+    let model = biolever_on_mica();
+    let mut settings = window(&model, 9.0, 8.95, 20.0);
+    settings.lockin_cycles = 2;
+    settings.retract = true;
+    let all = run(&model, settings.clone());
+    settings.every = 3;
+    let decimated = run(&model, settings);
+    let expected: Vec<_> = [SweepDirection::Approach, SweepDirection::Retract]
+        .into_iter()
+        .flat_map(|direction| {
+            all.iter()
+                .filter(move |record| record.direction == direction)
+                .step_by(3)
+                .cloned()
+        })
+        .collect();
+    assert!(expected.len() >= 6, "{} records", expected.len());
+    assert_eq!(decimated, expected);
+}
+
 /// With `retract`, the sweep comes back from the floor to the start at the same rate: as many
 /// cycles as the approach, Z rising by one cycle's travel per cycle, the cycle count continued.
 #[test]

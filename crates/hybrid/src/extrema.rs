@@ -97,7 +97,9 @@ impl Samples {
     /// Sample `h_k` and `dh_k/dt` (in `mode`) at the step's points between `t0` and `t1`;
     /// with `grid`, the interior states are read from it (interior point `i` at
     /// `grid[(i - 1) n .. i n]`, as [`crate::ExactFlow::exact_flow_grid`] writes them) instead of
-    /// `state_at`.
+    /// `state_at`. With `ends_sampled`, the step's ends were just recorded by
+    /// [`Samples::sample_ends`] (from the same states `state_at` gives there), and only the
+    /// interior points are sampled.
     ///
     /// # Errors
     /// [`HybridError::NonFiniteSwitching`] if a sample is NaN or infinite.
@@ -107,8 +109,7 @@ impl Samples {
         &mut self,
         system: &S,
         mode: Mode,
-        t0: f64,
-        t1: f64,
+        (t0, t1, ends_sampled): (f64, f64, bool),
         state_at: &mut StateAt<'_>,
         grid: Option<&[f64]>,
         x: &mut [f64],
@@ -121,7 +122,8 @@ impl Samples {
         }
         self.ends_only = false;
         let first = usize::from(self.start_valid);
-        for i in first..p {
+        let end = if ends_sampled { last } else { p };
+        for i in first..end {
             let t = self.times[i];
             match grid {
                 Some(states) if i > 0 && i < last => {
@@ -358,7 +360,7 @@ mod tests {
         let mut x = [0.0; 2];
         let mut state_at = |t: f64, x: &mut [f64]| valley.state_at(t, x);
         samples
-            .sample(&valley, 0, 0.0, 1.0, &mut state_at, None, &mut x)
+            .sample(&valley, 0, (0.0, 1.0, false), &mut state_at, None, &mut x)
             .expect("finite samples");
         let mut found = Vec::with_capacity(4);
         let bounds = [2.0];

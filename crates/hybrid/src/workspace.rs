@@ -75,6 +75,9 @@ pub(crate) struct Buffers {
     pub samples: Samples,
     pub extrema: Vec<Extremum>,
     pub x: Vec<f64>,
+    /// The state at the earliest far-side point the last crossing search evaluated
+    /// ([`crate::solver`]'s `earliest_crossing`), for the event fired there.
+    pub x_far: Vec<f64>,
     pub x_after: Vec<f64>,
     pub f_minus: Vec<f64>,
     pub f_plus: Vec<f64>,
@@ -134,6 +137,7 @@ impl Buffers {
             samples,
             extrema: Vec::with_capacity(extrema_capacity),
             x: vec![0.0; n],
+            x_far: vec![0.0; n],
             x_after: vec![0.0; n],
             f_minus: vec![0.0; n],
             f_plus: vec![0.0; n],

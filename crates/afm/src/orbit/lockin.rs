@@ -323,6 +323,21 @@ impl BlockAverage {
         (self.count == self.cycles_per_block).then(|| self.flush())
     }
 
+    /// Count cycle `cycle` without a reading, for a block whose reading is not wanted (every
+    /// cycle of the block is counted so): `true` when this cycle completes the block, which is
+    /// then discarded.
+    pub fn skip(&mut self, cycle: u64) -> bool {
+        if self.count == 0 {
+            self.first_cycle = cycle;
+        }
+        self.count += 1;
+        let complete = self.count == self.cycles_per_block;
+        if complete {
+            self.clear();
+        }
+        complete
+    }
+
     /// Discard a partly filled block (at a change of sweep direction).
     pub fn clear(&mut self) {
         self.count = 0;

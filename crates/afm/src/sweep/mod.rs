@@ -20,7 +20,9 @@
 //! Cycles are grouped in consecutive, non-overlapping blocks of `lockin_cycles`; each block
 //! gives one [`SweepRecord`] (Fourier coefficients averaged over the block), and every
 //! `every`-th record is returned. A block never spans the turn from approach to retract: the
-//! unfinished block at the floor is discarded.
+//! unfinished block at the floor is discarded. The cycles of the blocks not returned, and the
+//! settling cycles, are integrated without the lock-in ([`advance_cycle`]: the same steps,
+//! no reading).
 
 pub mod amplitude_ratio;
 
@@ -410,9 +412,16 @@ impl Sweep {
 
     fn advance(&mut self) -> Result<Option<SweepRecord>, AfmError> {
         if !self.settled {
-            let separation = Separation::Constant(self.settings.from_nm);
+            // The settling cycles are not read.
+            self.model
+                .set_separation(Separation::Constant(self.settings.from_nm))?;
             for _ in 0..self.settings.settle_cycles {
-                self.run_cycle(separation)?;
+                advance_cycle(
+                    &self.model,
+                    &self.settings.integration,
+                    &mut self.state,
+                    &mut self.workspace,
+                )?;
             }
             self.settled = true;
         }
@@ -443,16 +452,31 @@ impl Sweep {
                     z0 + 0.5 * self.z_step_nm,
                 )
             };
-            let reading = self.run_cycle(separation)?;
+            // Only the blocks whose records are returned (every `every`-th) are read: the
+            // cycles of the others are integrated without the lock-in.
+            let due = self
+                .blocks_in_leg
+                .is_multiple_of(self.settings.every as u64);
+            let (completed, block) = if due {
+                let reading = self.run_cycle(separation)?;
+                let block = self.average.push(k, z_mid, &reading);
+                (block.is_some(), block)
+            } else {
+                self.model.set_separation(separation)?;
+                advance_cycle(
+                    &self.model,
+                    &self.settings.integration,
+                    &mut self.state,
+                    &mut self.workspace,
+                )?;
+                (self.average.skip(k), None)
+            };
             self.cycles_done += 1;
-            if let Some(block) = self.average.push(k, z_mid, &reading) {
-                let due = self
-                    .blocks_in_leg
-                    .is_multiple_of(self.settings.every as u64);
+            if completed {
                 self.blocks_in_leg += 1;
-                if due {
-                    return Ok(Some(SweepRecord::new(direction, block)));
-                }
+            }
+            if let Some(block) = block {
+                return Ok(Some(SweepRecord::new(direction, block)));
             }
         }
         Ok(None)
@@ -506,6 +530,31 @@ pub fn integrate_cycle(
     *workspace = solver.into_workspace();
     debug_assert_eq!(state.len(), model.dim());
     Ok(reading)
+}
+
+/// Integrate one drive cycle (local time `[0, T]`) of `model` under its separation law from
+/// `state` (replaced by the state at the cycle's end) without reading it: the same steps and
+/// states as [`integrate_cycle`], for cycles whose reading nobody asks for. The solver's
+/// buffers are taken from `workspace` and given back.
+pub fn advance_cycle(
+    model: &TappingModel,
+    integration: &Settings,
+    state: &mut [f64],
+    workspace: &mut SolverWorkspace,
+) -> Result<(), AfmError> {
+    let period = model.period_us();
+    let mut solver = Solver::with_workspace(
+        model,
+        0.0,
+        state,
+        Sensitivity::None,
+        integration.clone(),
+        std::mem::take(workspace),
+    )?;
+    while !matches!(solver.step(period)?, StepOutcome::EndTime) {}
+    state.copy_from_slice(solver.state());
+    *workspace = solver.into_workspace();
+    Ok(())
 }
 
 impl Iterator for Sweep {

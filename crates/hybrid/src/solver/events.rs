@@ -7,7 +7,7 @@ use crate::event_location::{crossing_guess, locate_sign_change, Bracket};
 use crate::system::{side_sign, Direction, HybridSystem, Mode};
 
 use super::dense_output::state_in_step;
-use super::Solver;
+use super::{Solver, StepKind};
 
 impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// Scan every surface for its first strict crossing in the step (through samples and
@@ -27,6 +27,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let intervals = if ends_only { 1 } else { p - 1 };
         let mut best: Option<(usize, Bracket)> = None;
         let value_tolerance = self.settings.event_value_tolerance;
+        self.far_evaluated = None;
         for k in 0..self.surfaces {
             let side = side_sign(mode, k);
             // At the step start the side is the mode's, whatever the computed value.
@@ -82,11 +83,20 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             let z_new = &self.buffers.z_new;
             let clock = (self.clock, self.sigma_start);
             let x = &mut self.buffers.x;
+            let (x_far, far_evaluated) = (&mut self.buffers.x_far, &mut self.far_evaluated);
             let mut g = |t: f64| {
                 state_in_step(
                     exact_flow, kind, mode, dense, clock, z_start, z_new, t0, t1, n, t, x,
                 );
-                side * system.switching(k, t, x)
+                let value = side * system.switching(k, t, x);
+                // The earliest far-side state is kept: the located crossing's far end is
+                // usually one of them, and the event fires there.
+                if value <= 0.0 && far_evaluated.is_none_or(|(surface, at)| surface != k || t < at)
+                {
+                    x_far.copy_from_slice(x);
+                    *far_evaluated = Some((k, t));
+                }
+                value
             };
             let bracket = locate_sign_change(
                 a,
@@ -134,10 +144,17 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         }
         let reset = system.has_reset(k, direction);
         let mut t_event = bracket.far;
-        if !reset {
-            self.redo_onto_crossing(k, t_event)?;
+        let redone = !reset && self.redo_onto_crossing(k, t_event)?;
+        if !redone && self.dim == n && self.far_evaluated == Some((k, t_event)) {
+            // The crossing search evaluated the state there (the same call on the same step).
+            self.buffers.z.copy_from_slice(&self.buffers.x_far);
+            if self.kind == StepKind::Exact {
+                // As `augmented_at` leaves it: the truncated exact step's end.
+                self.buffers.z_new.copy_from_slice(&self.buffers.x_far);
+            }
+        } else {
+            self.augmented_at(t_event);
         }
-        self.augmented_at(t_event);
         if reset {
             // Does the reset send the state back to the side it came from (a bounce)? Then
             // return the bracket end on that side.

@@ -257,6 +257,14 @@ pub struct Solver<'a, S: HybridSystem + ?Sized> {
     /// Whether the last step was proven clear of every surface before it was taken (an exact
     /// step inside the span of [`Solver::clear_exact_span`], stretched or not).
     proven_clear: bool,
+    /// The curvature bounds of every surface over the span [`Solver::clear_exact_span`]
+    /// considered from the last step's start, where `span_bounded`: a bound over that span
+    /// bounds the step taken inside it, so the step's search reuses them.
+    span_bounds: [f64; MAX_SURFACES],
+    span_bounded: bool,
+    /// `(surface, t)` of the state in `x_far`: the earliest point on the far side of that
+    /// surface the crossing search of the last step evaluated, `None` if none.
+    far_evaluated: Option<(usize, f64)>,
     /// Whether every switching function is affine (gradients and drifts in the buffers), so
     /// that a Runge-Kutta step may be proven settled on its interpolant.
     affine_switching: bool,
@@ -392,6 +400,9 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             step_end: t0,
             full_dense: false,
             proven_clear: false,
+            span_bounds: [0.0; MAX_SURFACES],
+            span_bounded: false,
+            far_evaluated: None,
             affine_switching,
             series_switching,
             given_series,

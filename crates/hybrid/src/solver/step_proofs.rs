@@ -6,7 +6,7 @@ use crate::bernstein::{stays_above, strict_sign};
 use crate::clock::Clock;
 use crate::extrema::Clearance;
 use crate::series_step::TAYLOR_ORDER;
-use crate::system::{side_sign, HybridSystem, Mode};
+use crate::system::{side_sign, HybridSystem, Mode, MAX_SURFACES};
 
 use super::tuning::BOUND_ROUNDING_MARGIN;
 use super::{Solver, StepKind};
@@ -18,25 +18,26 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// bound `M` over `[t0, t0 + longest]`, `g(t0 + s) >= g0 + g0' s - M s^2 / 2`, which stays
     /// above the height up to the positive root of that parabola. `None` if the start samples
     /// are not at hand (first step after an event), the height is infinite, the system gives
-    /// no bound, or a surface is already within the height.
-    pub(super) fn clear_exact_span(&self, mode: Mode, t0: f64, longest: f64) -> Option<f64> {
+    /// no bound, or a surface is already within the height. The bounds, where the system gave
+    /// them all, are kept in `span_bounds` for the search of the step taken inside the span.
+    pub(super) fn clear_exact_span(&mut self, mode: Mode, t0: f64, longest: f64) -> Option<f64> {
         let height = self.settings.extremum_height;
         if !height.is_finite() || !self.buffers.samples.start_valid {
             return None;
         }
+        let mut bounds = [0.0; MAX_SURFACES];
+        if !self.curvature_bounds_over(mode, t0, longest, &mut bounds) {
+            return None;
+        }
+        let surfaces = self.surfaces;
+        self.span_bounds[..surfaces].copy_from_slice(&bounds[..surfaces]);
+        self.span_bounded = true;
         let p = self.buffers.samples.points();
         let mut span = longest;
-        for k in 0..self.surfaces {
+        for (k, &bound) in bounds.iter().enumerate().take(self.surfaces) {
             let side = side_sign(mode, k);
             let margin = side * self.buffers.samples.values[k * p] - height;
             let rate = side * self.buffers.samples.rates[k * p];
-            let bound = self.accelerations.switching_curvature_bound(
-                k,
-                mode,
-                t0,
-                &self.buffers.z_start[..self.n],
-                longest,
-            )?;
             if !(side > 0.0
                 && margin > 0.0
                 && bound >= 0.0
@@ -171,13 +172,18 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         t1: f64,
         bounds: &mut [f64],
     ) -> bool {
+        self.curvature_bounds_over(mode, t0, t1 - t0, bounds)
+    }
+
+    /// [`Solver::curvature_bounds`] over `[t0, t0 + dt]`.
+    fn curvature_bounds_over(&self, mode: Mode, t0: f64, dt: f64, bounds: &mut [f64]) -> bool {
         (0..self.surfaces).all(|k| {
             match self.accelerations.switching_curvature_bound(
                 k,
                 mode,
                 t0,
                 &self.buffers.z_start[..self.n],
-                t1 - t0,
+                dt,
             ) {
                 Some(bound) if bound >= 0.0 => {
                     bounds[k] = bound;

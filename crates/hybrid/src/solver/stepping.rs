@@ -41,6 +41,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let mode = self.mode;
         self.buffers.z_start.copy_from_slice(&self.buffers.z);
         self.proven_clear = false;
+        self.span_bounded = false;
         let t1 = if self.accelerations.has_exact_flow(mode) {
             self.exact_step(t_end)?
         } else if let Some(t1) = self.taylor_step(t_end)? {
@@ -102,7 +103,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         // interval of it, that they prove farther than the height from every surface is not
         // searched for extrema.
         let mut bounds = [0.0; MAX_SURFACES];
-        let bounded = !self.proven_clear && self.curvature_bounds(mode, t0, t1, &mut bounds);
+        let surfaces = self.surfaces;
+        let bounded = !self.proven_clear
+            && if self.span_bounded {
+                // The bounds over the span the step lies in, from the same start.
+                bounds[..surfaces].copy_from_slice(&self.span_bounds[..surfaces]);
+                true
+            } else {
+                self.curvature_bounds(mode, t0, t1, &mut bounds)
+            };
         let clearance = (bounded && self.settings.extremum_height.is_finite()).then(|| Clearance {
             height: self.settings.extremum_height,
             bounds: &bounds[..self.surfaces],
@@ -115,7 +124,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             StepKind::Taylor => self.series_switching,
             _ => false,
         };
-        let clear = (self.settings.extremum_height.is_finite() || polynomial || bounded) && {
+        let ends_sampled = self.settings.extremum_height.is_finite() || polynomial || bounded;
+        let clear = ends_sampled && {
             self.buffers.samples.sample_ends(
                 self.system,
                 mode,
@@ -132,13 +142,14 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 || (bounded && self.monotone_by_curvature(t1 - t0, &bounds))
         };
         if !clear {
-            self.sample_inside(mode, t0, t1, time_tolerance, clearance)?;
+            self.sample_inside(mode, t0, t1, time_tolerance, clearance, ends_sampled)?;
         }
         Ok(())
     }
 
     /// Sample the step `[t0, t1]` at its interior points and locate the extrema of every
-    /// `h_k` between them (skipping sample intervals `clearance` proves clear).
+    /// `h_k` between them (skipping sample intervals `clearance` proves clear); `ends_sampled`:
+    /// its ends were just sampled ([`Samples::sample_ends`]), and are not sampled again.
     fn sample_inside(
         &mut self,
         mode: Mode,
@@ -146,6 +157,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         t1: f64,
         time_tolerance: f64,
         clearance: Option<Clearance<'_>>,
+        ends_sampled: bool,
     ) -> Result<(), HybridError> {
         self.statistics.sampled_steps += 1;
         let system = self.system;
@@ -190,8 +202,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         self.buffers.samples.sample(
             system,
             mode,
-            t0,
-            t1,
+            (t0, t1, ends_sampled),
             &mut state_at,
             grid,
             &mut self.buffers.x,
