@@ -193,7 +193,22 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             } else {
                 None
             };
+            // Located by continuing a square-root step centred ahead (a mode whose Jacobian
+            // diverges at the crossing, `continue_last_step`): far past that step's end in its
+            // clock's variable, too coarse to land on (a landing that ends short of the crossing
+            // leaves the tangents' branch point at its end), so the step that reaches it probes.
+            let continued_root_clock = self.accelerations.jacobian_diverges_at_crossing(mode)
+                && matches!(self.clock, Clock::SquareRoot { reference } if reference > t0);
             match located {
+                Some(t_cross)
+                    if continued_root_clock
+                        && resolvable(t_cross - t0, t0)
+                        && h >= t_cross - t0
+                        && t_cross - t0 <= max_step =>
+                {
+                    attempts.h = ((t_cross - t0) * (1.0 + PROBE_OVERSHOOT)).min(max_step);
+                    attempts.landing = Some(t_cross - t0);
+                }
                 Some(t_cross) if resolvable(t_cross - t0, t0) && t_cross - t0 <= max_step => {
                     let target = (t_cross - t0) * (1.0 + ROOT_OVERSHOOT);
                     let reference = t0 + target;
