@@ -103,8 +103,8 @@ fn recoverable(error: &ContinuationError) -> bool {
 ///
 /// A failed evaluation of the period map or a singular matrix at a trial point ends the
 /// iteration as not converged (the caller cuts its step), as does an iteration that has not
-/// halved its residual between its 3rd and 6th update ([`NEWTON_STALL`]: a guess with no orbit
-/// near it); dimension errors propagate.
+/// halved its residual over 3 updates, from its start on ([`NEWTON_STALL`]: a guess with no
+/// orbit near it); dimension errors propagate.
 pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
     problem: &P,
     guess: DVector<f64>,
