@@ -12,7 +12,7 @@ use super::tuning::{
     APPROACH_FRACTION, FAILED_LANDING_ORDER, LANDING_OVERSHOOT, LANDING_REACH, MAX_RETARGETS,
     MIN_STEP_EPSILONS, NON_FINITE_RETRY, ORDER_ESTIMATE_RANGE, PREDICTED_OVERSHOOT,
     PROBE_OVERSHOOT, REJECTION_TARGET_ERROR, RETARGET_MOVE, ROOT_APPROACH, ROOT_CLOCK_SPAN,
-    ROOT_OVERSHOOT, STEP_RATIO_AFTER_REJECTION,
+    ROOT_OVERSHOOT, SERIES_HANDOVER_FRACTION, STEP_RATIO_AFTER_REJECTION,
 };
 use super::{Solver, StepKind};
 use crate::variational_field::clocked_field;
@@ -203,8 +203,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             // Located by continuing a square-root step centred ahead (`continue_last_step`), or
             // by a series expanded before it: too coarse to land on (a landing that ends short
             // of the crossing leaves the tangents' branch point at its end). After a series, a
-            // step in time at most `APPROACH_FRACTION` of the way (not a probe from afar, which
-            // the crossing's square root rejects, nor a square-root clock centred on the
+            // step in time at most `SERIES_HANDOVER_FRACTION` of the way (not a probe from afar,
+            // which the crossing's square root rejects, nor a square-root clock centred on the
             // series' estimate: tried, it left the adhesive retract's period doublings 7e-9 nm
             // off); after a continued square-root step, the step that reaches it probes.
             let continued_root_clock = divergent
@@ -213,7 +213,7 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 Some(t_cross)
                     if after_series && resolvable(t_cross - t0, t0) && t_cross - t0 <= max_step =>
                 {
-                    attempts.h = h.min(APPROACH_FRACTION * (t_cross - t0));
+                    attempts.h = h.min(SERIES_HANDOVER_FRACTION * (t_cross - t0));
                 }
                 Some(t_cross)
                     if continued_root_clock
