@@ -190,12 +190,12 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
                 converged: true,
             });
         }
-        if iterations == 0 && residual > NOISE_FLOOR * settings.tolerance {
-            checkpoint = residual;
-        }
+        // The stall check's first window starts at the guess (update 0) only above the noise
+        // floor; below it, the check's first residual is the 3rd update's.
+        let checked = iterations > 0 || residual > NOISE_FLOOR * settings.tolerance;
         if iterations >= settings.max_iterations
             || residual > settings.divergence_factor * previous_residual
-            || NEWTON_STALL.stalled(iterations, residual, &mut checkpoint)
+            || (checked && NEWTON_STALL.stalled(iterations, residual, &mut checkpoint))
             || (iterations >= 2
                 && best_residual > NOISE_FLOOR * settings.tolerance
                 && residual >= best_residual)

@@ -97,8 +97,8 @@ pub fn shoot<P: PeriodicProblem + ?Sized>(
     shoot_checked(problem, x0, p, settings, None)
 }
 
-/// A check of Newton's progress: from `updates` updates on, every further `updates` updates
-/// must reduce the residual by `reduction`, else the iteration stops (not converged).
+/// A check of Newton's progress: every `updates` updates, from the first evaluation on, must
+/// reduce the residual by `reduction`, else the iteration stops (not converged).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct StallCheck {
     /// The updates between two residuals compared (and before the first).
@@ -109,10 +109,15 @@ pub(crate) struct StallCheck {
 
 impl StallCheck {
     /// Whether the iteration stops at update `iterations` with `residual`: at every multiple
-    /// of `updates` from the second on, the residual is compared with the one `updates`
-    /// updates earlier, recorded in `checkpoint` (kept across calls; start it at infinity).
+    /// of `updates`, the residual is compared with the one `updates` updates earlier (the
+    /// first with the residual before any update), recorded in `checkpoint` (kept across
+    /// calls, set at update 0; call it at every update from 0 on).
     pub(crate) fn stalled(&self, iterations: usize, residual: f64, checkpoint: &mut f64) -> bool {
-        if iterations == 0 || !iterations.is_multiple_of(self.updates) {
+        if iterations == 0 {
+            *checkpoint = residual;
+            return false;
+        }
+        if !iterations.is_multiple_of(self.updates) {
             return false;
         }
         let stalled = residual > self.reduction * *checkpoint;
@@ -122,14 +127,16 @@ impl StallCheck {
 }
 
 /// The progress a Newton iteration that may start outside its basin must make to go on: its
-/// residual halved over every 3 updates from the 3rd on. From a guess in its basin Newton's
+/// residual halved over every 3 updates from the start. From a guess in its basin Newton's
 /// method converges quadratically (corrections and corner jumps that land converge in 1 to 5
 /// updates), while an iteration with no orbit near its guess wanders at a residual that barely
 /// moves, or cycles: on JKR's hysteretic grazings (`biolever-adhesive`'s approach) the 72 failed
 /// corrections and 13 of the 18 corner-jump shots each spent all their 12 (48) updates at
 /// residuals of 0.05 to 0.15 nm, 40% of the diagram's period maps; on `biolever-sticky` 4 shots
-/// halved their residual between the 3rd and 6th update and ran on to 48 at 0.7 to 1.2 nm.
-/// Used by the continuation's corrector and its corner jumps.
+/// halved their residual between the 3rd and 6th update and ran on to 48 at 0.7 to 1.2 nm. The
+/// first window counts from the start: such an iteration sits at about the residual it starts
+/// with, and is given up after 3 updates.
+/// Used by the continuation's corrector, its corner jumps and the locations' shots.
 pub(crate) const NEWTON_STALL: StallCheck = StallCheck {
     updates: 3,
     reduction: 0.5,
@@ -270,9 +277,9 @@ mod tests {
 
     /// With no fixed point (`x^2 + 1 = 0`), Newton's iterates from `x_0 = cot(theta)` are
     /// `x_k = cot(2^k theta)` (`x -> (x - 1/x)/2` doubles the angle), with residuals `1 +
-    /// x_k^2 = 1/sin^2(2^k theta)`: from `theta = 0.3`, 2.19 after 3 updates and 8.50 after 6,
-    /// not halved, so the checked iteration stops after 6 updates at `cot(19.2)`, where the
-    /// unchecked one runs on to its 12.
+    /// x_k^2 = 1/sin^2(2^k theta)`: from `theta = 0.3`, 11.4 at the start, 2.19 after 3 updates
+    /// (halved) and 8.50 after 6 (not halved), so the checked iteration stops after 6 updates at
+    /// `cot(19.2)`, where the unchecked one runs on to its 12.
     #[test]
     fn a_wandering_iteration_stops_after_two_checks() {
         let theta: f64 = 0.3;
@@ -288,6 +295,23 @@ mod tests {
         assert!((checked.residual - residual).abs() < 1e-11 * residual);
         let unchecked = shoot(&Quadratic, &[x0], 1.0, &settings).expect("shot");
         assert_eq!(unchecked.iterations, settings.max_iterations);
+    }
+
+    /// The first window counts from the start: from `theta = 1.2` (iterates and residuals as
+    /// above) the residual is 1.15 at the start and 33.0 after 3 updates, not halved, so the
+    /// checked iteration stops after 3 updates at `cot(9.6)`.
+    #[test]
+    fn an_iteration_that_does_not_start_converging_stops_at_the_first_check() {
+        let theta: f64 = 1.2;
+        let x0 = 1.0 / theta.tan();
+        let settings = NewtonSettings::default();
+        let checked = shoot_checked(&Quadratic, &[x0], 1.0, &settings, Some(CHECK)).expect("shot");
+        assert!(!checked.converged);
+        assert_eq!(checked.iterations, 3);
+        let x3 = 1.0 / (8.0 * theta).tan();
+        assert!((checked.state[0] - x3).abs() < 1e-12 * x3.abs().max(1.0));
+        let residual = 1.0 / (8.0 * theta).sin().powi(2);
+        assert!((checked.residual - residual).abs() < 1e-11 * residual);
     }
 
     /// A converging iteration is the unchecked one, iterate for iterate: `x^2 - 2 = 0` from

@@ -13,13 +13,30 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     /// The time at which surface `k` is crossed within `reach` of the current time, located on
     /// the last accepted step's dense output continued past its end (which ended here, with
     /// no event since), if it is crossed there.
+    ///
+    /// In a mode whose Jacobian diverges at the crossing
+    /// ([`crate::SwitchingStructure::jacobian_diverges_at_crossing`]: no series centred ahead of
+    /// it, so Runge-Kutta steps make the whole approach), a last step on a square-root clock
+    /// centred ahead is continued up to its reference at most: past it the continuation in the
+    /// clock's variable retraces the approach (`t - reference` is even in it), so it never shows
+    /// the crossing the clock was centred just past, and the next step would fall back to the
+    /// time clock, whose steps the crossing's square root cuts short. Elsewhere (a series makes
+    /// the approach, and these steps are rare) the continuation is as before, so that those
+    /// systems' steps do not change.
     pub(super) fn continue_last_step(&mut self, k: usize, reach: f64) -> Option<f64> {
         let n = self.n;
         let system = self.system;
         let mode = self.mode;
         let (clock, sigma0, dsigma) = (self.clock, self.sigma_start, self.buffers.rk.h);
         let t0 = self.t;
-        let t1 = t0 + reach;
+        let t1 = match clock {
+            Clock::SquareRoot { reference }
+                if reference > t0 && self.accelerations.jacobian_diverges_at_crossing(mode) =>
+            {
+                (t0 + reach).min(reference)
+            }
+            _ => t0 + reach,
+        };
         let side = side_sign(mode, k);
         let rk = &self.buffers.rk;
         let z_end = &self.buffers.z;

@@ -12,7 +12,7 @@ use super::tuning::{
     APPROACH_FRACTION, FAILED_LANDING_ORDER, LANDING_OVERSHOOT, LANDING_REACH, MAX_RETARGETS,
     MIN_STEP_EPSILONS, NON_FINITE_RETRY, ORDER_ESTIMATE_RANGE, PREDICTED_OVERSHOOT,
     PROBE_OVERSHOOT, REJECTION_TARGET_ERROR, RETARGET_MOVE, ROOT_APPROACH, ROOT_CLOCK_SPAN,
-    ROOT_OVERSHOOT, STEP_RATIO_AFTER_REJECTION,
+    ROOT_OVERSHOOT, SERIES_HANDOVER_FRACTION, STEP_RATIO_AFTER_REJECTION,
 };
 use super::{Solver, StepKind};
 use crate::variational_field::clocked_field;
@@ -188,12 +188,42 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             // continued (the solution is smooth up to the crossing); the step that reaches it
             // lands on it. Without that location, a probe: a step just past the predicted
             // crossing, whose dense output locates it if the kink makes it fail.
+            let divergent = self.accelerations.jacobian_diverges_at_crossing(mode);
+            // After a Taylor step in a mode whose Jacobian diverges at the crossing (its series
+            // take no square-root clock centred ahead, so Runge-Kutta steps make the approach):
+            // the crossing that step's series predicted.
+            let after_series = divergent && self.kind == StepKind::Taylor && self.steps_in_mode > 0;
             let located = if self.first_same_as_last && self.kind == StepKind::RungeKutta {
                 self.continue_last_step(k, s * (1.0 + PROBE_OVERSHOOT))
+            } else if after_series {
+                self.predicted_crossing.filter(|&t_cross| t_cross > t0)
             } else {
                 None
             };
+            // Located by continuing a square-root step centred ahead (`continue_last_step`), or
+            // by a series expanded before it: too coarse to land on (a landing that ends short
+            // of the crossing leaves the tangents' branch point at its end). After a series, a
+            // step in time at most `SERIES_HANDOVER_FRACTION` of the way (not a probe from afar,
+            // which the crossing's square root rejects, nor a square-root clock centred on the
+            // series' estimate: tried, it left the adhesive retract's period doublings 7e-9 nm
+            // off); after a continued square-root step, the step that reaches it probes.
+            let continued_root_clock = divergent
+                && matches!(self.clock, Clock::SquareRoot { reference } if reference > t0);
             match located {
+                Some(t_cross)
+                    if after_series && resolvable(t_cross - t0, t0) && t_cross - t0 <= max_step =>
+                {
+                    attempts.h = h.min(SERIES_HANDOVER_FRACTION * (t_cross - t0));
+                }
+                Some(t_cross)
+                    if continued_root_clock
+                        && resolvable(t_cross - t0, t0)
+                        && h >= t_cross - t0
+                        && t_cross - t0 <= max_step =>
+                {
+                    attempts.h = ((t_cross - t0) * (1.0 + PROBE_OVERSHOOT)).min(max_step);
+                    attempts.landing = Some(t_cross - t0);
+                }
                 Some(t_cross) if resolvable(t_cross - t0, t0) && t_cross - t0 <= max_step => {
                     let target = (t_cross - t0) * (1.0 + ROOT_OVERSHOOT);
                     let reference = t0 + target;

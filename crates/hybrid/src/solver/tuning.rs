@@ -16,6 +16,13 @@ pub(super) const LANDING_REACH: f64 = 0.6;
 /// step growth after a contact onset).
 pub(super) const APPROACH_FRACTION: f64 = 0.5;
 
+/// In a mode whose Jacobian diverges at its half-power crossing, the first Runge-Kutta step after
+/// the series (which take no square-root clock centred ahead) is a step in time of at most this
+/// fraction of the distance to the crossing the series predicted: it ends more than twice its
+/// length from the crossing's `|h|^{-1/2}` in the Jacobian, which the state's error control does
+/// not see (half the way left the tangents' error several times larger).
+pub(super) const SERIES_HANDOVER_FRACTION: f64 = 0.3;
+
 /// Fraction of the predicted distance past a predicted crossing of a half-power surface at
 /// which a square-root-clock landing is centred (the crossing's non-smooth remainder inside
 /// the step is then of relative size ~`ROOT_OVERSHOOT^2.5`, far below the tolerance).
