@@ -80,7 +80,8 @@ pub(crate) enum WalkEnd {
     Near(Vec<f64>),
 }
 
-/// One orbit of the walk: the separation (nm), the state at `t = 0` and its slope `dx/dZ`.
+/// One orbit of the walk: the separation (nm), the state at `t = 0` and its slope `dx/dZ`
+/// (empty for the landing orbit, whose slope predicts nothing).
 #[derive(Debug, Clone)]
 struct WalkPoint {
     z_nm: f64,
@@ -119,12 +120,17 @@ pub(crate) fn walk_approach(
         let mut at_next = model.clone();
         at_next.set_separation(Separation::Constant(z_next))?;
         let prediction = predict(z_next, &last);
-        let tolerance = if z_next == z_nm {
+        let landing = z_next == z_nm;
+        let tolerance = if landing {
             LANDING_TOLERANCE
         } else {
             WALK_TOLERANCE
         } * amplitude;
-        if let Some(point) = corrected(&at_next, &prediction, tolerance, workspace)? {
+        // The landing orbit predicts nothing: its slope is not computed.
+        if let Some(point) = corrected(&at_next, &prediction, tolerance, !landing, workspace)? {
+            if landing {
+                return Ok(WalkEnd::Predicted(point.state));
+            }
             step = (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude);
             last = point;
         } else if step / 2.0 >= MIN_WALK_STEP * amplitude {
@@ -176,14 +182,21 @@ fn predict(z_nm: f64, last: &WalkPoint) -> Vec<f64> {
 /// [`WALK_INTEGRATION_TOLERANCE`]. Once two residuals measure Newton's constant `C`
 /// (`r_k = C r_{k-1}^2`), an iterate whose predicted residual `C r_k^2` is below the tolerance
 /// is taken without a map of its own; its slope and stability are those of the map before,
-/// which is as close to the orbit as a walk's prediction needs. The orbit with its slope, or
+/// which is as close to the orbit as a walk's prediction needs. The orbit with its slope
+/// `dx/dZ` if `with_slope` (the maps then carry `dP/dZ`; else the slope is left empty), or
 /// `None` if Newton does not converge within [`WALK_ITERATIONS`] or the orbit repels.
 fn corrected(
     model: &TappingModel,
     prediction: &[f64],
     tolerance: f64,
+    with_slope: bool,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<Option<WalkPoint>, AfmError> {
+    let sensitivity = if with_slope {
+        Sensitivity::TransitionAndParameter
+    } else {
+        Sensitivity::Transition
+    };
     let integration = newton_maps(&Settings {
         relative_tolerance: WALK_INTEGRATION_TOLERANCE,
         absolute_tolerance: WALK_INTEGRATION_TOLERANCE,
@@ -193,13 +206,7 @@ fn corrected(
     let mut x = prediction.to_vec();
     let mut previous_residual = f64::INFINITY;
     for _ in 0..=WALK_ITERATIONS {
-        let Ok(map) = period_map(
-            model,
-            &x,
-            Sensitivity::TransitionAndParameter,
-            &integration,
-            workspace,
-        ) else {
+        let Ok(map) = period_map(model, &x, sensitivity, &integration, workspace) else {
             return Ok(None);
         };
         let residual =
@@ -222,15 +229,16 @@ fn corrected(
             if !is_stable(&floquet_multipliers(&map.transition)) {
                 return Ok(None);
             }
-            return Ok(
-                branch_tangent(&map.transition, &map.parameter_sensitivity, z_nm).map(|slope| {
-                    WalkPoint {
-                        z_nm,
-                        state: x,
-                        slope,
-                    }
-                }),
-            );
+            let slope = if with_slope {
+                branch_tangent(&map.transition, &map.parameter_sensitivity, z_nm)
+            } else {
+                Some(Vec::new())
+            };
+            return Ok(slope.map(|slope| WalkPoint {
+                z_nm,
+                state: x,
+                slope,
+            }));
         }
         previous_residual = size;
         let Ok(update) = newton_update(&map.transition, &residual, z_nm) else {
