@@ -36,10 +36,10 @@ const INITIAL_WALK_STEP: f64 = 0.05;
 
 /// The longest step of the walk, in units of `A0`: long enough that the walk from its first
 /// orbit (0.05 `A0` below `Z_G1`) reaches `A/A0 = 0.5` in one more step (on the paper's
-/// Biolever on mica 0.68 `A0` below it, across the grazing of a second impact), short enough
-/// that Newton from the tangent line stays on the approach branch (on a grid of 30 separations
-/// from `Z_G1` down to `-0.95 A0` on every built-in case, the walk reaches the same period-1
-/// orbits as with steps of at most 0.25 `A0`).
+/// Biolever on mica 0.68 `A0` below it, across the grazings of a second and a third impact),
+/// short enough that Newton from the tangent line stays on the approach branch (the walk
+/// reaches the same period-1 orbits as with steps of at most 0.25 `A0` on every built-in case,
+/// docs/guide/performance.md; with 1 `A0` it did not).
 const MAX_WALK_STEP: f64 = 0.7;
 
 /// The shortest step, in units of `A0`, before the walk decides its branch has ended and jumps
