@@ -34,6 +34,15 @@ use crate::model::TappingModel;
 /// so that no shorter step would give a closer prediction.
 const INITIAL_WALK_STEP: f64 = 0.05;
 
+/// The farthest below `Z_G1`, in units of `A0`, that the walk's first step, from the free
+/// orbit itself, lands on the requested `Z` (twice [`INITIAL_WALK_STEP`]; the later steps,
+/// from an orbit with its slope, land within the step grown by [`STEP_GROWTH`]). Where a
+/// long-range force bends the approach branch away from the free orbit above `Z_G1`, Newton
+/// from the free state can converge to another orbit that stays near it: on the built-in
+/// silicon-air-polymer, 0.105 `A0` below `Z_G1` it finds the near-free orbit (`A/A0 = 0.999`)
+/// beside the approach branch's (0.898), which the walk reaches over shorter steps.
+const FIRST_LANDING: f64 = 0.1;
+
 /// The longest step of the walk, in units of `A0`: long enough that the walk from its first
 /// orbit (0.05 `A0` below `Z_G1`) reaches `A/A0 = 0.5` in one more step (on the paper's
 /// Biolever on mica 0.68 `A0` below it, across the grazings of a second and a third impact),
@@ -112,7 +121,12 @@ pub(crate) fn walk_approach(
     while last.z_nm > z_nm {
         // A remainder within the step the walk would grow to is taken at once, rather than
         // as this step and a shorter one after it.
-        let z_next = if last.z_nm - z_nm <= (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude) {
+        let landing_reach = if last.z_nm == z_g1 {
+            FIRST_LANDING * amplitude
+        } else {
+            (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude)
+        };
+        let z_next = if last.z_nm - z_nm <= landing_reach {
             z_nm
         } else {
             last.z_nm - step
