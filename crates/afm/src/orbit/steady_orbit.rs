@@ -131,7 +131,7 @@ impl SteadyOrbitSettings {
 pub enum OrbitStart<'a> {
     /// The orbit of the quasi-static approach, without a previous orbit: the free orbit above
     /// first contact, else the approach branch walked down from it in steps of `Z`, each a
-    /// loose Newton from the cubic prediction of the last two orbits, jumping by transients
+    /// loose Newton from the tangent-line prediction of the last orbit, jumping by transients
     /// where the branch ends (a fold), as the quasi-static approach does.
     Approach,
     /// The attractor a transient from the free steady state reaches: `transient_periods`

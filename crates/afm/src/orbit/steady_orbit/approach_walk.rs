@@ -3,13 +3,13 @@
 //!
 //! Above the separation of first contact `Z_G1` the steady orbit is the free one, known in
 //! closed form ([`crate::model::free_response::FreeResponse`]). Below it, the approach branch is walked down from the
-//! free orbit at `Z_G1` in steps of `Z`: each step predicts the orbit from the last two with
-//! their slopes `dx/dZ` (the cubic Hermite extrapolation of [`crate::orbit::prediction`]; the
-//! free orbit's slope is zero, since it does not depend on `Z`), corrects it by Newton on the
-//! stroboscopic map at a loose tolerance, and keeps it if Newton converges within a few
-//! iterations to an orbit that attracts. Steps grow to at most [`MAX_WALK_STEP`] `A0`, so that a
-//! prediction stays within Newton's reach of its own branch's orbit. A step that fails is
-//! halved; where the step falls below
+//! free orbit at `Z_G1` in steps of `Z`: each step predicts the orbit by the tangent line of
+//! the last one, its state plus the step times its slope `dx/dZ` (the free orbit's slope is
+//! zero, since it does not depend on `Z`), corrects it by Newton on the stroboscopic map at a
+//! loose tolerance, and keeps it if Newton converges within a few iterations to an orbit that
+//! attracts. Steps grow to at most [`MAX_WALK_STEP`] `A0`, so that a prediction stays within
+//! Newton's reach of its own branch's orbit. A step that fails is halved; where the step
+//! falls below
 //! [`MIN_WALK_STEP`] `A0`, the branch has ended (a fold, a period doubling) and the walk does
 //! what the quasi-static approach does there: it jumps, by transient periods from the last
 //! orbit, to the attractor that takes over, and walks on from it.
@@ -17,7 +17,7 @@
 //! The walk ends with the orbit at the requested `Z` converged at the walk's loose tolerance;
 //! [`crate::orbit::steady_orbit`] converges it at full tolerance.
 
-use continuation::{floquet_multipliers, hermite_basis, is_stable, newton_update};
+use continuation::{floquet_multipliers, is_stable, newton_update};
 use hybrid::{Sensitivity, Settings};
 use nalgebra::DVector;
 
@@ -34,9 +34,22 @@ use crate::model::TappingModel;
 /// so that no shorter step would give a closer prediction.
 const INITIAL_WALK_STEP: f64 = 0.05;
 
-/// The longest step of the walk, in units of `A0`: long enough that a walk across the whole
-/// approach takes a handful of steps, short enough that a step does not straddle a regime.
-const MAX_WALK_STEP: f64 = 0.25;
+/// The farthest below `Z_G1`, in units of `A0`, that the walk's first step, from the free
+/// orbit itself, lands on the requested `Z` (twice [`INITIAL_WALK_STEP`]; the later steps,
+/// from an orbit with its slope, land within the step grown by [`STEP_GROWTH`]). Where a
+/// long-range force bends the approach branch away from the free orbit above `Z_G1`, Newton
+/// from the free state can converge to another orbit that stays near it: on the built-in
+/// silicon-air-polymer, 0.105 `A0` below `Z_G1` it finds the near-free orbit (`A/A0 = 0.999`)
+/// beside the approach branch's (0.898), which the walk reaches over shorter steps.
+const FIRST_LANDING: f64 = 0.1;
+
+/// The longest step of the walk, in units of `A0`: long enough that the walk from its first
+/// orbit (0.05 `A0` below `Z_G1`) reaches `A/A0 = 0.5` in one more step (on the paper's
+/// Biolever on mica 0.68 `A0` below it, across the grazings of a second and a third impact),
+/// short enough that Newton from the tangent line stays on the approach branch (the walk
+/// reaches the same period-1 orbits as with steps of at most 0.25 `A0` on every built-in case,
+/// docs/guide/performance.md; with 1 `A0` it did not).
+const MAX_WALK_STEP: f64 = 0.7;
 
 /// The shortest step, in units of `A0`, before the walk decides its branch has ended and jumps
 /// by transients (a fold or a period doubling lies within this distance).
@@ -44,11 +57,18 @@ const MIN_WALK_STEP: f64 = 1e-3;
 
 /// The factor by which a step grows after a successful one, up to [`MAX_WALK_STEP`]; a
 /// remainder of the walk within the grown step is walked in one step.
-const STEP_GROWTH: f64 = 2.0;
+const STEP_GROWTH: f64 = 4.0;
 
 /// Newton's tolerance on a walk step's residual `|P(x) - x|`, in units of `A0`: the walk's
 /// orbits only predict the next, so they need not be converged to the final tolerance.
 const WALK_TOLERANCE: f64 = 1e-6;
+
+/// Newton's tolerance on the residual of the walk's last step, the one that lands on the
+/// requested `Z`, in units of `A0`: its orbit is where the full-tolerance Newton starts, which
+/// takes one update and the final map only from a residual within about 3e-6 nm
+/// ([`super::newton`]'s quadratic prediction with its assumed constant 1/nm), near the error
+/// of the walk's maps at [`WALK_INTEGRATION_TOLERANCE`].
+const LANDING_TOLERANCE: f64 = 1e-8;
 
 /// The integration tolerance (relative and absolute) of the walk's period maps: well below
 /// [`WALK_TOLERANCE`] `A0` for any `A0` above 1 nm.
@@ -69,7 +89,8 @@ pub(crate) enum WalkEnd {
     Near(Vec<f64>),
 }
 
-/// One orbit of the walk: the separation (nm), the state at `t = 0` and its slope `dx/dZ`.
+/// One orbit of the walk: the separation (nm), the state at `t = 0` and its slope `dx/dZ`
+/// (empty for the landing orbit, whose slope predicts nothing).
 #[derive(Debug, Clone)]
 struct WalkPoint {
     z_nm: f64,
@@ -96,24 +117,35 @@ pub(crate) fn walk_approach(
         slope: vec![0.0; free.len()],
         state: free,
     };
-    let mut before: Option<WalkPoint> = None;
     let mut step = INITIAL_WALK_STEP * amplitude;
     while last.z_nm > z_nm {
         // A remainder within the step the walk would grow to is taken at once, rather than
         // as this step and a shorter one after it.
-        let z_next = if last.z_nm - z_nm <= (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude) {
+        let landing_reach = if last.z_nm == z_g1 {
+            FIRST_LANDING * amplitude
+        } else {
+            (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude)
+        };
+        let z_next = if last.z_nm - z_nm <= landing_reach {
             z_nm
         } else {
             last.z_nm - step
         };
         let mut at_next = model.clone();
         at_next.set_separation(Separation::Constant(z_next))?;
-        let prediction = predict(z_next, &last, before.as_ref());
-        if let Some(point) = corrected(&at_next, &prediction, amplitude, workspace)? {
+        let prediction = predict(z_next, &last);
+        let landing = z_next == z_nm;
+        let tolerance = if landing {
+            LANDING_TOLERANCE
+        } else {
+            WALK_TOLERANCE
+        } * amplitude;
+        // The landing orbit predicts nothing: its slope is not computed.
+        if let Some(point) = corrected(&at_next, &prediction, tolerance, !landing, workspace)? {
+            if landing {
+                return Ok(WalkEnd::Predicted(point.state));
+            }
             step = (step * STEP_GROWTH).min(MAX_WALK_STEP * amplitude);
-            // The free orbit's zero slope does not extend below the grazing at `Z_G1`: the
-            // cubic needs two orbits below it.
-            before = (last.z_nm < z_g1).then(|| last.clone());
             last = point;
         } else if step / 2.0 >= MIN_WALK_STEP * amplitude {
             step /= 2.0;
@@ -135,7 +167,6 @@ pub(crate) fn walk_approach(
                         state: attractor.state,
                         slope,
                     };
-                    before = None;
                     step = INITIAL_WALK_STEP * amplitude;
                 }
                 _ => return Ok(WalkEnd::Near(attractor.state)),
@@ -145,62 +176,51 @@ pub(crate) fn walk_approach(
     Ok(WalkEnd::Predicted(last.state))
 }
 
-/// The state at `z_nm` predicted from the walk's last orbit and, if there is one, the orbit
-/// before it: the cubic Hermite extrapolation of the two with their slopes, or the last one's
-/// tangent line.
-fn predict(z_nm: f64, last: &WalkPoint, before: Option<&WalkPoint>) -> Vec<f64> {
-    match before {
-        Some(before) => {
-            let h = last.z_nm - before.z_nm;
-            let [h00, h10, h01, h11] = hermite_basis((z_nm - before.z_nm) / h);
-            (0..last.state.len())
-                .map(|i| {
-                    h00 * before.state[i]
-                        + h10 * h * before.slope[i]
-                        + h01 * last.state[i]
-                        + h11 * h * last.slope[i]
-                })
-                .collect()
-        }
-        None => last
-            .state
-            .iter()
-            .zip(&last.slope)
-            .map(|(x, s)| x + (z_nm - last.z_nm) * s)
-            .collect(),
-    }
+/// The state at `z_nm` predicted from the walk's last orbit by its tangent line,
+/// `x + (z_nm - Z) dx/dZ`. Over the walk's steps, which grow by [`STEP_GROWTH`], it is closer
+/// than the cubic Hermite extrapolation of the last two orbits with their slopes, which
+/// reaches `1 + STEP_GROWTH` of their interval beyond them (on the paper's Biolever on mica,
+/// walking 10.01 -> 9.51 -> 8.51 -> 6.51 -> 4.01 -> 2.73 nm, Newton's first residuals from the
+/// cubic were 11.8, 6.1 and 0.52 nm over the last three steps, from the tangent line 3.0, 0.61
+/// and 0.51 nm).
+fn predict(z_nm: f64, last: &WalkPoint) -> Vec<f64> {
+    last.state
+        .iter()
+        .zip(&last.slope)
+        .map(|(x, s)| x + (z_nm - last.z_nm) * s)
+        .collect()
 }
 
-/// Newton from `prediction` on the period map of `model` (at its separation) to
-/// [`WALK_TOLERANCE`] `amplitude` (`A0`, nm), the maps integrated at
+/// Newton from `prediction` on the period map of `model` (at its separation) to `tolerance`
+/// (nm, nm/us: [`WALK_TOLERANCE`] or [`LANDING_TOLERANCE`] `A0`), the maps integrated at
 /// [`WALK_INTEGRATION_TOLERANCE`]. Once two residuals measure Newton's constant `C`
 /// (`r_k = C r_{k-1}^2`), an iterate whose predicted residual `C r_k^2` is below the tolerance
 /// is taken without a map of its own; its slope and stability are those of the map before,
-/// which is as close to the orbit as a walk's prediction needs. The orbit with its slope, or
+/// which is as close to the orbit as a walk's prediction needs. The orbit with its slope
+/// `dx/dZ` if `with_slope` (the maps then carry `dP/dZ`; else the slope is left empty), or
 /// `None` if Newton does not converge within [`WALK_ITERATIONS`] or the orbit repels.
 fn corrected(
     model: &TappingModel,
     prediction: &[f64],
-    amplitude: f64,
+    tolerance: f64,
+    with_slope: bool,
     workspace: &mut SteadyOrbitWorkspace,
 ) -> Result<Option<WalkPoint>, AfmError> {
+    let sensitivity = if with_slope {
+        Sensitivity::TransitionAndParameter
+    } else {
+        Sensitivity::Transition
+    };
     let integration = newton_maps(&Settings {
         relative_tolerance: WALK_INTEGRATION_TOLERANCE,
         absolute_tolerance: WALK_INTEGRATION_TOLERANCE,
         ..Settings::default()
     });
-    let tolerance = WALK_TOLERANCE * amplitude;
     let z_nm = model.separation().at(0.0);
     let mut x = prediction.to_vec();
     let mut previous_residual = f64::INFINITY;
     for _ in 0..=WALK_ITERATIONS {
-        let Ok(map) = period_map(
-            model,
-            &x,
-            Sensitivity::TransitionAndParameter,
-            &integration,
-            workspace,
-        ) else {
+        let Ok(map) = period_map(model, &x, sensitivity, &integration, workspace) else {
             return Ok(None);
         };
         let residual =
@@ -223,15 +243,16 @@ fn corrected(
             if !is_stable(&floquet_multipliers(&map.transition)) {
                 return Ok(None);
             }
-            return Ok(
-                branch_tangent(&map.transition, &map.parameter_sensitivity, z_nm).map(|slope| {
-                    WalkPoint {
-                        z_nm,
-                        state: x,
-                        slope,
-                    }
-                }),
-            );
+            let slope = if with_slope {
+                branch_tangent(&map.transition, &map.parameter_sensitivity, z_nm)
+            } else {
+                Some(Vec::new())
+            };
+            return Ok(slope.map(|slope| WalkPoint {
+                z_nm,
+                state: x,
+                slope,
+            }));
         }
         previous_residual = size;
         let Ok(update) = newton_update(&map.transition, &residual, z_nm) else {
