@@ -54,6 +54,7 @@ impl TappingModel {
 
     /// `sigma' = (d sigma/d rho) rho'` of mode `mode`, nm/us (0 without a standard linear
     /// solid): the unrecovered surface's rate, part of `dh_0/dt`.
+    #[inline]
     pub(crate) fn surface_depth_rate(&self, mode: Mode, t: f64, x: &[f64]) -> f64 {
         match self.force.law.standard_linear_solid() {
             Some(sls) => {
