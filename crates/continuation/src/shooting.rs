@@ -136,7 +136,8 @@ impl StallCheck {
 /// halved their residual between the 3rd and 6th update and ran on to 48 at 0.7 to 1.2 nm. The
 /// first window counts from the start: such an iteration sits at about the residual it starts
 /// with, and is given up after 3 updates.
-/// Used by the continuation's corrector, its corner jumps and the locations' shots.
+/// Used by the continuation's corner jumps and the locations' shots, and by its corrector,
+/// whose first window starts at the guess only above its noise floor (`corrector::correct`).
 pub(crate) const NEWTON_STALL: StallCheck = StallCheck {
     updates: 3,
     reduction: 0.5,
