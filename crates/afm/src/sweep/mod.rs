@@ -508,26 +508,11 @@ pub fn integrate_cycle(
     workspace: &mut SolverWorkspace,
     lockin: &mut CycleLockIn,
 ) -> Result<CycleReading, AfmError> {
-    let period = model.period_us();
-    let mut solver = Solver::with_workspace(
-        model,
-        0.0,
-        state,
-        Sensitivity::None,
-        integration.clone(),
-        std::mem::take(workspace),
-    )?;
     lockin.begin(model, state);
-    loop {
-        let outcome = solver.step(period)?;
-        lockin.observe(&solver, &outcome);
-        if matches!(outcome, StepOutcome::EndTime) {
-            break;
-        }
-    }
-    let reading = lockin.finish(model, solver.state());
-    state.copy_from_slice(solver.state());
-    *workspace = solver.into_workspace();
+    step_through_cycle(model, integration, state, workspace, |solver, outcome| {
+        lockin.observe(solver, outcome);
+    })?;
+    let reading = lockin.finish(model, state);
     debug_assert_eq!(state.len(), model.dim());
     Ok(reading)
 }
@@ -542,6 +527,20 @@ pub fn advance_cycle(
     state: &mut [f64],
     workspace: &mut SolverWorkspace,
 ) -> Result<(), AfmError> {
+    step_through_cycle(model, integration, state, workspace, |_, _| {})
+}
+
+/// The solver's steps over one drive cycle from `state` (replaced by the state at the cycle's
+/// end), each handed to `observe` as it is taken; the solver's buffers are taken from
+/// `workspace` and given back. The one loop of [`integrate_cycle`] and [`advance_cycle`].
+#[inline(always)]
+fn step_through_cycle(
+    model: &TappingModel,
+    integration: &Settings,
+    state: &mut [f64],
+    workspace: &mut SolverWorkspace,
+    mut observe: impl FnMut(&Solver<TappingModel>, &StepOutcome),
+) -> Result<(), AfmError> {
     let period = model.period_us();
     let mut solver = Solver::with_workspace(
         model,
@@ -551,7 +550,13 @@ pub fn advance_cycle(
         integration.clone(),
         std::mem::take(workspace),
     )?;
-    while !matches!(solver.step(period)?, StepOutcome::EndTime) {}
+    loop {
+        let outcome = solver.step(period)?;
+        observe(&solver, &outcome);
+        if matches!(outcome, StepOutcome::EndTime) {
+            break;
+        }
+    }
     state.copy_from_slice(solver.state());
     *workspace = solver.into_workspace();
     Ok(())
