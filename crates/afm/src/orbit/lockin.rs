@@ -305,10 +305,7 @@ impl BlockAverage {
     /// Add the reading of cycle `cycle` whose mid-cycle separation is `z_nm`; returns the
     /// block's reading when this cycle completes a block.
     pub fn push(&mut self, cycle: u64, z_nm: f64, reading: &CycleReading) -> Option<BlockReading> {
-        if self.count == 0 {
-            self.first_cycle = cycle;
-        }
-        self.count += 1;
+        let complete = self.count_cycle(cycle);
         self.cosine += reading.cosine_nm;
         self.sine += reading.sine_nm;
         self.z += z_nm;
@@ -320,22 +317,29 @@ impl BlockAverage {
         }
         self.harmonic_count = reading.harmonic_count;
         self.dissipated += reading.dissipated_ev;
-        (self.count == self.cycles_per_block).then(|| self.flush())
+        complete.then(|| self.flush())
     }
 
     /// Count cycle `cycle` without a reading, for a block whose reading is not wanted (every
     /// cycle of the block is counted so): `true` when this cycle completes the block, which is
     /// then discarded.
     pub fn skip(&mut self, cycle: u64) -> bool {
-        if self.count == 0 {
-            self.first_cycle = cycle;
-        }
-        self.count += 1;
-        let complete = self.count == self.cycles_per_block;
+        let complete = self.count_cycle(cycle);
         if complete {
             self.clear();
         }
         complete
+    }
+
+    /// Count cycle `cycle` into the block (the first counted is the block's first cycle):
+    /// whether it completes the block. Shared by [`BlockAverage::push`] and
+    /// [`BlockAverage::skip`].
+    fn count_cycle(&mut self, cycle: u64) -> bool {
+        if self.count == 0 {
+            self.first_cycle = cycle;
+        }
+        self.count += 1;
+        self.count == self.cycles_per_block
     }
 
     /// Discard a partly filled block (at a change of sweep direction).
