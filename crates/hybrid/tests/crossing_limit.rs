@@ -30,6 +30,17 @@ const DAMPING: f64 = 0.1;
 const DRIVE: f64 = 1.2;
 
 impl ViscousContact {
+    /// The obstacle at 0.8 with `gamma = 2`, giving the onset limit and declaring the divergent
+    /// Jacobian: the tests switch one of the two off.
+    fn both_declared() -> Self {
+        ViscousContact {
+            obstacle: 0.8,
+            gamma: 2.0,
+            limit: true,
+            diverges: true,
+        }
+    }
+
     fn indentation(&self, x: &[f64]) -> f64 {
         (x[0] - self.obstacle).max(0.0)
     }
@@ -195,12 +206,7 @@ fn worst_error(system: &ViscousContact) -> f64 {
 
 #[test]
 fn transition_through_a_viscous_contact_needs_the_onset_limit() {
-    let with = ViscousContact {
-        obstacle: 0.8,
-        gamma: 2.0,
-        limit: true,
-        diverges: true,
-    };
+    let with = ViscousContact::both_declared();
     let without = ViscousContact {
         limit: false,
         ..with
@@ -273,12 +279,7 @@ fn release_error(system: &ViscousContact, settings: &Settings) -> f64 {
 /// and 5.3e-4.
 #[test]
 fn transition_through_a_viscous_release_needs_a_step_ending_on_it() {
-    let with = ViscousContact {
-        obstacle: 0.8,
-        gamma: 2.0,
-        limit: true,
-        diverges: true,
-    };
+    let with = ViscousContact::both_declared();
     let without = ViscousContact {
         diverges: false,
         ..with

@@ -622,11 +622,12 @@ fn state_recurrence(
         cos[k + 1] = -drive_frequency * tau_sin;
         sin[k + 1] = drive_frequency * tau_cos;
         // Both drives' factor `cos(w t) + (F_1b / F_1) cos(w_b t)`, times tau.
-        let tau_drive = if drive.second.is_some() {
-            tau_cos + second_factor * (rate * second_cos[k] + curvature * second_cos[below])
-        } else {
-            tau_cos
-        };
+        let tau_drive = clocked_drive_coefficient(
+            tau_cos,
+            drive.second.map(|_| (second_factor, &second_cos[..])),
+            (rate, curvature),
+            (k, below),
+        );
         total += modal_coefficients(
             modes,
             (rate, curvature),
@@ -637,6 +638,26 @@ fn state_recurrence(
         );
     }
     total.is_finite()
+}
+
+/// Coefficient `k` of `tau(s) D(t(s))`, the clock's rate times both drives' factor
+/// `D = cos(w t) + (F_1b / F_1) cos(w_b t)` (MODEL.md section 14), from `tau_cos`, coefficient
+/// `k` of `tau cos(w t)`, and with a second drive `(F_1b / F_1, the series of cos(w_b t))`;
+/// `clock = (a / (k + 1), 2 b / (k + 1))` as in [`modal_coefficients`], `(k, below)` the
+/// coefficients it multiplies (`below = k - 1`, or `0` with zero curvature at `k = 0`).
+#[inline(always)]
+pub(crate) fn clocked_drive_coefficient(
+    tau_cos: f64,
+    second: Option<(f64, &[f64])>,
+    (rate, curvature): (f64, f64),
+    (k, below): (usize, usize),
+) -> f64 {
+    match second {
+        Some((factor, second_cos)) => {
+            tau_cos + factor * (rate * second_cos[k] + curvature * second_cos[below])
+        }
+        None => tau_cos,
+    }
 }
 
 /// Coefficient `k + 1` of each mode's `[q_i, q_i']` (Eq. 1 on the clock `t(s)`, MODEL.md

@@ -21,8 +21,8 @@ use hybrid::{ClockPolynomial, TaylorSeries};
 
 use crate::contact::standard_linear_solid::StandardLinearSolid;
 use crate::model::contact_series::{
-    convolution, indentation_coefficient, indentation_root, modal_coefficients, phase_series,
-    separation_coefficients, SeriesDrive, MAX_ORDER,
+    clocked_drive_coefficient, convolution, indentation_coefficient, indentation_root,
+    modal_coefficients, phase_series, separation_coefficients, SeriesDrive, MAX_ORDER,
 };
 use crate::model::modal_constants::ModalConstants;
 use crate::model::separation::Separation;
@@ -111,10 +111,12 @@ pub(crate) fn relaxing_state_series(
             (0.0, 0, row)
         };
         let tau_force = rate * force[k] + curvature * force[below];
-        let mut tau_drive = rate * cos[k] + curvature * cos[below];
-        if drive.second.is_some() {
-            tau_drive += second_factor * (rate * second_cos[k] + curvature * second_cos[below]);
-        }
+        let tau_drive = clocked_drive_coefficient(
+            rate * cos[k] + curvature * cos[below],
+            drive.second.map(|_| (second_factor, &second_cos[..])),
+            (rate, curvature),
+            (k, below),
+        );
         total += modal_coefficients(
             modes,
             (rate, curvature),

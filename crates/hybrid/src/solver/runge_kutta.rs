@@ -16,6 +16,7 @@ use super::tuning::{
 };
 use super::{Solver, StepKind};
 use crate::variational_field::clocked_field;
+use crate::workspace::Buffers;
 
 /// The attempts at one Runge-Kutta step: the clock and step they run on and the crossing they
 /// aim at, as the rejections adjust them.
@@ -467,43 +468,15 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         sigma0: f64,
         trial: Trial,
     ) -> Result<f64, HybridError> {
-        let (system, mode, n) = (self.system, self.mode, self.n);
         let Trial { dsigma, t1, .. } = trial;
-        {
-            let mut rhs = clocked_field(&mut self.buffers.field, system, mode, clock, true);
-            self.buffers
-                .rk
-                .derivative_at_end(&mut rhs, sigma0, &self.buffers.z_new);
-        }
-        {
-            let mut rhs = clocked_field(&mut self.buffers.field, system, mode, clock, false);
-            self.buffers.rk.dense_coefficients(
-                &mut rhs,
-                sigma0,
-                &self.buffers.z,
-                &self.buffers.z_new,
-                n,
-            );
-        }
-        let buffers = &mut self.buffers;
-        if let Some(tangents) = buffers.tangents.as_mut() {
-            let (x1, end) = buffers.z_new.split_at_mut(n);
-            let (rk, z0) = (&buffers.rk, &buffers.z);
-            let mut state_at = |fraction: f64, x: &mut [f64]| match fraction {
-                0.0 => x.copy_from_slice(&z0[..n]),
-                1.0 => x.copy_from_slice(x1),
-                _ => rk.interpolate(z0, fraction, x),
-            };
-            buffers.field.evaluations += tangents.advance(
-                system,
-                mode,
-                clock,
-                (sigma0, dsigma),
-                &mut state_at,
-                &z0[n..],
-                end,
-            );
-        }
+        complete_stages(
+            &mut self.buffers,
+            self.system,
+            self.mode,
+            clock,
+            (sigma0, dsigma),
+            StepStart::Step,
+        );
         self.statistics.rhs_evaluations = self.buffers.field.evaluations;
         if self.buffers.z_new.iter().any(|v| !v.is_finite()) {
             return Err(HybridError::NonFiniteState { t: t1 });
@@ -519,45 +492,16 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     }
 
     /// Complete the attempt of [`Solver::redo_onto_crossing`] in `mode` on `clock` from reading
-    /// `sigma0` over `dsigma`, from `z_start` to `z_new`: stage 12 and the state's dense
-    /// output, and the tangents carried apart from the state's stages under
-    /// [`crate::SensitivityMethod::Decoupled`] (as [`Solver::finish_runge_kutta_step`] does for
-    /// an accepted step, which keeps its own copy: sharing this one changed the inlining of the
-    /// stepping loop, and Hertz's diagrams took 0.4% more instructions).
+    /// `sigma0` over `dsigma`, from `z_start` to `z_new`: [`complete_stages`].
     fn complete_redone_step(&mut self, mode: Mode, clock: Clock, sigma0: f64, dsigma: f64) {
-        let (system, n) = (self.system, self.n);
-        let buffers = &mut self.buffers;
-        let z0 = &buffers.z_start;
-        {
-            let mut rhs = clocked_field(&mut buffers.field, system, mode, clock, true);
-            buffers
-                .rk
-                .derivative_at_end(&mut rhs, sigma0, &buffers.z_new);
-        }
-        {
-            let mut rhs = clocked_field(&mut buffers.field, system, mode, clock, false);
-            buffers
-                .rk
-                .dense_coefficients(&mut rhs, sigma0, z0, &buffers.z_new, n);
-        }
-        if let Some(tangents) = buffers.tangents.as_mut() {
-            let (x1, end) = buffers.z_new.split_at_mut(n);
-            let rk = &buffers.rk;
-            let mut state_at = |fraction: f64, x: &mut [f64]| match fraction {
-                0.0 => x.copy_from_slice(&z0[..n]),
-                1.0 => x.copy_from_slice(x1),
-                _ => rk.interpolate(z0, fraction, x),
-            };
-            buffers.field.evaluations += tangents.advance(
-                system,
-                mode,
-                clock,
-                (sigma0, dsigma),
-                &mut state_at,
-                &z0[n..],
-                end,
-            );
-        }
+        complete_stages(
+            &mut self.buffers,
+            self.system,
+            mode,
+            clock,
+            (sigma0, dsigma),
+            StepStart::Attempt,
+        );
         self.statistics.rhs_evaluations = self.buffers.field.evaluations;
     }
 
@@ -705,5 +649,65 @@ fn next_after_rejections(previous: Option<(f64, f64)>, dsigma: f64, error: f64) 
             }
         }
         _ => Dop853::next_step(dsigma, error, false),
+    }
+}
+
+/// The buffer a Runge-Kutta step being completed started from.
+#[derive(Clone, Copy)]
+enum StepStart {
+    /// `z`: a step accepted by the error control.
+    Step,
+    /// `z_start`: a step redone onto a crossing ([`Solver::redo_onto_crossing`]).
+    Attempt,
+}
+
+/// Complete a Runge-Kutta step in `mode` on `clock` from reading `sigma0` over `dsigma`, from
+/// the state named by `start` to `z_new`: stage 12 and the state's dense output, and the
+/// tangents carried apart from the state's stages under
+/// [`crate::SensitivityMethod::Decoupled`]. Always inlined: as a call it changed the stepping
+/// loop's inlining.
+#[inline(always)]
+fn complete_stages<S: HybridSystem + ?Sized>(
+    buffers: &mut Buffers,
+    system: &S,
+    mode: Mode,
+    clock: Clock,
+    (sigma0, dsigma): (f64, f64),
+    start: StepStart,
+) {
+    let n = buffers.n;
+    let z0 = match start {
+        StepStart::Step => &buffers.z,
+        StepStart::Attempt => &buffers.z_start,
+    };
+    {
+        let mut rhs = clocked_field(&mut buffers.field, system, mode, clock, true);
+        buffers
+            .rk
+            .derivative_at_end(&mut rhs, sigma0, &buffers.z_new);
+    }
+    {
+        let mut rhs = clocked_field(&mut buffers.field, system, mode, clock, false);
+        buffers
+            .rk
+            .dense_coefficients(&mut rhs, sigma0, z0, &buffers.z_new, n);
+    }
+    if let Some(tangents) = buffers.tangents.as_mut() {
+        let (x1, end) = buffers.z_new.split_at_mut(n);
+        let rk = &buffers.rk;
+        let mut state_at = |fraction: f64, x: &mut [f64]| match fraction {
+            0.0 => x.copy_from_slice(&z0[..n]),
+            1.0 => x.copy_from_slice(x1),
+            _ => rk.interpolate(z0, fraction, x),
+        };
+        buffers.field.evaluations += tangents.advance(
+            system,
+            mode,
+            clock,
+            (sigma0, dsigma),
+            &mut state_at,
+            &z0[n..],
+            end,
+        );
     }
 }
