@@ -7,7 +7,7 @@ use afm::{Cantilever, Case, Sample, SteadyOrbitSettings, TappingModel};
 use serde::Serialize;
 use serde_json::{json, Value};
 
-use crate::sorted_keys::sorted_keys;
+use crate::json_value::{plain_value, sorted_keys};
 
 /// The `inputs` object (docs/output-schema.md) as a derived `Serialize` of borrowed fields,
 /// declared in alphabetical order of their keys: the bytes of the same object as a
@@ -148,12 +148,6 @@ pub fn orbit_inputs_json(
     settings: &SteadyOrbitSettings,
 ) -> Value {
     plain_value(&InputsJson::orbit(command, options, case, model, settings))
-}
-
-/// `value` as a `serde_json::Value`, for a value whose objects all have string keys (the only
-/// case where serde_json's conversion fails is a map with other keys).
-pub fn plain_value<T: Serialize + ?Sized>(value: &T) -> Value {
-    serde_json::to_value(value).expect("objects with string keys")
 }
 
 /// The `drive` object of [`inputs_json`] (docs/output-schema.md; MODEL.md section 14): the

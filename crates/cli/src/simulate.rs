@@ -11,7 +11,8 @@ use serde_json::json;
 use std::path::PathBuf;
 
 use crate::digits;
-use crate::inputs::{plain_value, InputsJson};
+use crate::inputs::InputsJson;
+use crate::json_value::plain_value;
 use crate::model_args::ModelArgs;
 use crate::option_ranges;
 use crate::orbit_json::OrbitJson;
