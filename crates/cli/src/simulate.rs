@@ -11,9 +11,11 @@ use serde_json::json;
 use std::path::PathBuf;
 
 use crate::digits;
-use crate::inputs::orbit_inputs_json;
+use crate::inputs::InputsJson;
+use crate::json_value::plain_value;
 use crate::model_args::ModelArgs;
 use crate::option_ranges;
+use crate::orbit_json::OrbitJson;
 use crate::output::print_stdout;
 use crate::plot::{render_svg, FigureFile};
 use crate::trajectory_plot::{harmonic_spectrum_panel, trajectory_panels};
@@ -135,7 +137,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             "start": start.name(),
             "harmonics": harmonics,
         });
-        let object = simulate_json(
+        let object = simulate_object(
             &case,
             &model,
             &settings,
@@ -189,10 +191,31 @@ pub fn orbit_at(
     }
 }
 
-/// The whole `simulate --json` object: [`orbit_json`] of `orbit` found from the start named
+/// The whole `simulate --json` object: [`OrbitJson`] of `orbit` found from the start named
 /// `start` (`approach`, `transient`, `near`, ...), with `coexisting_orbit` (the other start's
 /// orbit and that start's name, or `null`) and `inputs` (the command's `options` and
 /// `settings`).
+pub fn simulate_object<'a>(
+    case: &'a Case,
+    model: &TappingModel,
+    settings: &SteadyOrbitSettings,
+    orbit: &'a SteadyOrbit,
+    start: &'a str,
+    coexisting: Option<(&'a SteadyOrbit, &'a str)>,
+    options: serde_json::Value,
+) -> OrbitJson<'a> {
+    let coexisting = coexisting.map(|(other, other_start)| {
+        OrbitJson::new(&case.name, model, other).with_start(other_start)
+    });
+    OrbitJson::new(&case.name, model, orbit)
+        .with_start(start)
+        .with_coexisting_and_inputs(
+            coexisting,
+            InputsJson::orbit("simulate", options, case, model, settings),
+        )
+}
+
+/// [`simulate_object`] as a `serde_json::Value`.
 pub fn simulate_json(
     case: &Case,
     model: &TappingModel,
@@ -202,16 +225,9 @@ pub fn simulate_json(
     coexisting: Option<(&SteadyOrbit, &str)>,
     options: serde_json::Value,
 ) -> serde_json::Value {
-    let mut object = orbit_json(&case.name, model, orbit);
-    object["start"] = json!(start);
-    object["coexisting_orbit"] =
-        coexisting.map_or(serde_json::Value::Null, |(other, other_start)| {
-            let mut other_json = orbit_json(&case.name, model, other);
-            other_json["start"] = json!(other_start);
-            other_json
-        });
-    object["inputs"] = orbit_inputs_json("simulate", options, case, model, settings);
-    object
+    plain_value(&simulate_object(
+        case, model, settings, orbit, start, coexisting, options,
+    ))
 }
 
 /// The figure `simulate --plot` draws (SVG): two periods of `u(t)` above `F_ts(t)` of `orbit`
@@ -237,58 +253,10 @@ pub fn check_orbit_options(z: Option<f64>, amplitude_ratio: Option<f64>) -> Resu
     Ok(())
 }
 
-/// The JSON object of one steady orbit (units in the key names; docs/output-schema.md). Every
-/// observable covers the whole orbit (all its `multiplicity` drive periods), with the
-/// per-period breakdown in `periods`.
+/// The JSON object of one steady orbit ([`OrbitJson::new`]; units in the key names,
+/// docs/output-schema.md) as a `serde_json::Value`.
 pub fn orbit_json(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> serde_json::Value {
-    let observables = orbit.observables();
-    let (amplitude_ratio, phase_deg) = orbit.lockin(model.free_amplitude_nm());
-    let min_gap = observables.min_gap_nm();
-    json!({
-        "case": case,
-        "z_nm": orbit.z_nm,
-        "first_contact_z_nm": model.grazing_separation_nm(),
-        "free_amplitude_nm": model.free_amplitude_nm(),
-        "drive_frequency_khz": model.drive_frequency_khz(),
-        "period_us": model.period_us(),
-        "amplitude_ratio": amplitude_ratio,
-        "phase_deg": phase_deg,
-        "free_phase_deg": model.free_phase_deg(),
-        "multiplicity": orbit.multiplicity,
-        "impacts_per_period": orbit.impacts_per_period(),
-        "impacts_per_orbit": orbit.impacts_per_orbit(),
-        "converged": orbit.converged,
-        "newton_iterations": orbit.iterations,
-        "residual": orbit.residual,
-        "stable": orbit.stable,
-        "floquet_multipliers": orbit.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-        "spectral_radius": continuation::spectral_radius(&orbit.multipliers),
-        "gap_minima": observables.gap_minima,
-        "min_gap_nm": min_gap.is_finite().then_some(min_gap),
-        "impacts": observables.impacts,
-        "peak_force_nn": observables.peak_force_nn,
-        "mean_force_nn": observables.mean_force_nn,
-        "contact_time_periods": observables.contact_time_periods,
-        "impulse_nn_us": observables.impulse_nn_us,
-        "dissipated_ev": observables.dissipated_ev,
-        "virial_ev": observables.virial_ev,
-        "max_indentation_nm": observables.max_indentation_nm,
-        "mean_indentation_nm": observables.mean_indentation_nm,
-        "energy_balance_residual": observables.energy_balance_residual,
-        "harmonics": observables.harmonics,
-        "second_drive": observables.second_drive.map(|response| json!({
-            "frequency_khz": model.second_drive().map(|second| second.frequency_khz),
-            "free_amplitude_nm": model.second_drive().map(|second| second.free_amplitude_nm),
-            "amplitude_nm": response.amplitude_nm,
-            "phase_deg": response.phase_deg,
-            "free_phase_deg": model
-                .free_response()
-                .second_photodiode_harmonic()
-                .map(|[a, b]| b.atan2(a).to_degrees()),
-        })),
-        "state": orbit.state,
-        "periods": orbit.period_breakdown(model.free_amplitude_nm()),
-    })
+    plain_value(&OrbitJson::new(case, model, orbit))
 }
 
 /// Distance from +1 within which a real Floquet multiplier of an orbit Newton did not converge

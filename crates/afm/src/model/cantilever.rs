@@ -4,7 +4,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::AfmError;
 use crate::model::eigenmode::Eigenmode;
-use crate::validation::{check_all, check_name, gathered_warnings, invalid, ranges, NumericField};
+use crate::validation::{
+    check_all, check_name, gathered_warnings, invalid, ranges, FieldPath, NumericField,
+};
 
 /// The tip's Young's modulus the paper uses, GPa (its note 15).
 pub const DEFAULT_TIP_YOUNGS_MODULUS_GPA: f64 = 130.0;
@@ -100,22 +102,22 @@ impl Cantilever {
     fn numeric_fields(&self) -> Vec<NumericField> {
         vec![
             (
-                String::from("tip_radius_nm"),
+                FieldPath::top("tip_radius_nm"),
                 self.tip_radius_nm,
                 ranges::TIP_RADIUS_NM,
             ),
             (
-                String::from("tip_mass_ratio"),
+                FieldPath::top("tip_mass_ratio"),
                 self.tip_mass_ratio,
                 ranges::TIP_MASS_RATIO,
             ),
             (
-                String::from("tip_youngs_modulus_gpa"),
+                FieldPath::top("tip_youngs_modulus_gpa"),
                 self.tip_youngs_modulus_gpa,
                 ranges::YOUNGS_MODULUS_GPA,
             ),
             (
-                String::from("tip_poisson_ratio"),
+                FieldPath::top("tip_poisson_ratio"),
                 self.tip_poisson_ratio,
                 ranges::POISSON_RATIO,
             ),

@@ -6,7 +6,7 @@ use crate::error::AfmError;
 use crate::model::cantilever::Cantilever;
 use crate::model::drive_spec::DriveSpec;
 use crate::model::sample::Sample;
-use crate::validation::{check_all, check_name, ranges, warnings_of, NumericField};
+use crate::validation::{check_all, check_name, ranges, warnings_of, FieldPath, NumericField};
 
 /// A case file as written on disk (`fixtures/cases/*.json`): the cantilever and the sample are
 /// referenced by name (a built-in fixture) or by a path ending in `.json` (relative to the case
@@ -55,13 +55,13 @@ impl CaseFile {
 /// The numeric fields of a case with their ranges.
 fn case_fields(free_amplitude_nm: f64, drive_frequency_khz: Option<f64>) -> Vec<NumericField> {
     let mut fields = vec![(
-        String::from("free_amplitude_nm"),
+        FieldPath::top("free_amplitude_nm"),
         free_amplitude_nm,
         ranges::FREE_AMPLITUDE_NM,
     )];
     if let Some(frequency) = drive_frequency_khz {
         fields.push((
-            String::from("drive_frequency_khz"),
+            FieldPath::top("drive_frequency_khz"),
             frequency,
             ranges::FREQUENCY_KHZ,
         ));

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::AfmError;
-use crate::validation::{check_all, invalid, ranges, warnings_of, NumericField};
+use crate::validation::{check_all, invalid, ranges, warnings_of, FieldPath, NumericField};
 
 /// Convert a frequency in kHz to an angular frequency in rad/us: `w = 2 pi f / 1000`.
 pub fn angular_frequency_rad_per_us(frequency_khz: f64) -> f64 {
@@ -39,7 +39,7 @@ impl Eigenmode {
     /// `modes[index].field` (`index` 0-based: mode `index + 1`). Mode 1's ratios are fixed to 1
     /// and checked apart.
     pub(crate) fn numeric_fields(&self, index: usize) -> Vec<NumericField> {
-        let field = |name: &str| format!("modes[{index}].{name}");
+        let field = |name| FieldPath::entry("modes", index, name);
         let mut fields = vec![
             (
                 field("stiffness_n_per_m"),

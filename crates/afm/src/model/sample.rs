@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 use crate::contact::{ContactSpec, ElectrostaticSpec, HydrationSpec};
 use crate::error::AfmError;
 use crate::model::cantilever::DEFAULT_POISSON_RATIO;
-use crate::validation::{check_all, check_name, ranges, warnings_of, NumericField};
+use crate::validation::{check_all, check_name, ranges, warnings_of, FieldPath, NumericField};
 
 fn default_poisson_ratio() -> f64 {
     DEFAULT_POISSON_RATIO
@@ -42,12 +42,12 @@ impl Sample {
     fn numeric_fields(&self) -> Vec<NumericField> {
         vec![
             (
-                String::from("youngs_modulus_gpa"),
+                FieldPath::top("youngs_modulus_gpa"),
                 self.youngs_modulus_gpa,
                 ranges::YOUNGS_MODULUS_GPA,
             ),
             (
-                String::from("poisson_ratio"),
+                FieldPath::top("poisson_ratio"),
                 self.poisson_ratio,
                 ranges::POISSON_RATIO,
             ),
