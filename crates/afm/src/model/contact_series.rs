@@ -51,7 +51,8 @@ const LEN: usize = MAX_ORDER + 1;
 const SHARED_LEN: usize = 8 * LEN + ROOT_LEN;
 
 /// The values of the force's auxiliary series in [`SharedSeries`]: three series and one value
-/// (JKR's `b`, `b^2`, `b^3` and `d delta/db` at the start).
+/// (JKR's `b`, `b^2`, `b^3` and `d delta/db` at the start; the hydration force's `w` and
+/// `j delta_j`).
 const ROOT_LEN: usize = 3 * LEN + 1;
 const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 
@@ -65,8 +66,8 @@ const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 /// After a state series of order `p` (clock rate `a`): `delta_0..delta_{p-1}`; `root` (Hertz:
 /// the indentation's square root, `r_0..r_{p-1}`, at an onset `r_0 = 0` and
 /// `r_1..r_{max(p, 3) - 3}`; van der Waals: `1/d`; JKR: `b`, `b^2`, `b^3` one after the other;
-/// hydration: `w`'s real then imaginary parts; each to `p - 1`); the drive phase's `cos` and
-/// `sin` to `p`.
+/// hydration: `w`'s real then imaginary parts, then `j delta_j`; each to `p - 1`); the drive
+/// phase's `cos` and `sin` to `p`.
 struct SharedSeries<'a> {
     /// The indentation below the contact surface, nm.
     delta: &'a mut [f64; LEN],
@@ -147,11 +148,12 @@ pub(crate) enum SeriesForce {
 
 /// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`; real parts in
 /// `re`, imaginary in `im`) from `delta`'s coefficients to `k` and `w`'s below `k`:
-/// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`.
-#[inline]
+/// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`. `weighted` holds
+/// `j delta_j` for `j < k` and gets `k delta_k` here, so that each is formed once; the two
+/// sums are [`convolution`]s (their terms added in the order `j = 1, ..., k`).
+#[inline(always)]
 fn update_layer_exponential(
-    re: &mut [f64],
-    im: &mut [f64],
+    [re, im, weighted]: [&mut [f64]; 3],
     delta: &[f64],
     k: usize,
     wavenumber: f64,
@@ -163,14 +165,12 @@ fn update_layer_exponential(
         let (sin, cos) = (c_im * delta[0]).sin_cos();
         re[0] = magnitude * cos;
         im[0] = magnitude * sin;
+        weighted[0] = 0.0;
         return;
     }
-    let (mut sum_re, mut sum_im) = (0.0, 0.0);
-    for j in 1..=k {
-        let weight = j as f64 * delta[j];
-        sum_re += weight * re[k - j];
-        sum_im += weight * im[k - j];
-    }
+    weighted[k] = k as f64 * delta[k];
+    let sum_re = convolution(&weighted[1..=k], &re[..k]);
+    let sum_im = convolution(&weighted[1..=k], &im[..k]);
     let scale = 1.0 / k as f64;
     re[k] = scale * (c_re * sum_re - c_im * sum_im);
     im[k] = scale * (c_re * sum_im + c_im * sum_re);
@@ -545,13 +545,14 @@ fn force_coefficient(
             wavenumber,
             decay_length,
         } => {
-            // Analytic in d everywhere, on the time clock; `root` holds `w`'s real parts then
-            // its imaginary parts.
+            // Analytic in d everywhere, on the time clock; `root` holds `w`'s real parts, its
+            // imaginary parts, then `j delta_j`.
             if onset {
                 return None;
             }
-            let (re, im) = root.split_at_mut(MAX_ORDER + 1);
-            update_layer_exponential(re, im, delta, k, wavenumber, decay_length);
+            let (re, rest) = root.split_at_mut(MAX_ORDER + 1);
+            let (im, weighted) = rest.split_at_mut(MAX_ORDER + 1);
+            update_layer_exponential([re, im, weighted], delta, k, wavenumber, decay_length);
             Some(amplitude * (re[k] - wavenumber * decay_length * im[k]))
         }
     }
