@@ -836,20 +836,23 @@ impl TangentRecurrence<'_> {
     /// [`COLUMN_BLOCK`], the rest one by one.
     #[inline(always)]
     fn run_columns(&self, columns: usize, v: &mut [f64], gaps: &mut Vec<f64>) {
+        // `2N` or `2N + 1` columns for `N` modes: the first `N` of `modes` as a slice of
+        // constant length, so that the loops over modes unroll too.
+        let modes = self.modes;
         match columns {
-            2 => self.run::<2>(2, 0, v, gaps),
-            3 => self.run::<3>(3, 0, v, gaps),
-            4 => self.run::<4>(4, 0, v, gaps),
-            5 => self.run::<5>(5, 0, v, gaps),
-            6 => self.run::<6>(6, 0, v, gaps),
-            7 => self.run::<7>(7, 0, v, gaps),
+            2 => self.run::<2>(&modes[..1], 2, 0, v, gaps),
+            3 => self.run::<3>(&modes[..1], 3, 0, v, gaps),
+            4 => self.run::<4>(&modes[..2], 4, 0, v, gaps),
+            5 => self.run::<5>(&modes[..2], 5, 0, v, gaps),
+            6 => self.run::<6>(&modes[..3], 6, 0, v, gaps),
+            7 => self.run::<7>(&modes[..3], 7, 0, v, gaps),
             _ => {
                 let blocks = columns / COLUMN_BLOCK * COLUMN_BLOCK;
                 for start in (0..blocks).step_by(COLUMN_BLOCK) {
-                    self.run::<COLUMN_BLOCK>(columns, start, v, gaps);
+                    self.run::<COLUMN_BLOCK>(modes, columns, start, v, gaps);
                 }
                 for start in blocks..columns {
-                    self.run::<1>(columns, start, v, gaps);
+                    self.run::<1>(modes, columns, start, v, gaps);
                 }
             }
         }
@@ -861,16 +864,18 @@ impl TangentRecurrence<'_> {
     /// (-(3/2) c) (tau r g)_k - w_i^2 (tau q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a
     /// convolution. The columns evolve independently along the given state series, so the
     /// recurrence runs over a block of them at once, its values in arrays of the constant width
-    /// `C`. `scratch` holds the gap's coefficients (resized here).
+    /// `C`. `modes` are the recurrence's modes (`self.modes`, passed as a slice whose length
+    /// the caller may fix); `scratch` holds the gap's coefficients (resized here).
     #[inline(always)]
     fn run<const C: usize>(
         &self,
+        modes: &[ModalConstants],
         columns: usize,
         start: usize,
         v: &mut [f64],
         scratch: &mut Vec<f64>,
     ) {
-        let modes = self.modes;
+        debug_assert_eq!(modes.len(), self.modes.len());
         let p = self.root_reversed.len();
         let dim = 2 * modes.len() * columns;
         let (a, b2) = (self.rate, self.curvature);
