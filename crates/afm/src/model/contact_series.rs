@@ -66,8 +66,8 @@ const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 /// After a state series of order `p` (clock rate `a`): `delta_0..delta_{p-1}`; `root` (Hertz:
 /// the indentation's square root, `r_0..r_{p-1}`, at an onset `r_0 = 0` and
 /// `r_1..r_{max(p, 3) - 3}`; van der Waals: `1/d`; JKR: `b`, `b^2`, `b^3` one after the other;
-/// hydration: `w`'s real then imaginary parts, then `j delta_j`; each to `p - 1`); the drive
-/// phase's `cos` and `sin` to `p`.
+/// hydration: `w`'s `[re, im]` pairs, then `j delta_j`; each to `p - 1`); the drive phase's
+/// `cos` and `sin` to `p`.
 struct SharedSeries<'a> {
     /// The indentation below the contact surface, nm.
     delta: &'a mut [f64; LEN],
@@ -146,14 +146,15 @@ pub(crate) enum SeriesForce {
     },
 }
 
-/// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`; real parts in
-/// `re`, imaginary in `im`) from `delta`'s coefficients to `k` and `w`'s below `k`:
+/// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`; `w_k` as the pair
+/// `[re, im]` in `w[k]`) from `delta`'s coefficients to `k` and `w`'s below `k`:
 /// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`. `weighted` holds
-/// `j delta_j` for `j < k` and gets `k delta_k` here, so that each is formed once; the two
-/// sums are [`convolution`]s (their terms added in the order `j = 1, ..., k`).
+/// `j delta_j` for `j < k` and gets `k delta_k` here, so that each is formed once; the sum's
+/// terms are added in the order `j = 1, ..., k`, its real and imaginary parts side by side.
 #[inline(always)]
 fn update_layer_exponential(
-    [re, im, weighted]: [&mut [f64]; 3],
+    w: &mut [[f64; 2]],
+    weighted: &mut [f64],
     delta: &[f64],
     k: usize,
     wavenumber: f64,
@@ -163,17 +164,22 @@ fn update_layer_exponential(
     if k == 0 {
         let magnitude = (c_re * delta[0]).exp();
         let (sin, cos) = (c_im * delta[0]).sin_cos();
-        re[0] = magnitude * cos;
-        im[0] = magnitude * sin;
+        w[0] = [magnitude * cos, magnitude * sin];
         weighted[0] = 0.0;
         return;
     }
     weighted[k] = k as f64 * delta[k];
-    let sum_re = convolution(&weighted[1..=k], &re[..k]);
-    let sum_im = convolution(&weighted[1..=k], &im[..k]);
+    let mut sum = [-0.0, -0.0];
+    for (factor, below) in weighted[1..=k].iter().zip(w[..k].iter().rev()) {
+        sum[0] += factor * below[0];
+        sum[1] += factor * below[1];
+    }
+    let [sum_re, sum_im] = sum;
     let scale = 1.0 / k as f64;
-    re[k] = scale * (c_re * sum_re - c_im * sum_im);
-    im[k] = scale * (c_re * sum_im + c_im * sum_re);
+    w[k] = [
+        scale * (c_re * sum_re - c_im * sum_im),
+        scale * (c_re * sum_im + c_im * sum_re),
+    ];
 }
 
 /// The drives a series expands Eq. 1 with (MODEL.md sections 1 and 14): the drive at
@@ -545,15 +551,16 @@ fn force_coefficient(
             wavenumber,
             decay_length,
         } => {
-            // Analytic in d everywhere, on the time clock; `root` holds `w`'s real parts, its
-            // imaginary parts, then `j delta_j`.
+            // Analytic in d everywhere, on the time clock; `root` holds `w`'s coefficients as
+            // `[re, im]` pairs, then `j delta_j`.
             if onset {
                 return None;
             }
-            let (re, rest) = root.split_at_mut(MAX_ORDER + 1);
-            let (im, weighted) = rest.split_at_mut(MAX_ORDER + 1);
-            update_layer_exponential([re, im, weighted], delta, k, wavenumber, decay_length);
-            Some(amplitude * (re[k] - wavenumber * decay_length * im[k]))
+            let (pairs, weighted) = root.split_at_mut(2 * LEN);
+            let (w, _) = pairs.as_chunks_mut::<2>();
+            update_layer_exponential(w, weighted, delta, k, wavenumber, decay_length);
+            let [re, im] = w[k];
+            Some(amplitude * (re - wavenumber * decay_length * im))
         }
     }
 }
@@ -771,10 +778,14 @@ pub(crate) fn contact_tangent_series(
             wavenumber,
             decay_length,
         } => {
-            // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w.
+            // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w (`w`'s
+            // real parts are every other value of `root`).
+            for (m, re) in derivative[..p].iter_mut().zip(root.iter().step_by(2)) {
+                *m = *re;
+            }
             (
                 -amplitude * (1.0 / decay_length + wavenumber * wavenumber * decay_length),
-                &root[..p],
+                &derivative[..p],
             )
         }
     };
