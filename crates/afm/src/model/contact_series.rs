@@ -170,7 +170,9 @@ fn update_layer_exponential(
     }
     weighted[k] = k as f64 * delta[k];
     let mut sum = [-0.0, -0.0];
-    for (factor, below) in weighted[1..=k].iter().zip(w[..k].iter().rev()) {
+    let (factors, below) = (&weighted[1..=k], &w[..k]);
+    for j in 0..k {
+        let (factor, below) = (factors[j], below[k - 1 - j]);
         sum[0] += factor * below[0];
         sum[1] += factor * below[1];
     }
