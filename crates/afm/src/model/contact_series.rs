@@ -66,8 +66,8 @@ const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 /// After a state series of order `p` (clock rate `a`): `delta_0..delta_{p-1}`; `root` (Hertz:
 /// the indentation's square root, `r_0..r_{p-1}`, at an onset `r_0 = 0` and
 /// `r_1..r_{max(p, 3) - 3}`; van der Waals: `1/d`; JKR: `b`, `b^2`, `b^3` one after the other;
-/// hydration: `w`'s `[re, im]` pairs, then `j delta_j`; each to `p - 1`); the drive phase's
-/// `cos` and `sin` to `p`.
+/// hydration: `w`'s `[re, im]` pairs, highest power first, then `j delta_j`; each to `p - 1`);
+/// the drive phase's `cos` and `sin` to `p`.
 struct SharedSeries<'a> {
     /// The indentation below the contact surface, nm.
     delta: &'a mut [f64; LEN],
@@ -146,14 +146,16 @@ pub(crate) enum SeriesForce {
     },
 }
 
-/// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`; `w_k` as the pair
-/// `[re, im]` in `w[k]`) from `delta`'s coefficients to `k` and `w`'s below `k`:
-/// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`. `weighted` holds
-/// `j delta_j` for `j < k` and gets `k delta_k` here, so that each is formed once; the sum's
-/// terms are added in the order `j = 1, ..., k`, its real and imaginary parts side by side.
+/// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`) from `delta`'s
+/// coefficients to `k` and `w`'s below `k`: `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j
+/// delta_j w_{k-j}`. `w` holds the coefficients highest power last-in first, as `[re, im]`
+/// pairs: `w_k` in `w[LEN - 1 - k]` (so that `w_{k-1}, ..., w_0` run forward, as the sum takes
+/// them). `weighted` holds `j delta_j` for `j < k` and gets `k delta_k` here, so that each is
+/// formed once; the sum's terms are added in the order `j = 1, ..., k`, its real and imaginary
+/// parts side by side.
 #[inline(always)]
 fn update_layer_exponential(
-    w: &mut [[f64; 2]],
+    w: &mut [[f64; 2]; LEN],
     weighted: &mut [f64],
     delta: &[f64],
     k: usize,
@@ -164,24 +166,32 @@ fn update_layer_exponential(
     if k == 0 {
         let magnitude = (c_re * delta[0]).exp();
         let (sin, cos) = (c_im * delta[0]).sin_cos();
-        w[0] = [magnitude * cos, magnitude * sin];
+        w[LEN - 1] = [magnitude * cos, magnitude * sin];
         weighted[0] = 0.0;
         return;
     }
     weighted[k] = k as f64 * delta[k];
     let mut sum = [-0.0, -0.0];
-    let (factors, below) = (&weighted[1..=k], &w[..k]);
-    for j in 0..k {
-        let (factor, below) = (factors[j], below[k - 1 - j]);
+    for (factor, below) in weighted[1..=k].iter().zip(&w[LEN - k..]) {
         sum[0] += factor * below[0];
         sum[1] += factor * below[1];
     }
     let [sum_re, sum_im] = sum;
     let scale = 1.0 / k as f64;
-    w[k] = [
+    w[LEN - 1 - k] = [
         scale * (c_re * sum_re - c_im * sum_im),
         scale * (c_re * sum_im + c_im * sum_re),
     ];
+}
+
+/// The `LEN` pairs `[re, im]` of [`update_layer_exponential`]'s `w` laid out in `values`
+/// (`2 LEN` of them).
+#[inline(always)]
+fn layer_exponential_pairs(values: &mut [f64]) -> &mut [[f64; 2]; LEN] {
+    let (pairs, _) = values.as_chunks_mut::<2>();
+    (&mut pairs[..LEN])
+        .try_into()
+        .expect("2 LEN values hold LEN pairs")
 }
 
 /// The drives a series expands Eq. 1 with (MODEL.md sections 1 and 14): the drive at
@@ -554,14 +564,15 @@ fn force_coefficient(
             decay_length,
         } => {
             // Analytic in d everywhere, on the time clock; `root` holds `w`'s coefficients as
-            // `[re, im]` pairs, then `j delta_j`.
+            // `[re, im]` pairs, the highest power first (`update_layer_exponential`), then
+            // `j delta_j`.
             if onset {
                 return None;
             }
             let (pairs, weighted) = root.split_at_mut(2 * LEN);
-            let (w, _) = pairs.as_chunks_mut::<2>();
+            let w = layer_exponential_pairs(pairs);
             update_layer_exponential(w, weighted, delta, k, wavenumber, decay_length);
-            let [re, im] = w[k];
+            let [re, im] = w[LEN - 1 - k];
             Some(amplitude * (re - wavenumber * decay_length * im))
         }
     }
@@ -781,9 +792,10 @@ pub(crate) fn contact_tangent_series(
             decay_length,
         } => {
             // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w (`w`'s
-            // real parts are every other value of `root`).
-            for (m, re) in derivative[..p].iter_mut().zip(root.iter().step_by(2)) {
-                *m = *re;
+            // pairs are in `root`, the highest power first).
+            let w = layer_exponential_pairs(&mut root[..2 * LEN]);
+            for (m, pair) in derivative[..p].iter_mut().zip(w.iter().rev()) {
+                *m = pair[0];
             }
             (
                 -amplitude * (1.0 / decay_length + wavenumber * wavenumber * decay_length),
