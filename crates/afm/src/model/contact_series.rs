@@ -861,16 +861,16 @@ impl TangentRecurrence<'_> {
     /// [`COLUMN_BLOCK`], the rest one by one.
     #[inline(always)]
     fn run_columns(&self, columns: usize, v: &mut [f64], gaps: &mut Vec<f64>) {
-        // `2N` or `2N + 1` columns for `N` modes: the first `N` of `modes` as a slice of
-        // constant length, so that the loops over modes unroll too.
+        // `2N` or `2N + 1` columns for `N` modes: `modes` as a slice of constant length, so
+        // that the loops over modes unroll too.
         let modes = self.modes;
-        match columns {
-            2 => self.run::<2>(&modes[..1], 2, 0, v, gaps),
-            3 => self.run::<3>(&modes[..1], 3, 0, v, gaps),
-            4 => self.run::<4>(&modes[..2], 4, 0, v, gaps),
-            5 => self.run::<5>(&modes[..2], 5, 0, v, gaps),
-            6 => self.run::<6>(&modes[..3], 6, 0, v, gaps),
-            7 => self.run::<7>(&modes[..3], 7, 0, v, gaps),
+        match (columns, modes.len()) {
+            (2, 1) => self.run::<2>(&modes[..1], 2, 0, v, gaps),
+            (3, 1) => self.run::<3>(&modes[..1], 3, 0, v, gaps),
+            (4, 2) => self.run::<4>(&modes[..2], 4, 0, v, gaps),
+            (5, 2) => self.run::<5>(&modes[..2], 5, 0, v, gaps),
+            (6, 3) => self.run::<6>(&modes[..3], 6, 0, v, gaps),
+            (7, 3) => self.run::<7>(&modes[..3], 7, 0, v, gaps),
             _ => {
                 let blocks = columns / COLUMN_BLOCK * COLUMN_BLOCK;
                 for start in (0..blocks).step_by(COLUMN_BLOCK) {
@@ -889,8 +889,8 @@ impl TangentRecurrence<'_> {
     /// (-(3/2) c) (tau r g)_k - w_i^2 (tau q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a
     /// convolution. The columns evolve independently along the given state series, so the
     /// recurrence runs over a block of them at once, its values in arrays of the constant width
-    /// `C`. `modes` are the recurrence's modes (`self.modes`, passed as a slice whose length
-    /// the caller may fix); `scratch` holds the gap's coefficients (resized here).
+    /// `C`. `modes` are the recurrence's modes (`self.modes`, passed as a slice of a length the
+    /// caller may make a constant); `scratch` holds the gap's coefficients (resized here).
     #[inline(always)]
     fn run<const C: usize>(
         &self,
@@ -900,7 +900,6 @@ impl TangentRecurrence<'_> {
         v: &mut [f64],
         scratch: &mut Vec<f64>,
     ) {
-        debug_assert_eq!(modes.len(), self.modes.len());
         let p = self.root_reversed.len();
         let dim = 2 * modes.len() * columns;
         let (a, b2) = (self.rate, self.curvature);
