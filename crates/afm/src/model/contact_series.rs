@@ -51,7 +51,8 @@ const LEN: usize = MAX_ORDER + 1;
 const SHARED_LEN: usize = 8 * LEN + ROOT_LEN;
 
 /// The values of the force's auxiliary series in [`SharedSeries`]: three series and one value
-/// (JKR's `b`, `b^2`, `b^3` and `d delta/db` at the start).
+/// (JKR's `b`, `b^2`, `b^3` and `d delta/db` at the start; the hydration force's `w` and
+/// `j delta_j`).
 const ROOT_LEN: usize = 3 * LEN + 1;
 const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 
@@ -65,8 +66,8 @@ const _: () = assert!(SHARED_LEN <= hybrid::SHARED_SERIES_CAPACITY);
 /// After a state series of order `p` (clock rate `a`): `delta_0..delta_{p-1}`; `root` (Hertz:
 /// the indentation's square root, `r_0..r_{p-1}`, at an onset `r_0 = 0` and
 /// `r_1..r_{max(p, 3) - 3}`; van der Waals: `1/d`; JKR: `b`, `b^2`, `b^3` one after the other;
-/// hydration: `w`'s real then imaginary parts; each to `p - 1`); the drive phase's `cos` and
-/// `sin` to `p`.
+/// hydration: `w`'s `[re, im]` pairs, highest power first, then `j delta_j`; each to `p - 1`);
+/// the drive phase's `cos` and `sin` to `p`.
 struct SharedSeries<'a> {
     /// The indentation below the contact surface, nm.
     delta: &'a mut [f64; LEN],
@@ -145,13 +146,17 @@ pub(crate) enum SeriesForce {
     },
 }
 
-/// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`; real parts in
-/// `re`, imaginary in `im`) from `delta`'s coefficients to `k` and `w`'s below `k`:
-/// `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j delta_j w_{k-j}`.
-#[inline]
+/// Coefficient `k` of `w = exp(c delta)` (complex, `c = 1/lambda - i k_w`) from `delta`'s
+/// coefficients to `k` and `w`'s below `k`: `w_0 = exp(c delta_0)`, `k w_k = c sum_{j=1}^{k} j
+/// delta_j w_{k-j}`. `w` holds the coefficients highest power last-in first, as `[re, im]`
+/// pairs: `w_k` in `w[LEN - 1 - k]` (so that `w_{k-1}, ..., w_0` run forward, as the sum takes
+/// them). `weighted` holds `j delta_j` for `j < k` and gets `k delta_k` here, so that each is
+/// formed once; the sum's terms are added in the order `j = 1, ..., k`, its real and imaginary
+/// parts side by side.
+#[inline(always)]
 fn update_layer_exponential(
-    re: &mut [f64],
-    im: &mut [f64],
+    w: &mut [[f64; 2]; LEN],
+    weighted: &mut [f64],
     delta: &[f64],
     k: usize,
     wavenumber: f64,
@@ -161,19 +166,32 @@ fn update_layer_exponential(
     if k == 0 {
         let magnitude = (c_re * delta[0]).exp();
         let (sin, cos) = (c_im * delta[0]).sin_cos();
-        re[0] = magnitude * cos;
-        im[0] = magnitude * sin;
+        w[LEN - 1] = [magnitude * cos, magnitude * sin];
+        weighted[0] = 0.0;
         return;
     }
-    let (mut sum_re, mut sum_im) = (0.0, 0.0);
-    for j in 1..=k {
-        let weight = j as f64 * delta[j];
-        sum_re += weight * re[k - j];
-        sum_im += weight * im[k - j];
+    weighted[k] = k as f64 * delta[k];
+    let mut sum = [-0.0, -0.0];
+    for (factor, below) in weighted[1..=k].iter().zip(&w[LEN - k..]) {
+        sum[0] += factor * below[0];
+        sum[1] += factor * below[1];
     }
+    let [sum_re, sum_im] = sum;
     let scale = 1.0 / k as f64;
-    re[k] = scale * (c_re * sum_re - c_im * sum_im);
-    im[k] = scale * (c_re * sum_im + c_im * sum_re);
+    w[LEN - 1 - k] = [
+        scale * (c_re * sum_re - c_im * sum_im),
+        scale * (c_re * sum_im + c_im * sum_re),
+    ];
+}
+
+/// The `LEN` pairs `[re, im]` of [`update_layer_exponential`]'s `w` laid out in `values`
+/// (`2 LEN` of them).
+#[inline(always)]
+fn layer_exponential_pairs(values: &mut [f64]) -> &mut [[f64; 2]; LEN] {
+    let (pairs, _) = values.as_chunks_mut::<2>();
+    (&mut pairs[..LEN])
+        .try_into()
+        .expect("2 LEN values hold LEN pairs")
 }
 
 /// The drives a series expands Eq. 1 with (MODEL.md sections 1 and 14): the drive at
@@ -545,14 +563,17 @@ fn force_coefficient(
             wavenumber,
             decay_length,
         } => {
-            // Analytic in d everywhere, on the time clock; `root` holds `w`'s real parts then
-            // its imaginary parts.
+            // Analytic in d everywhere, on the time clock; `root` holds `w`'s coefficients as
+            // `[re, im]` pairs, the highest power first (`update_layer_exponential`), then
+            // `j delta_j`.
             if onset {
                 return None;
             }
-            let (re, im) = root.split_at_mut(MAX_ORDER + 1);
-            update_layer_exponential(re, im, delta, k, wavenumber, decay_length);
-            Some(amplitude * (re[k] - wavenumber * decay_length * im[k]))
+            let (pairs, weighted) = root.split_at_mut(2 * LEN);
+            let w = layer_exponential_pairs(pairs);
+            update_layer_exponential(w, weighted, delta, k, wavenumber, decay_length);
+            let [re, im] = w[LEN - 1 - k];
+            Some(amplitude * (re - wavenumber * decay_length * im))
         }
     }
 }
@@ -791,10 +812,15 @@ pub(crate) fn contact_tangent_series(
             wavenumber,
             decay_length,
         } => {
-            // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w.
+            // F' = -B (1/lambda + k^2 lambda) exp(-d/lambda) cos(k d) = slope Re w (`w`'s
+            // pairs are in `root`, the highest power first).
+            let w = layer_exponential_pairs(&mut root[..2 * LEN]);
+            for (m, pair) in derivative[..p].iter_mut().zip(w.iter().rev()) {
+                *m = pair[0];
+            }
             (
                 -amplitude * (1.0 / decay_length + wavenumber * wavenumber * decay_length),
-                &root[..p],
+                &derivative[..p],
             )
         }
     };
@@ -856,20 +882,23 @@ impl TangentRecurrence<'_> {
     /// [`COLUMN_BLOCK`], the rest one by one.
     #[inline(always)]
     fn run_columns(&self, columns: usize, v: &mut [f64], gaps: &mut Vec<f64>) {
-        match columns {
-            2 => self.run::<2>(2, 0, v, gaps),
-            3 => self.run::<3>(3, 0, v, gaps),
-            4 => self.run::<4>(4, 0, v, gaps),
-            5 => self.run::<5>(5, 0, v, gaps),
-            6 => self.run::<6>(6, 0, v, gaps),
-            7 => self.run::<7>(7, 0, v, gaps),
+        // `2N` or `2N + 1` columns for `N` modes: `modes` as a slice of constant length, so
+        // that the loops over modes unroll too.
+        let modes = self.modes;
+        match (columns, modes.len()) {
+            (2, 1) => self.run::<2>(&modes[..1], 2, 0, v, gaps),
+            (3, 1) => self.run::<3>(&modes[..1], 3, 0, v, gaps),
+            (4, 2) => self.run::<4>(&modes[..2], 4, 0, v, gaps),
+            (5, 2) => self.run::<5>(&modes[..2], 5, 0, v, gaps),
+            (6, 3) => self.run::<6>(&modes[..3], 6, 0, v, gaps),
+            (7, 3) => self.run::<7>(&modes[..3], 7, 0, v, gaps),
             _ => {
                 let blocks = columns / COLUMN_BLOCK * COLUMN_BLOCK;
                 for start in (0..blocks).step_by(COLUMN_BLOCK) {
-                    self.run::<COLUMN_BLOCK>(columns, start, v, gaps);
+                    self.run::<COLUMN_BLOCK>(modes, columns, start, v, gaps);
                 }
                 for start in blocks..columns {
-                    self.run::<1>(columns, start, v, gaps);
+                    self.run::<1>(modes, columns, start, v, gaps);
                 }
             }
         }
@@ -881,16 +910,17 @@ impl TangentRecurrence<'_> {
     /// (-(3/2) c) (tau r g)_k - w_i^2 (tau q_i)_k - (w_i/Q_i) (tau v_i)_k`, `(r g)_k` a
     /// convolution. The columns evolve independently along the given state series, so the
     /// recurrence runs over a block of them at once, its values in arrays of the constant width
-    /// `C`. `scratch` holds the gap's coefficients (resized here).
+    /// `C`. `modes` are the recurrence's modes (`self.modes`, passed as a slice of a length the
+    /// caller may make a constant); `scratch` holds the gap's coefficients (resized here).
     #[inline(always)]
     fn run<const C: usize>(
         &self,
+        modes: &[ModalConstants],
         columns: usize,
         start: usize,
         v: &mut [f64],
         scratch: &mut Vec<f64>,
     ) {
-        let modes = self.modes;
         let p = self.root_reversed.len();
         let dim = 2 * modes.len() * columns;
         let (a, b2) = (self.rate, self.curvature);
