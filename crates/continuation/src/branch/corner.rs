@@ -38,6 +38,21 @@ pub(super) struct Jump {
 pub(super) const CORNER_FAILURES: usize = 6;
 
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
+    /// The parameter offsets `dp` (parameter units) at which [`Continuation::corner_jump`] shoots
+    /// and [`Continuation::terminal_location`] probes past a corner: `1e-4 .. 100` times the
+    /// initial step by factors of 10, each capped at the largest step, without repeating an
+    /// offset the cap has already given (the same shot, or the same trajectory, again).
+    fn offsets_past_corner(&self) -> Vec<f64> {
+        let mut offsets: Vec<f64> = Vec::with_capacity(7);
+        for j in 0..=6 {
+            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+            if offsets.last() != Some(&dp) {
+                offsets.push(dp);
+            }
+        }
+        offsets
+    }
+
     /// Jump over a corner of the branch at a structure change (the square-root singularity
     /// of a hard impact at grazing, where the branch turns too sharply for the corrector):
     /// shoot at fixed parameters `p_A + dp` beyond the current point, `dp` growing from
@@ -53,8 +68,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             max_iterations: self.settings.corrector.max_iterations * 4,
             ..self.settings.corrector.clone()
         };
-        for j in 0..=6 {
-            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+        for dp in self.offsets_past_corner() {
             let p = a.parameter() + direction * dp;
             if p > self.settings.parameter_max || p < self.settings.parameter_min {
                 break;
@@ -119,8 +133,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             return Ok(Vec::new());
         }
         let direction = tp.signum();
-        for j in 0..=6 {
-            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+        for dp in self.offsets_past_corner() {
             let p = a.parameter() + direction * dp;
             if p > self.settings.parameter_max || p < self.settings.parameter_min {
                 break;
