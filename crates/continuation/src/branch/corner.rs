@@ -56,7 +56,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// Jump over a corner of the branch at a structure change (the square-root singularity
     /// of a hard impact at grazing, where the branch turns too sharply for the corrector):
     /// shoot at fixed parameters `p_A + dp` beyond the current point, `dp` growing from
-    /// `1e-4` to `100` times the initial step, from the state extrapolated along the tangent.
+    /// `1e-4` to `100` times the initial step ([`Continuation::offsets_past_corner`], within
+    /// the parameter range), from the state extrapolated along the tangent. On a branch whose
+    /// period map jumps at its grazings ([`crate::ContinuationSettings::hysteretic_grazing`])
+    /// only at the largest of those offsets: across such a jump no orbit lies near the branch,
+    /// and what a shot can converge to is an orbit coexisting across the hysteresis.
     /// The first converged orbit whose structure differs from the current one is returned,
     /// with its tangent oriented along the secant (also returned).
     pub(super) fn corner_jump(&self) -> Result<Option<Jump>, ContinuationError> {
@@ -68,11 +72,23 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             max_iterations: self.settings.corrector.max_iterations * 4,
             ..self.settings.corrector.clone()
         };
-        for dp in self.offsets_past_corner() {
+        let in_range = |dp: &f64| {
             let p = a.parameter() + direction * dp;
-            if p > self.settings.parameter_max || p < self.settings.parameter_min {
-                break;
-            }
+            p <= self.settings.parameter_max && p >= self.settings.parameter_min
+        };
+        let mut offsets: Vec<f64> = self
+            .offsets_past_corner()
+            .into_iter()
+            .take_while(in_range)
+            .collect();
+        if self.settings.hysteretic_grazing {
+            // Where the period map jumps at the grazing, no orbit lies just past it near the
+            // branch: only the largest offset can reach one (an orbit coexisting across the
+            // hysteresis).
+            offsets.drain(..offsets.len().saturating_sub(1));
+        }
+        for dp in offsets {
+            let p = a.parameter() + direction * dp;
             let slope = if tp.abs() > 1e-12 { 1.0 / tp } else { 0.0 };
             let guess = a.u.rows(0, n) + (direction * dp * slope) * a.tangent.rows(0, n);
             let result = match shoot_checked(
