@@ -100,6 +100,9 @@ pub(crate) struct Segment<'a, P: PeriodicProblem + ?Sized> {
     reference: DVector<f64>,
     settings: NewtonSettings,
     natural: bool,
+    /// Whether the far end (`sigma = 1`) is an orbit, whose tangent a shot in natural mode can
+    /// start from (not where it is the trajectory past the end of a branch).
+    far_is_orbit: bool,
     samples: RefCell<Vec<Sample>>,
     trials: Cell<usize>,
 }
@@ -216,9 +219,18 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             reference,
             settings,
             natural,
+            far_is_orbit: true,
             samples: RefCell::new(vec![a, b]),
             trials: Cell::new(0),
         }
+    }
+
+    /// The segment with a far end (`b`) that is a trajectory, not an orbit (the state
+    /// extrapolated past the end of a branch): natural-mode trials shoot from the near end's
+    /// tangent only.
+    pub(crate) fn with_far_trajectory(mut self) -> Self {
+        self.far_is_orbit = false;
+        self
     }
 
     /// Parameter at `sigma`: linear in natural mode, else that of the cached sample at
@@ -306,12 +318,16 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     }
 
     /// Shooting at the fixed parameter of `sigma`, from the states extrapolated along the
-    /// tangents at `A`, then at `B` (each shot given up when it stalls, [`NEWTON_STALL`]: a
-    /// trial past the structure change, with no orbit near its guess).
+    /// tangents at `A`, then at `B` where `B` is an orbit (each shot given up when it stalls,
+    /// [`NEWTON_STALL`]: a trial past the structure change, with no orbit near its guess).
     fn shoot_at(&self, sigma: f64) -> Result<Option<(DVector<f64>, PeriodMap)>, ContinuationError> {
         let n = self.u_a.len() - 1;
         let p = self.parameter_at(sigma);
-        let ends = [self.get(0), self.get(1)];
+        let ends = if self.far_is_orbit {
+            vec![self.get(0), self.get(1)]
+        } else {
+            vec![self.get(0)]
+        };
         let settings = NewtonSettings {
             max_iterations: self.settings.max_iterations * 4,
             ..self.settings.clone()

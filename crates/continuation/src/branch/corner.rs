@@ -139,7 +139,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// into, if any: a trajectory started from the state extrapolated along the tangent,
     /// `dp = 1e-4 .. 100` initial steps ahead, that has a different structure marks the far
     /// side; the change is then located in the natural parameter between the last orbit and
-    /// that parameter, trials with no orbit counting as the far side. `impacts_after` is the
+    /// that parameter, trials (shot from the state extrapolated along the last orbit's tangent)
+    /// with no orbit counting as the far side. `impacts_after` is the
     /// impact count of that extrapolated trajectory (no orbit exists there).
     pub(super) fn terminal_location(&self) -> Result<Vec<SpecialPoint>, ContinuationError> {
         let a = &self.current;
@@ -178,7 +179,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 a.tangent.clone(),
                 self.settings.corrector.clone(),
                 true,
-            );
+            )
+            .with_far_trajectory();
             let index = self.produced.saturating_sub(1);
             return self.locate_all(&segment, &structure, index, true, false);
         }
