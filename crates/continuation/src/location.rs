@@ -13,12 +13,15 @@
 //! along the tangent at `A` (then at `B`). There a trial that converges on neither side is
 //! counted as lying on the far (`B`) side of a structure change: near the grazing of a hard
 //! impact the orbit past it is too singular for Newton's method, while the orbit before it is
-//! smooth and its extrapolated guess is excellent.
+//! smooth and its extrapolated guess is excellent. The far side's values there are not the test
+//! function's own (a failed trial, or past a jump of the period map), so the root is found by
+//! regula falsi with the Anderson-Bjorck modification, which follows the near side's secant,
+//! rather than the Illinois method.
 
 use std::cell::{Cell, RefCell};
 
 use nalgebra::{Complex, DVector};
-use roots::{find_root_regula_falsi, Convergency};
+use roots::{find_root_regula_falsi, Convergency, SearchError};
 
 use crate::corrector::{correct, tangent, Purpose};
 use crate::error::ContinuationError;
@@ -97,6 +100,9 @@ pub(crate) struct Segment<'a, P: PeriodicProblem + ?Sized> {
     reference: DVector<f64>,
     settings: NewtonSettings,
     natural: bool,
+    /// Whether the far end (`sigma = 1`) is an orbit, whose tangent a shot in natural mode can
+    /// start from (not where it is the trajectory past the end of a branch).
+    far_is_orbit: bool,
     samples: RefCell<Vec<Sample>>,
     trials: Cell<usize>,
 }
@@ -123,6 +129,66 @@ impl<P: PeriodicProblem + ?Sized> Convergency<f64> for ParameterBracket<'_, '_, 
 
     fn is_iteration_limit_reached(&mut self, iter: usize) -> bool {
         iter >= self.max_iterations
+    }
+}
+
+/// Regula falsi with the Anderson-Bjorck modification (Anderson and Bjorck, BIT 12, 1973):
+/// where the new point falls on the same side as the last one, the value kept at the other end
+/// is scaled by `m = 1 - y / y_side` (`y_side` the value the new point replaces; 0.5, as in the
+/// Illinois method, where `m <= 0`), stopping by `convergency` as `roots`' regula falsi does.
+/// Where one end's value is not the test function's own (in natural mode, a failed trial or
+/// the far trajectory standing for the far side), the Illinois halving takes a step per
+/// doubling of the distance covered from the near end; the scaling by `m` takes the secant of
+/// the near side's values instead.
+fn anderson_bjorck(
+    a: f64,
+    b: f64,
+    mut f: impl FnMut(f64) -> f64,
+    convergency: &mut dyn Convergency<f64>,
+) -> Result<f64, SearchError> {
+    let (mut x1, mut x2) = if a > b { (b, a) } else { (a, b) };
+    let mut y1 = f(x1);
+    if convergency.is_root_found(y1) {
+        return Ok(x1);
+    }
+    let mut y2 = f(x2);
+    if convergency.is_root_found(y2) {
+        return Ok(x2);
+    }
+    if y1 * y2 > 0.0 {
+        return Err(SearchError::NoBracketing);
+    }
+    let scale = |y: f64, side: f64| {
+        let m = 1.0 - y / side;
+        if m > 0.0 {
+            m
+        } else {
+            0.5
+        }
+    };
+    let mut iterations = 0;
+    loop {
+        let x = (x1 * y2 - x2 * y1) / (y2 - y1);
+        if convergency.is_converged(x1, x2) {
+            return Ok(x);
+        }
+        let y = f(x);
+        if convergency.is_root_found(y) {
+            return Ok(x);
+        }
+        if y * y1 > 0.0 {
+            y2 *= scale(y, y1);
+            (x1, y1) = (x, y);
+        } else if y * y2 > 0.0 {
+            y1 *= scale(y, y2);
+            (x2, y2) = (x, y);
+        } else {
+            return Ok(x);
+        }
+        iterations += 1;
+        if convergency.is_iteration_limit_reached(iterations) {
+            return Err(SearchError::NoConvergency);
+        }
     }
 }
 
@@ -153,9 +219,18 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             reference,
             settings,
             natural,
+            far_is_orbit: true,
             samples: RefCell::new(vec![a, b]),
             trials: Cell::new(0),
         }
+    }
+
+    /// The segment with a far end (`b`) that is a trajectory, not an orbit (the state
+    /// extrapolated past the end of a branch): natural-mode trials shoot from the near end's
+    /// tangent only.
+    pub(crate) fn with_far_trajectory(mut self) -> Self {
+        self.far_is_orbit = false;
+        self
     }
 
     /// Parameter at `sigma`: linear in natural mode, else that of the cached sample at
@@ -243,12 +318,16 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     }
 
     /// Shooting at the fixed parameter of `sigma`, from the states extrapolated along the
-    /// tangents at `A`, then at `B` (each shot given up when it stalls, [`NEWTON_STALL`]: a
-    /// trial past the structure change, with no orbit near its guess).
+    /// tangents at `A`, then at `B` where `B` is an orbit (each shot given up when it stalls,
+    /// [`NEWTON_STALL`]: a trial past the structure change, with no orbit near its guess).
     fn shoot_at(&self, sigma: f64) -> Result<Option<(DVector<f64>, PeriodMap)>, ContinuationError> {
         let n = self.u_a.len() - 1;
         let p = self.parameter_at(sigma);
-        let ends = [self.get(0), self.get(1)];
+        let ends = if self.far_is_orbit {
+            vec![self.get(0), self.get(1)]
+        } else {
+            vec![self.get(0)]
+        };
         let settings = NewtonSettings {
             max_iterations: self.settings.max_iterations * 4,
             ..self.settings.clone()
@@ -324,7 +403,11 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             max_iterations,
             bracket: &bracket,
         };
-        let root = find_root_regula_falsi(s_low, s_high, value, &mut convergency);
+        let root = if self.natural {
+            anderson_bjorck(s_low, s_high, value, &mut convergency)
+        } else {
+            find_root_regula_falsi(s_low, s_high, value, &mut convergency)
+        };
         if let Some(e) = error.into_inner() {
             return Err(e);
         }
@@ -377,5 +460,78 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             converged,
             iterations: self.trials.get() - before,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    use roots::{find_root_regula_falsi, Convergency};
+
+    use super::anderson_bjorck;
+
+    /// Stop when the bracket is narrower than `width`.
+    struct Bracket {
+        width: f64,
+    }
+
+    impl Convergency<f64> for Bracket {
+        fn is_root_found(&mut self, y: f64) -> bool {
+            y == 0.0
+        }
+
+        fn is_converged(&mut self, x1: f64, x2: f64) -> bool {
+            (x1 - x2).abs() <= self.width
+        }
+
+        fn is_iteration_limit_reached(&mut self, iter: usize) -> bool {
+            iter >= 200
+        }
+    }
+
+    /// A test function that vanishes at `x = 0.004` on the near side and is replaced past
+    /// `0.0041` by the far end's value -0.04 (a failed trial in natural mode): the bracket
+    /// `[x, 0.0041]` around the root shrinks only from the near side until the search lands in
+    /// `(0.004, 0.0041]`.
+    fn near_side_then_proxy(x: f64) -> f64 {
+        if x < 0.0041 {
+            1e-6 * (0.004 - x)
+        } else {
+            -0.04
+        }
+    }
+
+    #[test]
+    fn anderson_bjorck_takes_the_near_side_secant_where_illinois_doubles() {
+        let (illinois_calls, scaled_calls) = (Cell::new(0), Cell::new(0));
+        fn counted(calls: &Cell<usize>) -> impl FnMut(f64) -> f64 + '_ {
+            move |x: f64| {
+                calls.set(calls.get() + 1);
+                near_side_then_proxy(x)
+            }
+        }
+        let width = 2e-4;
+        let illinois =
+            find_root_regula_falsi(0.0, 1.0, counted(&illinois_calls), &mut Bracket { width });
+        let scaled = anderson_bjorck(0.0, 1.0, counted(&scaled_calls), &mut Bracket { width });
+        // The zero of the near side's values within the bracket's width (the sign change itself
+        // lies in [0.004, 0.0041]).
+        let (scaled, illinois) = (scaled.expect("converges"), illinois.expect("converges"));
+        assert!((scaled - 0.004).abs() <= width, "{scaled}");
+        assert!((illinois - 0.004).abs() <= width, "{illinois}");
+        assert!(
+            scaled_calls.get() + 5 < illinois_calls.get(),
+            "Anderson-Bjorck {} evaluations, Illinois {}",
+            scaled_calls.get(),
+            illinois_calls.get()
+        );
+    }
+
+    #[test]
+    fn anderson_bjorck_finds_a_smooth_root() {
+        // x^3 - 2 on [0, 2]: the root 2^(1/3).
+        let root = anderson_bjorck(0.0, 2.0, |x| x * x * x - 2.0, &mut Bracket { width: 1e-12 });
+        assert!((root.unwrap() - 2f64.cbrt()).abs() <= 1e-12);
     }
 }

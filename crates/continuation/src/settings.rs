@@ -76,7 +76,8 @@ pub struct ContinuationSettings {
     /// prediction lies past such a grazing cuts the step to 0.99 of the way to the grazing
     /// extrapolated from the last two points, instead of by `step_cut`, and the steps after it
     /// are aimed the same way (`branch/hysteretic_break.rs`); the branch reaches the minimum
-    /// step, where it ends, in a few steps instead of about twenty failed corrections.
+    /// step, where it ends, in a few steps instead of about twenty failed corrections; the
+    /// corner jump tried there shoots at its largest offset only (`branch/corner.rs`).
     /// Default `false`.
     pub hysteretic_grazing: bool,
 }

@@ -79,6 +79,17 @@ pub(crate) fn has_complex_pair_on_unit_circle(multipliers: &[Complex<f64>]) -> b
     })
 }
 
+/// Whether `multipliers` hold a complex pair (a multiplier whose imaginary part exceeds
+/// [`COMPLEX_FRACTION`] of its modulus), on the unit circle or not. Where neither end of a step
+/// holds one, a sign change of [`neimark_sacker_test`] over the step is a product of two real
+/// multipliers passing 1 (a neutral saddle), not a Neimark-Sacker point: that would need a
+/// pair to turn complex, cross the unit circle and turn real again within the one step.
+pub(crate) fn has_complex_pair(multipliers: &[Complex<f64>]) -> bool {
+    multipliers
+        .iter()
+        .any(|m| m.im.abs() > COMPLEX_FRACTION * m.norm())
+}
+
 /// Which kind of extremum of the switching function a structure test follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(crate) enum ExtremumKind {
@@ -251,6 +262,22 @@ mod tests {
         let after = [Complex::new(-1.1, 0.0), Complex::new(0.5, 0.0)];
         assert!((period_doubling_test(&before) - 0.15).abs() < 1e-15);
         assert!((period_doubling_test(&after) + 0.15).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_neutral_saddle_has_no_complex_pair() {
+        // Two real multipliers with product 1 zero the Neimark-Sacker test without a pair.
+        let saddle = [Complex::new(2.0, 0.0), Complex::new(0.5, 0.0)];
+        assert!(neimark_sacker_test(&saddle).abs() < 1e-15);
+        assert!(!has_complex_pair(&saddle));
+        // Rounding-level imaginary parts of real eigenvalues are not a pair either.
+        let rounded = [Complex::new(2.0, 1e-12), Complex::new(0.5, -1e-12)];
+        assert!(!has_complex_pair(&rounded));
+        let pair = [
+            Complex::from_polar(1.0, 0.3),
+            Complex::from_polar(1.0, -0.3),
+        ];
+        assert!(has_complex_pair(&pair));
     }
 
     #[test]

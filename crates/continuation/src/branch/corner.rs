@@ -38,10 +38,29 @@ pub(super) struct Jump {
 pub(super) const CORNER_FAILURES: usize = 6;
 
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
+    /// The parameter offsets `dp` (parameter units) at which [`Continuation::corner_jump`] shoots
+    /// and [`Continuation::terminal_location`] probes past a corner: `1e-4 .. 100` times the
+    /// initial step by factors of 10, each capped at the largest step, without repeating an
+    /// offset the cap has already given (the same shot, or the same trajectory, again).
+    fn offsets_past_corner(&self) -> Vec<f64> {
+        let mut offsets: Vec<f64> = Vec::with_capacity(7);
+        for j in 0..=6 {
+            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+            if offsets.last() != Some(&dp) {
+                offsets.push(dp);
+            }
+        }
+        offsets
+    }
+
     /// Jump over a corner of the branch at a structure change (the square-root singularity
     /// of a hard impact at grazing, where the branch turns too sharply for the corrector):
     /// shoot at fixed parameters `p_A + dp` beyond the current point, `dp` growing from
-    /// `1e-4` to `100` times the initial step, from the state extrapolated along the tangent.
+    /// `1e-4` to `100` times the initial step ([`Continuation::offsets_past_corner`], within
+    /// the parameter range), from the state extrapolated along the tangent. On a branch whose
+    /// period map jumps at its grazings ([`crate::ContinuationSettings::hysteretic_grazing`])
+    /// only at the largest of those offsets: across such a jump no orbit lies near the branch,
+    /// and what a shot can converge to is an orbit coexisting across the hysteresis.
     /// The first converged orbit whose structure differs from the current one is returned,
     /// with its tangent oriented along the secant (also returned).
     pub(super) fn corner_jump(&self) -> Result<Option<Jump>, ContinuationError> {
@@ -53,12 +72,23 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             max_iterations: self.settings.corrector.max_iterations * 4,
             ..self.settings.corrector.clone()
         };
-        for j in 0..=6 {
-            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+        let in_range = |dp: &f64| {
             let p = a.parameter() + direction * dp;
-            if p > self.settings.parameter_max || p < self.settings.parameter_min {
-                break;
-            }
+            p <= self.settings.parameter_max && p >= self.settings.parameter_min
+        };
+        let mut offsets: Vec<f64> = self
+            .offsets_past_corner()
+            .into_iter()
+            .take_while(in_range)
+            .collect();
+        if self.settings.hysteretic_grazing {
+            // Where the period map jumps at the grazing, no orbit lies just past it near the
+            // branch: only the largest offset can reach one (an orbit coexisting across the
+            // hysteresis).
+            offsets.drain(..offsets.len().saturating_sub(1));
+        }
+        for dp in offsets {
+            let p = a.parameter() + direction * dp;
             let slope = if tp.abs() > 1e-12 { 1.0 / tp } else { 0.0 };
             let guess = a.u.rows(0, n) + (direction * dp * slope) * a.tangent.rows(0, n);
             let result = match shoot_checked(
@@ -109,7 +139,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// into, if any: a trajectory started from the state extrapolated along the tangent,
     /// `dp = 1e-4 .. 100` initial steps ahead, that has a different structure marks the far
     /// side; the change is then located in the natural parameter between the last orbit and
-    /// that parameter, trials with no orbit counting as the far side. `impacts_after` is the
+    /// that parameter, trials (shot from the state extrapolated along the last orbit's tangent)
+    /// with no orbit counting as the far side. `impacts_after` is the
     /// impact count of that extrapolated trajectory (no orbit exists there).
     pub(super) fn terminal_location(&self) -> Result<Vec<SpecialPoint>, ContinuationError> {
         let a = &self.current;
@@ -119,8 +150,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             return Ok(Vec::new());
         }
         let direction = tp.signum();
-        for j in 0..=6 {
-            let dp = (self.settings.initial_step * 10f64.powi(j - 4)).min(self.settings.max_step);
+        for dp in self.offsets_past_corner() {
             let p = a.parameter() + direction * dp;
             if p > self.settings.parameter_max || p < self.settings.parameter_min {
                 break;
@@ -149,7 +179,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 a.tangent.clone(),
                 self.settings.corrector.clone(),
                 true,
-            );
+            )
+            .with_far_trajectory();
             let index = self.produced.saturating_sub(1);
             return self.locate_all(&segment, &structure, index, true, false);
         }

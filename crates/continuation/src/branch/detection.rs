@@ -9,8 +9,8 @@ use crate::location::{Location, Sample, Segment};
 use crate::problem::PeriodicProblem;
 use crate::special_point::{SpecialPoint, SpecialPointKind};
 use crate::test_function::{
-    has_complex_pair_on_unit_circle, neimark_sacker_test, period_doubling_test, ExtremumKind,
-    StructureTest,
+    has_complex_pair, has_complex_pair_on_unit_circle, neimark_sacker_test, period_doubling_test,
+    ExtremumKind, StructureTest,
 };
 
 /// A test function of a corrected orbit on a step.
@@ -125,6 +125,14 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         for (kind, test) in smooth {
             let (ga, gb) = (test(&a0), test(&b1));
             if !(ga.is_finite() && gb.is_finite()) || sign(ga) == sign(gb) {
+                continue;
+            }
+            // A Neimark-Sacker test's sign change between two ends without a complex pair is a
+            // neutral saddle, which the location below would find and drop.
+            if kind == SpecialPointKind::NeimarkSacker
+                && !has_complex_pair(&a0.multipliers)
+                && !has_complex_pair(&b1.multipliers)
+            {
                 continue;
             }
             // Intervals between the structure brackets, in sigma order.
