@@ -11,6 +11,7 @@ use continuation::{
 use nalgebra::Complex;
 use serde::Serialize;
 
+use crate::diagram::branch_turn::{pull_off_at_fold, BranchTurn};
 use crate::diagram::observed_problem::ObservedPeriodProblem;
 use crate::diagram::period_one_budget::admits_period_one;
 use crate::error::AfmError;
@@ -308,8 +309,11 @@ const MAX_JUMPS: usize = 16;
 /// cantilever does: it takes the orbit that transients from the last branch point settle on,
 /// half a largest step further (`steady_orbit` with [`OrbitStart::AfterTransients`]; past a
 /// band where they settle on no stable period-1 orbit, [`settle_on_period_one`]), and
-/// continues from it; on a retract, the end of an attached branch that is not a located
-/// grazing is labelled `pull-off` (located to the continuation's smallest step, 1e-8).
+/// continues from it. On a retract, the end of an attached branch that is not a located
+/// grazing is labelled `pull-off`: at a fold of the attached orbits (where `Z` turns back) the
+/// located fold, else the last point (the corrector failed at the continuation's smallest
+/// step). A retract whose `Z` turned back with no fold located in the step (the tangent's
+/// orientation reversed after a corner jump) is no end: the branch goes on from its last point.
 pub fn diagram_until(
     model: &TappingModel,
     x0: &[f64],
@@ -317,7 +321,7 @@ pub fn diagram_until(
     settings: &DiagramSettings,
     interrupted: &mut dyn FnMut() -> bool,
 ) -> Result<BifurcationDiagram, AfmError> {
-    let (mut diagram, mut broke) = branch_until(model, x0, z_start, settings, interrupted)?;
+    let (mut diagram, mut turn) = branch_until(model, x0, z_start, settings, interrupted)?;
     if model.release_gap_nm().is_none() {
         return Ok(diagram);
     }
@@ -326,13 +330,31 @@ pub fn diagram_until(
         ParameterDirection::Increasing => 1.0,
     };
     let mut system = model.clone();
+    // The `Z` a reversed retract last went on from (a second reversal there ends the branch).
+    let mut resumed_at: Option<f64> = None;
     for _ in 0..MAX_JUMPS {
-        if !broke && (diagram.completed || diagram.stop != stop_words(StopReason::StepTooSmall)) {
+        if turn.is_none()
+            && (diagram.completed || diagram.stop != stop_words(StopReason::StepTooSmall))
+        {
             break;
         }
         let Some(last) = diagram.points.last().cloned() else {
             break;
         };
+        // A retract whose tangent only turned backwards goes on from its last point.
+        if sign > 0.0 && matches!(turn, Some(BranchTurn::Reversed)) && resumed_at != Some(last.z_nm)
+        {
+            resumed_at = Some(last.z_nm);
+            let next;
+            (next, turn) = branch_until(model, &last.state, last.z_nm, settings, interrupted)?;
+            // The resumed branch starts at the last point itself.
+            diagram.points.extend(next.points.into_iter().skip(1));
+            diagram.special_points.extend(next.special_points);
+            diagram.stop = next.stop;
+            diagram.completed = next.completed;
+            diagram.error = next.error;
+            continue;
+        }
         let z_jump = last.z_nm + sign * 0.5 * settings.max_step;
         if sign * (z_jump - settings.z_limit_nm) >= 0.0 {
             break;
@@ -350,9 +372,13 @@ pub fn diagram_until(
                 &settings.orbit.integration,
                 settings.orbit.harmonics,
             )?;
-            diagram
-                .special_points
-                .push(branch_end_point("pull-off", &last, &observables));
+            let end = match &turn {
+                Some(BranchTurn::Fold(fold)) => {
+                    pull_off_at_fold(fold, observables.impacts_per_window())
+                }
+                _ => branch_end_point("pull-off", &last, &observables),
+            };
+            diagram.special_points.push(end);
         }
         let Some((z_jump, orbit)) =
             settle_on_period_one(&mut system, &last.state, z_jump, sign, settings)
@@ -360,7 +386,7 @@ pub fn diagram_until(
             break;
         };
         let next;
-        (next, broke) = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
+        (next, turn) = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
         diagram.points.extend(next.points);
         diagram.special_points.extend(next.special_points);
         diagram.stop = next.stop;
@@ -491,16 +517,17 @@ fn branch_end_point(
     }
 }
 
-/// One branch of [`diagram_until`]: the continuation from `(x0, z_start)` until it stops, and
-/// whether it was stopped where `Z` turned back, at a hysteretic law's break of the branch
-/// (the point past the break and the special points not located there are dropped).
+/// One branch of [`diagram_until`]: the continuation from `(x0, z_start)` until it stops, and,
+/// where a hysteretic law's branch was stopped because `Z` turned back, how it turned (the
+/// point past the turn and the special points located beyond the last point are dropped; a
+/// fold among them is the turn's).
 fn branch_until(
     model: &TappingModel,
     x0: &[f64],
     z_start: f64,
     settings: &DiagramSettings,
     interrupted: &mut dyn FnMut() -> bool,
-) -> Result<(BifurcationDiagram, bool), AfmError> {
+) -> Result<(BifurcationDiagram, Option<BranchTurn>), AfmError> {
     let hysteretic = model.release_gap_nm().is_some();
     let sign = match settings.direction {
         ParameterDirection::Decreasing => -1.0,
@@ -593,7 +620,18 @@ fn branch_until(
     }
     if turned {
         let last_z = points.last().map_or(z_start, |p: &DiagramPoint| p.z_nm);
+        let fold = special_points
+            .iter()
+            .zip(&branch.special_points)
+            .find(|(p, special)| {
+                special.kind == SpecialPointKind::Fold && sign * (p.z_nm - last_z) > 1e-9
+            })
+            .map(|(p, _)| p.clone());
         special_points.retain(|p| sign * (p.z_nm - last_z) <= 1e-9);
+        let turn = match fold {
+            Some(fold) => BranchTurn::Fold(fold),
+            None => BranchTurn::Reversed,
+        };
         return Ok((
             BifurcationDiagram {
                 points,
@@ -602,7 +640,7 @@ fn branch_until(
                 completed: false,
                 error: None,
             },
-            true,
+            Some(turn),
         ));
     }
     Ok((
@@ -616,7 +654,7 @@ fn branch_until(
             ),
             error: branch.error.map(|e| e.to_string()),
         },
-        false,
+        None,
     ))
 }
 
