@@ -117,3 +117,38 @@ fn adhesive_retract_has_no_branch_end_between_g2_and_g1() {
         );
     }
 }
+
+/// `biolever-sticky` at A0 = 12 nm: the retract's three-impact branch ends at 4.2399 nm where
+/// the corrector fails at the smallest step (a gap minimum 1e-5 nm below zero, the
+/// monodromy's spectral radius about 1e3), with no grazing located. The end is reported
+/// unconverged, with the bracket from the last point to the grazing extrapolated from the
+/// branch; continued with largest steps 0.02 and 0.025 nm the last points lie 3.7e-5 nm apart
+/// (measured), and the two brackets overlap (measured: widths 4.7e-5 and 7.8e-5 nm, the
+/// extrapolated grazings 6.5e-6 nm apart), as brackets of one end must.
+#[test]
+fn sticky_unlocated_end_brackets_overlap() {
+    let ends: Vec<DiagramSpecialPoint> = [0.02, 0.025]
+        .iter()
+        .map(|&step| {
+            let retract = retract("biolever-sticky", 12.0, step);
+            let end = retract
+                .special_points
+                .iter()
+                .find(|p| p.label == "pull-off" && (p.z_nm - 4.2399).abs() < 1e-3)
+                .expect("the branch end at 4.2399 nm")
+                .clone();
+            assert!(!end.converged, "{end:?}");
+            assert_eq!(end.bracket_nm[0], end.z_nm);
+            assert!(end.precision_nm > 0.0);
+            end
+        })
+        .collect();
+    let low = ends[0].bracket_nm[0].max(ends[1].bracket_nm[0]);
+    let high = ends[0].bracket_nm[1].min(ends[1].bracket_nm[1]);
+    assert!(
+        low <= high,
+        "brackets {:?} and {:?} do not overlap",
+        ends[0].bracket_nm,
+        ends[1].bracket_nm
+    );
+}
