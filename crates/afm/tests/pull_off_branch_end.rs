@@ -46,7 +46,7 @@ fn highest<'a>(diagram: &'a BifurcationDiagram, label: &str) -> &'a DiagramSpeci
 /// 0.04 nm (the built-in `A0 / 250`), the two branch ends are located independently (different
 /// branch points, different brackets) and agree within the larger of their stated precisions
 /// plus 1e-10 nm (measured: 1.6e-12 nm apart, precisions about 1e-11 nm; the last branch
-/// points, which the end was before, lie 5.7e-6 nm apart). Each is converged, its bracket
+/// points before the fold lie 1.1e-6 nm apart). Each is converged, its bracket
 /// holds it, and it lies at or beyond the last point of the branch below it.
 #[test]
 fn sticky_branch_end_agrees_between_step_sizes() {
