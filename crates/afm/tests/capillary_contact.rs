@@ -272,8 +272,8 @@ fn vanishing_meniscus_reproduces_hertz_grazing() {
 /// formation per period, each dissipating `E_m` (1e-8 relative) with its energy balance
 /// closed (1e-9); the retract's branch ends (`pull-off`) where the inequality becomes an
 /// equality, its `A/A0` to 1e-5 of the root `A` of `A (A0 sin(phi) - A) = E_m Q / (pi k)` at
-/// its phase (the higher harmonics' share of the damping and the branch end's location to the
-/// continuation's smallest step; measured 7e-7), and the approach's first point past the jump
+/// its phase (the higher harmonics' share of the damping; the branch end is the located fold
+/// of the attached orbits; measured 6.8e-7), and the approach's first point past the jump
 /// lies below it, within one step of the walk past the jump (`A0/100`: the walk skips no
 /// separation where a stable period-1 orbit exists).
 #[test]

@@ -11,6 +11,7 @@ use continuation::{
 use nalgebra::Complex;
 use serde::Serialize;
 
+use crate::diagram::branch_end::{extrapolated_grazing, pull_off_at_fold, BranchEnd};
 use crate::diagram::observed_problem::ObservedPeriodProblem;
 use crate::diagram::period_one_budget::admits_period_one;
 use crate::error::AfmError;
@@ -308,8 +309,12 @@ const MAX_JUMPS: usize = 16;
 /// cantilever does: it takes the orbit that transients from the last branch point settle on,
 /// half a largest step further (`steady_orbit` with [`OrbitStart::AfterTransients`]; past a
 /// band where they settle on no stable period-1 orbit, [`settle_on_period_one`]), and
-/// continues from it; on a retract, the end of an attached branch that is not a located
-/// grazing is labelled `pull-off` (located to the continuation's smallest step, 1e-8).
+/// continues from it. On a retract, the end of an attached branch that is not a located
+/// grazing is labelled `pull-off`: at a fold of the attached orbits (where `Z` turns back) the
+/// located fold, else the last point (the corrector failed at the continuation's smallest
+/// step), not located: its bracket runs to the grazing extrapolated from the branch. A
+/// retract whose `Z` turned back with no fold located in the step (the tangent's orientation
+/// reversed after a corner jump) is no end: the branch goes on from its last point.
 pub fn diagram_until(
     model: &TappingModel,
     x0: &[f64],
@@ -317,7 +322,7 @@ pub fn diagram_until(
     settings: &DiagramSettings,
     interrupted: &mut dyn FnMut() -> bool,
 ) -> Result<BifurcationDiagram, AfmError> {
-    let (mut diagram, mut broke) = branch_until(model, x0, z_start, settings, interrupted)?;
+    let (mut diagram, mut end) = branch_until(model, x0, z_start, settings, interrupted)?;
     if model.release_gap_nm().is_none() {
         return Ok(diagram);
     }
@@ -326,13 +331,28 @@ pub fn diagram_until(
         ParameterDirection::Increasing => 1.0,
     };
     let mut system = model.clone();
+    // The `Z` a reversed retract last went on from (a second reversal there ends the branch).
+    let mut resumed_at: Option<f64> = None;
     for _ in 0..MAX_JUMPS {
-        if !broke && (diagram.completed || diagram.stop != stop_words(StopReason::StepTooSmall)) {
+        if end.is_none() {
             break;
         }
         let Some(last) = diagram.points.last().cloned() else {
             break;
         };
+        // A retract whose tangent only turned backwards goes on from its last point.
+        if sign > 0.0 && matches!(end, Some(BranchEnd::Reversed)) && resumed_at != Some(last.z_nm) {
+            resumed_at = Some(last.z_nm);
+            let next;
+            (next, end) = branch_until(model, &last.state, last.z_nm, settings, interrupted)?;
+            // The resumed branch starts at the last point itself.
+            diagram.points.extend(next.points.into_iter().skip(1));
+            diagram.special_points.extend(next.special_points);
+            diagram.stop = next.stop;
+            diagram.completed = next.completed;
+            diagram.error = next.error;
+            continue;
+        }
         let z_jump = last.z_nm + sign * 0.5 * settings.max_step;
         if sign * (z_jump - settings.z_limit_nm) >= 0.0 {
             break;
@@ -350,9 +370,16 @@ pub fn diagram_until(
                 &settings.orbit.integration,
                 settings.orbit.harmonics,
             )?;
-            diagram
-                .special_points
-                .push(branch_end_point("pull-off", &last, &observables));
+            let point = match &end {
+                Some(BranchEnd::Fold(fold)) => {
+                    pull_off_at_fold(fold, observables.impacts_per_window())
+                }
+                Some(BranchEnd::Stuck(Some(grazing))) => {
+                    branch_end_point("pull-off", &last, &observables, grazing.min(z_jump))
+                }
+                _ => branch_end_point("pull-off", &last, &observables, z_jump),
+            };
+            diagram.special_points.push(point);
         }
         let Some((z_jump, orbit)) =
             settle_on_period_one(&mut system, &last.state, z_jump, sign, settings)
@@ -360,7 +387,7 @@ pub fn diagram_until(
             break;
         };
         let next;
-        (next, broke) = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
+        (next, end) = branch_until(model, &orbit.state, z_jump, settings, interrupted)?;
         diagram.points.extend(next.points);
         diagram.special_points.extend(next.special_points);
         diagram.stop = next.stop;
@@ -464,14 +491,19 @@ fn settle_on_period_one(
     None
 }
 
-/// The special point `label` at the last point `last` of a branch that ends there (a
-/// hysteretic law's pull-off): located to the continuation's smallest step.
+/// The special point `label` at the last point `last` of a retract's branch that ends there
+/// unlocated (a hysteretic law's pull-off where the corrector failed at the smallest step):
+/// the end lies between `last` and `beyond_nm` (nm; the grazing the branch was running into,
+/// extrapolated, or where the diagram jumps to), which is its bracket; its width is the
+/// precision, converged only within the location tolerance (1e-9 nm).
 fn branch_end_point(
     label: &str,
     last: &DiagramPoint,
     observables: &OrbitObservables,
+    beyond_nm: f64,
 ) -> DiagramSpecialPoint {
-    let precision = ContinuationSettings::default().min_step;
+    let bracket = [last.z_nm.min(beyond_nm), last.z_nm.max(beyond_nm)];
+    let precision = bracket[1] - bracket[0];
     DiagramSpecialPoint {
         label: label.to_string(),
         z_nm: last.z_nm,
@@ -479,9 +511,9 @@ fn branch_end_point(
         phase_deg: last.phase_deg,
         impacts_before: observables.impacts_per_window(),
         impacts_after: 0,
-        bracket_nm: [last.z_nm - precision, last.z_nm + precision],
+        bracket_nm: bracket,
         precision_nm: precision,
-        converged: true,
+        converged: precision <= ContinuationSettings::default().location_tolerance,
         state: last.state.clone(),
         harmonics: last.harmonics.clone(),
         dissipated_ev: last.dissipated_ev,
@@ -491,16 +523,17 @@ fn branch_end_point(
     }
 }
 
-/// One branch of [`diagram_until`]: the continuation from `(x0, z_start)` until it stops, and
-/// whether it was stopped where `Z` turned back, at a hysteretic law's break of the branch
-/// (the point past the break and the special points not located there are dropped).
+/// One branch of [`diagram_until`]: the continuation from `(x0, z_start)` until it stops, and,
+/// where a hysteretic law's branch was stopped because `Z` turned back, how it turned (the
+/// point past the turn and the special points located beyond the last point are dropped; a
+/// fold among them is the turn's).
 fn branch_until(
     model: &TappingModel,
     x0: &[f64],
     z_start: f64,
     settings: &DiagramSettings,
     interrupted: &mut dyn FnMut() -> bool,
-) -> Result<(BifurcationDiagram, bool), AfmError> {
+) -> Result<(BifurcationDiagram, Option<BranchEnd>), AfmError> {
     let hysteretic = model.release_gap_nm().is_some();
     let sign = match settings.direction {
         ParameterDirection::Decreasing => -1.0,
@@ -593,7 +626,18 @@ fn branch_until(
     }
     if turned {
         let last_z = points.last().map_or(z_start, |p: &DiagramPoint| p.z_nm);
+        let fold = special_points
+            .iter()
+            .zip(&branch.special_points)
+            .find(|(p, special)| {
+                special.kind == SpecialPointKind::Fold && sign * (p.z_nm - last_z) > 1e-9
+            })
+            .map(|(p, _)| p.clone());
         special_points.retain(|p| sign * (p.z_nm - last_z) <= 1e-9);
+        let end = match fold {
+            Some(fold) => BranchEnd::Fold(fold),
+            None => BranchEnd::Reversed,
+        };
         return Ok((
             BifurcationDiagram {
                 points,
@@ -602,9 +646,11 @@ fn branch_until(
                 completed: false,
                 error: None,
             },
-            true,
+            Some(end),
         ));
     }
+    let end = (hysteretic && branch.stop == StopReason::StepTooSmall)
+        .then(|| BranchEnd::Stuck(extrapolated_grazing(&branch.points, sign)));
     Ok((
         BifurcationDiagram {
             points,
@@ -616,7 +662,7 @@ fn branch_until(
             ),
             error: branch.error.map(|e| e.to_string()),
         },
-        false,
+        end,
     ))
 }
 
