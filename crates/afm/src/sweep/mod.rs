@@ -410,18 +410,24 @@ impl Sweep {
         result
     }
 
+    /// One drive period at the separation already set, integrated without the lock-in (a
+    /// settling cycle, or a cycle of a block whose record is not returned).
+    fn advance_unread_cycle(&mut self) -> Result<(), AfmError> {
+        advance_cycle(
+            &self.model,
+            &self.settings.integration,
+            &mut self.state,
+            &mut self.workspace,
+        )
+    }
+
     fn advance(&mut self) -> Result<Option<SweepRecord>, AfmError> {
         if !self.settled {
             // The settling cycles are not read.
             self.model
                 .set_separation(Separation::Constant(self.settings.from_nm))?;
             for _ in 0..self.settings.settle_cycles {
-                advance_cycle(
-                    &self.model,
-                    &self.settings.integration,
-                    &mut self.state,
-                    &mut self.workspace,
-                )?;
+                self.advance_unread_cycle()?;
             }
             self.settled = true;
         }
@@ -463,12 +469,7 @@ impl Sweep {
                 (block.is_some(), block)
             } else {
                 self.model.set_separation(separation)?;
-                advance_cycle(
-                    &self.model,
-                    &self.settings.integration,
-                    &mut self.state,
-                    &mut self.workspace,
-                )?;
+                self.advance_unread_cycle()?;
                 (self.average.skip(k), None)
             };
             self.cycles_done += 1;
