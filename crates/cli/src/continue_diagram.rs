@@ -13,8 +13,9 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::continue_figure::{contrast_figure, figure, CaseDiagrams, PanelQuantity};
+use crate::diagram_json::DiagramJson;
 use crate::exit_status::Incomplete;
-use crate::inputs::orbit_inputs_json;
+use crate::json_value::plain_value;
 use crate::model_args::{model_of, output_path, ModelArgs};
 use crate::option_ranges::{self, OptionRange};
 use crate::output::{
@@ -310,13 +311,14 @@ pub fn continue_case_until(
     })
 }
 
-/// The `continue --json` object of one case (docs/output-schema.md).
-pub fn continue_json(
+/// The `continue --json` object of one case (docs/output-schema.md): [`DiagramJson`] of
+/// `continued`, computed from `continue`'s options `args` for `case` (resolved into `model`).
+pub fn continue_object<'a>(
     args: &ContinueArgs,
-    case: &Case,
+    case: &'a Case,
     model: &TappingModel,
-    continued: &Continued,
-) -> serde_json::Value {
+    continued: &'a Continued,
+) -> DiagramJson<'a> {
     let Continued {
         settings,
         approach,
@@ -332,28 +334,26 @@ pub fn continue_json(
         "retract": args.retract,
         "harmonics": settings.orbit.harmonics,
     });
-    let mut object = json!({
-        "inputs": orbit_inputs_json("continue", options, case, model, &settings.orbit),
-        "case": case.name,
-        "free_amplitude_nm": model.free_amplitude_nm(),
-        "first_contact_z_nm": model.grazing_separation_nm(),
-        "points": approach.points,
-        "special_points": approach.special_points,
-        "stop": approach.stop,
-        "completed": approach.completed,
-        "error": approach.error,
-    });
-    if let Some(retract) = &retract {
-        object["retract"] = json!({
-            "points": retract.points,
-            "special_points": retract.special_points,
-            "stop": retract.stop,
-            "completed": retract.completed,
-            "error": retract.error,
-        });
-        object["bistable_ranges_nm"] = json!(bistable);
-    }
-    object
+    DiagramJson::new(
+        case,
+        model,
+        &settings.orbit,
+        options,
+        approach,
+        retract
+            .as_ref()
+            .map(|retract| (retract, bistable.as_deref())),
+    )
+}
+
+/// [`continue_object`] as a `serde_json::Value`.
+pub fn continue_json(
+    args: &ContinueArgs,
+    case: &Case,
+    model: &TappingModel,
+    continued: &Continued,
+) -> serde_json::Value {
+    plain_value(&continue_object(args, case, model, continued))
 }
 
 /// Print one case's table (or JSON object, one line).
@@ -370,8 +370,9 @@ fn print_report(
         ..
     } = continued;
     if args.json {
-        let object = continue_json(args, case, model, continued);
-        print_stdout(&format!("{}\n", serde_json::to_string(&object)?))?;
+        let mut line = serde_json::to_string(&continue_object(args, case, model, continued))?;
+        line.push('\n');
+        print_stdout(&line)?;
     } else {
         print_stdout(&table(&case.name, model, "approach", approach))?;
         if let Some(retract) = &retract {

@@ -1,16 +1,17 @@
 //! The JSON object of one steady orbit (docs/output-schema.md) as a derived `Serialize` of
 //! borrowed fields: `simulate --json` writes it without building a `serde_json::Value` tree.
 //! The fields are declared in alphabetical order of their keys, so that the bytes are those of
-//! the same object as a `serde_json::Value` (whose objects are sorted maps); so are those of
-//! the entries of its lists (impacts, gap minima, harmonics, periods), copies of `afm`'s
-//! records whose fields are declared in another order.
+//! the same object as a `serde_json::Value` (whose objects are sorted maps); the entries of its
+//! lists (impacts, gap minima, harmonics, periods) are written in key order by
+//! [`crate::observable_records_json`].
 
-use afm::{
-    GapMinimum, GapMinimumKind, Harmonic, Impact, PeriodBreakdown, SteadyOrbit, TappingModel,
-};
+use afm::{GapMinimum, Harmonic, Impact, PeriodBreakdown, SteadyOrbit, TappingModel};
 use serde::Serialize;
 
 use crate::inputs::InputsJson;
+use crate::observable_records_json::{
+    gap_minima_in_key_order, harmonics_in_key_order, impacts_in_key_order, periods_in_key_order,
+};
 
 /// One steady orbit's JSON object (units in the key names; docs/output-schema.md): the
 /// observables of the whole orbit (all its `multiplicity` drive periods, MODEL.md section 10),
@@ -45,11 +46,14 @@ pub struct OrbitJson<'a> {
     /// The free orbit's phase lag, degrees.
     free_phase_deg: f64,
     /// The gap's local minima.
-    gap_minima: Vec<GapMinimumJson>,
+    #[serde(serialize_with = "gap_minima_in_key_order")]
+    gap_minima: &'a [GapMinimum],
     /// The harmonics of `u`.
-    harmonics: Vec<HarmonicJson>,
+    #[serde(serialize_with = "harmonics_in_key_order")]
+    harmonics: &'a [Harmonic],
     /// The impacts.
-    impacts: Vec<ImpactJson>,
+    #[serde(serialize_with = "impacts_in_key_order")]
+    impacts: &'a [Impact],
     /// The impacts over the whole orbit.
     impacts_per_orbit: usize,
     /// The impacts per drive period, on average over the orbit.
@@ -76,7 +80,8 @@ pub struct OrbitJson<'a> {
     /// The orbit's drive period, us.
     period_us: f64,
     /// The per-period breakdown.
-    periods: Vec<PeriodJson>,
+    #[serde(serialize_with = "periods_in_key_order")]
+    periods: Vec<PeriodBreakdown>,
     /// The first harmonic's phase lag, degrees.
     phase_deg: f64,
     /// Newton's last residual.
@@ -114,102 +119,6 @@ struct SecondDriveJson {
     phase_deg: f64,
 }
 
-/// An entry of [`OrbitJson`]'s `impacts` (afm's [`Impact`]).
-#[derive(Debug, Serialize)]
-struct ImpactJson {
-    end_periods: f64,
-    peak_force_nn: f64,
-    start_periods: f64,
-    velocity_nm_per_us: f64,
-}
-
-impl From<&Impact> for ImpactJson {
-    fn from(impact: &Impact) -> Self {
-        Self {
-            end_periods: impact.end_periods,
-            peak_force_nn: impact.peak_force_nn,
-            start_periods: impact.start_periods,
-            velocity_nm_per_us: impact.velocity_nm_per_us,
-        }
-    }
-}
-
-/// An entry of [`OrbitJson`]'s `gap_minima` (afm's [`GapMinimum`]).
-#[derive(Debug, Serialize)]
-struct GapMinimumJson {
-    gap_nm: f64,
-    kind: GapMinimumKind,
-    t_periods: f64,
-}
-
-impl From<&GapMinimum> for GapMinimumJson {
-    fn from(minimum: &GapMinimum) -> Self {
-        Self {
-            gap_nm: minimum.gap_nm,
-            kind: minimum.kind,
-            t_periods: minimum.t_periods,
-        }
-    }
-}
-
-/// An entry of [`OrbitJson`]'s `harmonics` (afm's [`Harmonic`]).
-#[derive(Debug, Serialize)]
-struct HarmonicJson {
-    amplitude_nm: f64,
-    n: usize,
-    phase_deg: f64,
-}
-
-impl From<&Harmonic> for HarmonicJson {
-    fn from(harmonic: &Harmonic) -> Self {
-        Self {
-            amplitude_nm: harmonic.amplitude_nm,
-            n: harmonic.n,
-            phase_deg: harmonic.phase_deg,
-        }
-    }
-}
-
-/// An entry of [`OrbitJson`]'s `periods` (afm's [`PeriodBreakdown`]).
-#[derive(Debug, Serialize)]
-struct PeriodJson {
-    amplitude_ratio: f64,
-    contact_time_periods: f64,
-    dissipated_ev: f64,
-    energy_balance_residual: f64,
-    impacts: usize,
-    impulse_nn_us: f64,
-    max_indentation_nm: f64,
-    mean_force_nn: f64,
-    mean_indentation_nm: f64,
-    min_gap_nm: Option<f64>,
-    peak_force_nn: f64,
-    period: usize,
-    phase_deg: f64,
-    virial_ev: f64,
-}
-
-impl From<&PeriodBreakdown> for PeriodJson {
-    fn from(period: &PeriodBreakdown) -> Self {
-        Self {
-            amplitude_ratio: period.amplitude_ratio,
-            contact_time_periods: period.contact_time_periods,
-            dissipated_ev: period.dissipated_ev,
-            energy_balance_residual: period.energy_balance_residual,
-            impacts: period.impacts,
-            impulse_nn_us: period.impulse_nn_us,
-            max_indentation_nm: period.max_indentation_nm,
-            mean_force_nn: period.mean_force_nn,
-            mean_indentation_nm: period.mean_indentation_nm,
-            min_gap_nm: period.min_gap_nm,
-            peak_force_nn: period.peak_force_nn,
-            period: period.period,
-            phase_deg: period.phase_deg,
-            virial_ev: period.virial_ev,
-        }
-    }
-}
-
 impl<'a> OrbitJson<'a> {
     /// The object of `orbit` of the model `model` of the case named `case`, without `start`,
     /// `coexisting_orbit` and `inputs`.
@@ -240,17 +149,9 @@ impl<'a> OrbitJson<'a> {
             floquet_multipliers: orbit.multipliers.iter().map(|m| [m.re, m.im]).collect(),
             free_amplitude_nm: model.free_amplitude_nm(),
             free_phase_deg: model.free_phase_deg(),
-            gap_minima: observables
-                .gap_minima
-                .iter()
-                .map(GapMinimumJson::from)
-                .collect(),
-            harmonics: observables
-                .harmonics
-                .iter()
-                .map(HarmonicJson::from)
-                .collect(),
-            impacts: observables.impacts.iter().map(ImpactJson::from).collect(),
+            gap_minima: &observables.gap_minima,
+            harmonics: &observables.harmonics,
+            impacts: &observables.impacts,
             impacts_per_orbit: orbit.impacts_per_orbit(),
             impacts_per_period: orbit.impacts_per_period(),
             impulse_nn_us: observables.impulse_nn_us,
@@ -263,11 +164,7 @@ impl<'a> OrbitJson<'a> {
             newton_iterations: orbit.iterations,
             peak_force_nn: observables.peak_force_nn,
             period_us: model.period_us(),
-            periods: orbit
-                .period_breakdown(model.free_amplitude_nm())
-                .iter()
-                .map(PeriodJson::from)
-                .collect(),
+            periods: orbit.period_breakdown(model.free_amplitude_nm()),
             phase_deg,
             residual: orbit.residual,
             second_drive,

@@ -3,12 +3,13 @@
 //! `serde_json::Value` with `json!` (the form it replaced, written out here as the reference):
 //! the same keys, in the same (sorted) order, with the same numbers.
 
-use afm::{
-    fixtures, steady_orbit, Case, OrbitStart, SteadyOrbit, SteadyOrbitSettings, TappingModel,
-};
-use drumroll::inputs::{drive_json, inputs_json};
+use afm::{steady_orbit, Case, OrbitStart, SteadyOrbit, SteadyOrbitSettings, TappingModel};
+use drumroll::inputs::inputs_json;
 use drumroll::simulate::{coexisting_orbit, orbit_at, simulate_json, simulate_object, Start};
 use serde_json::{json, Value};
+
+mod json_reference;
+use json_reference::{case_and_model, reference_inputs};
 
 /// The orbit object as `json!` builds it.
 fn reference_orbit(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> Value {
@@ -60,56 +61,6 @@ fn reference_orbit(case: &str, model: &TappingModel, orbit: &SteadyOrbit) -> Val
         "state": orbit.state,
         "periods": orbit.period_breakdown(model.free_amplitude_nm()),
     })
-}
-
-/// The `inputs` object as `json!` builds it, with Newton's and the orbit search's settings
-/// when `settings` is given.
-fn reference_inputs(
-    command: &str,
-    options: Value,
-    case: &Case,
-    model: &TappingModel,
-    integration: &hybrid::Settings,
-    settings: Option<&SteadyOrbitSettings>,
-) -> Value {
-    let mut inputs = json!({
-        "drumroll_version": env!("CARGO_PKG_VERSION"),
-        "command": command,
-        "options": options,
-        "case": case.name,
-        "cantilever": case.cantilever,
-        "sample": case.sample,
-        "free_amplitude_nm": model.free_amplitude_nm(),
-        "drive_frequency_khz": model.drive_frequency_khz(),
-        "drive": drive_json(model),
-        "solver": {
-            "relative_tolerance": integration.relative_tolerance,
-            "absolute_tolerance": integration.absolute_tolerance,
-            "event_time_tolerance": integration.event_time_tolerance,
-            "event_value_tolerance": integration.event_value_tolerance,
-            "samples_per_step": integration.samples_per_step,
-            "taylor_series": integration.taylor_series,
-        },
-    });
-    if let Some(settings) = settings {
-        inputs["newton"] = json!({
-            "tolerance": settings.newton.tolerance,
-            "max_iterations": settings.newton.max_iterations,
-        });
-        inputs["steady_orbit"] = json!({
-            "transient_periods": settings.transient_periods,
-            "recurrence_periods": settings.recurrence_periods,
-            "max_multiplicity": settings.max_multiplicity,
-        });
-    }
-    inputs
-}
-
-/// The case `name` and its model.
-fn case_and_model(name: &str) -> (Case, TappingModel) {
-    let case = fixtures::find_case(name).expect("built-in case");
-    let model = TappingModel::from_case(&case).expect("valid case");
-    (case, model)
 }
 
 /// The settings of `simulate --harmonics 3`.
