@@ -69,6 +69,7 @@ pub mod problem;
 pub mod settings;
 pub mod shooting;
 pub mod special_point;
+mod square_root_zero;
 pub mod test_function;
 pub mod two_parameter;
 

@@ -718,7 +718,7 @@ fn diagram_special_point(
     harmonics: usize,
 ) -> Result<DiagramSpecialPoint, AfmError> {
     let mut at_point = system.clone();
-    at_point.set_parameter(special.parameter);
+    at_point.set_parameter(special.orbit_parameter);
     let observables =
         orbit_observables(&at_point, special.state.as_slice(), integration, harmonics)?;
     // A grazing is named after the impact count on its impacting side, whichever way the

@@ -8,6 +8,7 @@ use crate::error::ContinuationError;
 use crate::location::{Location, Sample, Segment};
 use crate::problem::PeriodicProblem;
 use crate::special_point::{SpecialPoint, SpecialPointKind};
+use crate::square_root_zero::{square_root_zero, ExtrapolatedZero};
 use crate::test_function::{
     has_complex_pair, has_complex_pair_on_unit_circle, neimark_sacker_test, period_doubling_test,
     ExtremumKind, StructureTest,
@@ -15,6 +16,26 @@ use crate::test_function::{
 
 /// A test function of a corrected orbit on a step.
 type SampleTest = fn(&Sample) -> f64;
+
+/// Whether a structure test, on a branch whose period map jumps at its grazings, vanishes
+/// quadratically on the near side (`A`): a minimum of the contact surface below it (the orbit
+/// attaches there) or a release maximum above the release surface (the orbit releases there);
+/// see [`square_root_zero`].
+fn vanishes_quadratically(test: &StructureTest) -> bool {
+    match *test {
+        StructureTest::Extremum {
+            kind: ExtremumKind::Minimum,
+            value_a,
+            ..
+        } => value_a < 0.0,
+        StructureTest::Extremum {
+            kind: ExtremumKind::ReleaseMaximum,
+            value_a,
+            ..
+        } => value_a > 0.0,
+        _ => false,
+    }
+}
 
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// Locate every sign change of a test function in the step held by `segment`.
@@ -59,6 +80,14 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 f64::NAN
             };
             let location = segment.locate(0, 1, &value, failure, tolerance, max_iterations)?;
+            // Across a hysteretic grazing from the side that crosses the surface, the test
+            // vanishes quadratically and Newton stops converging short of its zero.
+            let extrapolated =
+                if jumped && self.settings.hysteretic_grazing && vanishes_quadratically(test) {
+                    self.quadratic_zero(segment, test)
+                } else {
+                    None
+                };
             let kind = match *test {
                 StructureTest::Extremum {
                     kind: ExtremumKind::Minimum,
@@ -88,9 +117,55 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 }
             };
             breaks.push((location.low.unwrap_or(0), location.high.unwrap_or(1)));
-            found.push(self.special_point(segment, kind, &location, location.converged, index));
+            let mut point = self.special_point(segment, kind, &location, location.converged, index);
+            if let Some((zero, nearest)) = extrapolated {
+                let nearest = segment.get(nearest);
+                let n = nearest.u.len() - 1;
+                let special = &mut point.1;
+                special.parameter = zero.parameter;
+                special.bracket = (zero.parameter - zero.error, zero.parameter + zero.error);
+                special.precision = 2.0 * zero.error;
+                special.converged = special.precision <= tolerance;
+                special.state = nearest.u.rows(0, n).into_owned();
+                special.orbit_parameter = nearest.parameter();
+                special.multipliers = nearest.multipliers.clone();
+            }
+            found.push(point);
         }
         Ok(breaks)
+    }
+
+    /// The zero of a structure test that vanishes quadratically on the segment's near side
+    /// ([`vanishes_quadratically`]), extrapolated from its values on the orbits of that side:
+    /// the segment's (its start and the location's converged trials) and the branch's points
+    /// before it ([`square_root_zero`]); with the index of the segment's orbit nearest it.
+    fn quadratic_zero(
+        &self,
+        segment: &Segment<'_, P>,
+        test: &StructureTest,
+    ) -> Option<(ExtrapolatedZero, usize)> {
+        let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
+        let on_segment = segment.values(&value);
+        let (_, p_a, g_a) = *on_segment.first()?;
+        let direction = (segment.get(1).parameter() - p_a).signum();
+        let near = |g: f64| g.is_finite() && g != 0.0 && (g < 0.0) == (g_a < 0.0);
+        let points: Vec<(f64, f64)> = on_segment
+            .iter()
+            .map(|&(_, p, g)| (p, g))
+            .chain(
+                self.recent_structures
+                    .iter()
+                    .map(|(p, structure)| (*p, test.value(0.0, structure))),
+            )
+            .filter(|&(_, g)| near(g))
+            .collect();
+        let zero = square_root_zero(&points, direction)?;
+
+        let nearest = on_segment
+            .iter()
+            .find(|&&(_, p, g)| p == zero.nearest && near(g))?
+            .0;
+        Some((zero, nearest))
     }
 
     /// Locate the sign changes of the smooth (tangent and multiplier) tests, fold and, with
@@ -247,6 +322,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 impacts_before,
                 impacts_after,
                 state: point.u.rows(0, n).into_owned(),
+                orbit_parameter: point.parameter(),
                 multipliers: point.multipliers.clone(),
                 iterations: location.iterations,
                 branch_index: index,
