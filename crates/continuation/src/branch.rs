@@ -128,7 +128,7 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// the start, after a jump over a corner and without `hysteretic_grazing`): the step
     /// towards a hysteretic grazing extrapolates its test function from the last of them and
     /// the current point (`branch/hysteretic_break.rs`), and the zero of a grazing test that
-    /// vanishes quadratically is extrapolated from them (`square_root_zero.rs`).
+    /// Newton's method does not reach is extrapolated from them (`extrapolated_zero.rs`).
     recent_structures: Vec<(f64, OrbitStructure)>,
     /// The test function of the hysteretic grazing the step was last cut towards, at which the
     /// steps after it are aimed (`branch/hysteretic_break.rs`); `None` otherwise.

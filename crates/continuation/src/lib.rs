@@ -61,6 +61,7 @@ pub mod curve;
 mod curve_corrector;
 pub mod curve_settings;
 pub mod error;
+mod extrapolated_zero;
 pub mod floquet;
 pub mod hermite;
 pub mod hybrid_problem;
@@ -69,7 +70,6 @@ pub mod problem;
 pub mod settings;
 pub mod shooting;
 pub mod special_point;
-mod square_root_zero;
 pub mod test_function;
 pub mod two_parameter;
 

@@ -5,10 +5,10 @@
 
 use super::Continuation;
 use crate::error::ContinuationError;
+use crate::extrapolated_zero::{extrapolated_zero, ExtrapolatedZero, Vanishing};
 use crate::location::{Location, Sample, Segment};
 use crate::problem::PeriodicProblem;
 use crate::special_point::{SpecialPoint, SpecialPointKind};
-use crate::square_root_zero::{square_root_zero, ExtrapolatedZero};
 use crate::test_function::{
     has_complex_pair, has_complex_pair_on_unit_circle, neimark_sacker_test, period_doubling_test,
     ExtremumKind, StructureTest,
@@ -17,24 +17,24 @@ use crate::test_function::{
 /// A test function of a corrected orbit on a step.
 type SampleTest = fn(&Sample) -> f64;
 
-/// Whether a structure test, on a branch whose period map jumps at its grazings, vanishes
-/// quadratically on the near side (`A`): a minimum of the contact surface below it (the orbit
-/// attaches there) or a release maximum above the release surface (the orbit releases there);
-/// see [`square_root_zero`].
-fn vanishes_quadratically(test: &StructureTest) -> bool {
-    match *test {
-        StructureTest::Extremum {
-            kind: ExtremumKind::Minimum,
-            value_a,
-            ..
-        } => value_a < 0.0,
-        StructureTest::Extremum {
-            kind: ExtremumKind::ReleaseMaximum,
-            value_a,
-            ..
-        } => value_a > 0.0,
-        _ => false,
-    }
+/// How a structure test, on a branch whose period map jumps at its grazings, vanishes on the
+/// near side (`A`, [`extrapolated_zero`]): quadratically where that side crosses the surface (a
+/// minimum of the contact surface below it: the orbit attaches there; a release maximum above
+/// the release surface: the orbit releases there), else linearly (`None`: not an extremum).
+fn near_side_vanishing(test: &StructureTest) -> Option<Vanishing> {
+    let StructureTest::Extremum { kind, value_a, .. } = *test else {
+        return None;
+    };
+    let crosses = match kind {
+        ExtremumKind::Minimum => value_a < 0.0,
+        ExtremumKind::ReleaseMaximum => value_a > 0.0,
+        ExtremumKind::Maximum => return None,
+    };
+    Some(if crosses {
+        Vanishing::Quadratically
+    } else {
+        Vanishing::Linearly
+    })
 }
 
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
@@ -80,14 +80,29 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 f64::NAN
             };
             let location = segment.locate(0, 1, &value, failure, tolerance, max_iterations)?;
-            // Across a hysteretic grazing from the side that crosses the surface, the test
-            // vanishes quadratically and Newton stops converging short of its zero.
-            let extrapolated =
-                if jumped && self.settings.hysteretic_grazing && vanishes_quadratically(test) {
-                    self.quadratic_zero(segment, test)
-                } else {
-                    None
-                };
+            // Across a hysteretic grazing Newton stops converging short of the zero: from the
+            // side that crosses the surface always (the test vanishes quadratically there);
+            // from an orbit attached through the release surface's maximum where the location
+            // ended at a failed trial (the free side of a contact grazing, whose flight is
+            // exact, is located between orbits as on any branch).
+            let release = matches!(
+                test,
+                StructureTest::Extremum {
+                    kind: ExtremumKind::ReleaseMaximum,
+                    ..
+                }
+            );
+            let extrapolated = match near_side_vanishing(test) {
+                Some(vanishing)
+                    if jumped
+                        && self.settings.hysteretic_grazing
+                        && (vanishing == Vanishing::Quadratically
+                            || (release && location.high.is_none())) =>
+                {
+                    self.extrapolated_zero(segment, test, vanishing)
+                }
+                _ => None,
+            };
             let kind = match *test {
                 StructureTest::Extremum {
                     kind: ExtremumKind::Minimum,
@@ -135,14 +150,15 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         Ok(breaks)
     }
 
-    /// The zero of a structure test that vanishes quadratically on the segment's near side
-    /// ([`vanishes_quadratically`]), extrapolated from its values on the orbits of that side:
-    /// the segment's (its start and the location's converged trials) and the branch's points
-    /// before it ([`square_root_zero`]); with the index of the segment's orbit nearest it.
-    fn quadratic_zero(
+    /// The zero of a structure test that vanishes as `vanishing` says on the segment's near
+    /// side, extrapolated from its values on the orbits of that side: the segment's (its start
+    /// and the location's converged trials) and the branch's points before it
+    /// ([`extrapolated_zero`]); with the index of the segment's orbit nearest it.
+    fn extrapolated_zero(
         &self,
         segment: &Segment<'_, P>,
         test: &StructureTest,
+        vanishing: Vanishing,
     ) -> Option<(ExtrapolatedZero, usize)> {
         let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
         let on_segment = segment.values(&value);
@@ -159,7 +175,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             )
             .filter(|&(_, g)| near(g))
             .collect();
-        let zero = square_root_zero(&points, direction)?;
+        let zero = extrapolated_zero(&points, direction, vanishing)?;
 
         let nearest = on_segment
             .iter()
