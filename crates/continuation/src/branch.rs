@@ -46,6 +46,12 @@ mod detection;
 mod hysteretic_break;
 mod step;
 
+/// The most points before the current one whose orbit structures a branch keeps
+/// (`Continuation::recent_structures`): enough that the last steps cut towards a hysteretic
+/// grazing, which shrink towards it, still leave points a few times further back than the
+/// distance the zero is extrapolated over.
+const RECENT_STRUCTURES: usize = 32;
+
 /// One accepted point of a branch of periodic orbits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BranchPoint {
@@ -117,10 +123,13 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// The point before `current` and its tangent, for the cubic predictor (`None` at the
     /// start and after a jump over a corner).
     previous: Option<(DVector<f64>, DVector<f64>)>,
-    /// The parameter and orbit structure of the point before `current` (`None` at the start
-    /// and after a jump over a corner): the step towards a hysteretic grazing extrapolates its
-    /// test function from it and the current point (`branch/hysteretic_break.rs`).
-    previous_structure: Option<(f64, OrbitStructure)>,
+    /// The parameters and orbit structures of the points before `current` on a branch whose
+    /// period map jumps at its grazings, oldest first, at most [`RECENT_STRUCTURES`] (empty at
+    /// the start, after a jump over a corner and without `hysteretic_grazing`): the step
+    /// towards a hysteretic grazing extrapolates its test function from the last of them and
+    /// the current point (`branch/hysteretic_break.rs`), and the zero of a grazing test that
+    /// Newton's method does not reach is extrapolated from them (`extrapolated_zero.rs`).
+    recent_structures: Vec<(f64, OrbitStructure)>,
     /// The test function of the hysteretic grazing the step was last cut towards, at which the
     /// steps after it are aimed (`branch/hysteretic_break.rs`); `None` otherwise.
     grazing_test: Option<StructureTest>,
@@ -194,7 +203,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             stop_predicate: None,
             current,
             previous: None,
-            previous_structure: None,
+            recent_structures: Vec::new(),
             grazing_test: None,
             start: Some(first),
             produced: 0,

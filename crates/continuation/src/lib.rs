@@ -61,6 +61,7 @@ pub mod curve;
 mod curve_corrector;
 pub mod curve_settings;
 pub mod error;
+mod extrapolated_zero;
 pub mod floquet;
 pub mod hermite;
 pub mod hybrid_problem;

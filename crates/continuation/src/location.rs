@@ -247,6 +247,17 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             .map_or(f64::NAN, Sample::parameter)
     }
 
+    /// `(index, p, test)` of every cached orbit on the segment (`0 <= sigma <= 1`).
+    pub(crate) fn values(&self, test: &dyn Fn(&Sample) -> f64) -> Vec<(usize, f64, f64)> {
+        self.samples
+            .borrow()
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| (0.0..=1.0).contains(&s.sigma))
+            .map(|(i, s)| (i, s.parameter(), test(s)))
+            .collect()
+    }
+
     /// A clone of sample `index`.
     pub(crate) fn get(&self, index: usize) -> Sample {
         self.samples.borrow()[index].clone()

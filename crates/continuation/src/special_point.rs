@@ -86,6 +86,10 @@ pub struct SpecialPoint {
     pub impacts_after: usize,
     /// The state `x` of the orbit at the located point (state units).
     pub state: DVector<f64>,
+    /// The parameter of the orbit `state` (parameter units): `parameter`, except at a
+    /// hysteretic grazing whose zero is extrapolated past the last orbit Newton's method
+    /// converged on (MODEL.md section 8), where it is that orbit's parameter.
+    pub orbit_parameter: f64,
     /// The Floquet multipliers at the located point.
     pub multipliers: Vec<Complex<f64>>,
     /// Root-finding iterations (corrected trial points) spent on the location.

@@ -198,7 +198,9 @@ pub struct DiagramSpecialPoint {
     pub precision_nm: f64,
     /// Whether the location reached its tolerance.
     pub converged: bool,
-    /// The orbit's state at the point.
+    /// The orbit's state at the point; at a hysteretic grazing whose `Z` is extrapolated past
+    /// the last orbit Newton's method converged on (MODEL.md section 8), that orbit's state
+    /// (and the observables below are that orbit's).
     pub state: Vec<f64>,
     /// Harmonics `1..=N` of `u` there (MODEL.md section 10).
     pub harmonics: Vec<Harmonic>,
@@ -718,7 +720,7 @@ fn diagram_special_point(
     harmonics: usize,
 ) -> Result<DiagramSpecialPoint, AfmError> {
     let mut at_point = system.clone();
-    at_point.set_parameter(special.parameter);
+    at_point.set_parameter(special.orbit_parameter);
     let observables =
         orbit_observables(&at_point, special.state.as_slice(), integration, harmonics)?;
     // A grazing is named after the impact count on its impacting side, whichever way the

@@ -87,7 +87,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let Some(test) = self.grazing_test.take() else {
             return;
         };
-        let Some((p_prev, previous)) = self.previous_structure.as_ref() else {
+        let Some((p_prev, previous)) = self.recent_structures.last() else {
             return;
         };
         let n = self.problem.dim();
@@ -120,8 +120,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             return test.linear_root();
         };
         let secant = self
-            .previous_structure
-            .as_ref()
+            .recent_structures
+            .last()
             .and_then(|(p_prev, previous)| {
                 let value_prev = test.value(0.0, previous);
                 let approaching = value_prev.is_finite()

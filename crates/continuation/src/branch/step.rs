@@ -6,7 +6,7 @@
 use nalgebra::DVector;
 
 use super::corner::CORNER_FAILURES;
-use super::{BranchPoint, Continuation, StopReason};
+use super::{BranchPoint, Continuation, StopReason, RECENT_STRUCTURES};
 use crate::corrector::{correct, Purpose};
 use crate::error::ContinuationError;
 use crate::floquet::is_stable;
@@ -324,8 +324,15 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         };
         self.special_points.extend(special);
         let accepted = std::mem::replace(&mut self.current, b);
-        self.previous_structure = (!jumped && self.settings.hysteretic_grazing)
-            .then(|| (accepted.parameter(), accepted.map.structure.clone()));
+        if jumped || !self.settings.hysteretic_grazing {
+            self.recent_structures.clear();
+        } else {
+            if self.recent_structures.len() == RECENT_STRUCTURES {
+                self.recent_structures.remove(0);
+            }
+            self.recent_structures
+                .push((accepted.parameter(), accepted.map.structure.clone()));
+        }
         self.previous = if jumped {
             None
         } else {
