@@ -315,8 +315,9 @@ const MAX_JUMPS: usize = 16;
 /// grazing is labelled `pull-off`: at a fold of the attached orbits (where `Z` turns back) the
 /// located fold, else the last point (the corrector failed at the continuation's smallest
 /// step), not located: its bracket runs to the grazing extrapolated from the branch. A
-/// retract whose `Z` turned back with no fold located in the step (the tangent's orientation
-/// reversed after a corner jump) is no end: the branch goes on from its last point.
+/// branch whose `Z` turned back with no fold located in the step (the tangent's orientation
+/// reversed after a corner jump) is no end: the branch goes on from its last point, on the
+/// approach as on the retract.
 pub fn diagram_until(
     model: &TappingModel,
     x0: &[f64],
@@ -333,7 +334,7 @@ pub fn diagram_until(
         ParameterDirection::Increasing => 1.0,
     };
     let mut system = model.clone();
-    // The `Z` a reversed retract last went on from (a second reversal there ends the branch).
+    // The `Z` a reversed branch last went on from (a second reversal there ends the branch).
     let mut resumed_at: Option<f64> = None;
     for _ in 0..MAX_JUMPS {
         if end.is_none() {
@@ -342,8 +343,8 @@ pub fn diagram_until(
         let Some(last) = diagram.points.last().cloned() else {
             break;
         };
-        // A retract whose tangent only turned backwards goes on from its last point.
-        if sign > 0.0 && matches!(end, Some(BranchEnd::Reversed)) && resumed_at != Some(last.z_nm) {
+        // A branch whose tangent only turned backwards goes on from its last point.
+        if matches!(end, Some(BranchEnd::Reversed)) && resumed_at != Some(last.z_nm) {
             resumed_at = Some(last.z_nm);
             let next;
             (next, end) = branch_until(model, &last.state, last.z_nm, settings, interrupted)?;
