@@ -49,8 +49,10 @@ mod step;
 /// The most points before the current one whose orbit structures a branch keeps
 /// (`Continuation::recent_structures`): enough that the last steps cut towards a hysteretic
 /// grazing, which shrink towards it, still leave points a few times further back than the
-/// distance the zero is extrapolated over.
-const RECENT_STRUCTURES: usize = 32;
+/// distance the zero is extrapolated over, also where the branch creeps towards the grazing at
+/// its smallest step (`biolever-adhesive --a0 8`'s retract at `--max-step` 0.025: about 60
+/// points within a factor of 2 of the last one's `sqrt(|g|)`).
+const RECENT_STRUCTURES: usize = 256;
 
 /// One accepted point of a branch of periodic orbits.
 #[derive(Debug, Clone, PartialEq)]

@@ -84,12 +84,29 @@ fn back_of(vanishing: Vanishing, points: &[(f64, f64)], from: usize) -> Option<u
     (from + 1..points.len()).find(|&j| vanishing.linear_in_p(points[j].1) >= 2.0 * s)
 }
 
+/// The point of `points` after the first with the largest `s` (`|g|` or `sqrt(|g|)`), if that
+/// exceeds the first's: the pair for the extrapolation where no point has twice the first's
+/// `s` (the branch crept towards the zero in steps so short that all the points kept lie
+/// within a factor of 2 of it in `s`).
+fn largest_back(vanishing: Vanishing, points: &[(f64, f64)]) -> Option<usize> {
+    let s = vanishing.linear_in_p(points.first()?.1);
+    (1..points.len())
+        .filter(|&j| vanishing.linear_in_p(points[j].1) > s)
+        .max_by(|&i, &j| {
+            vanishing
+                .linear_in_p(points[i].1)
+                .total_cmp(&vanishing.linear_in_p(points[j].1))
+        })
+}
+
 /// The zero of a test function that vanishes as `vanishing` says, from its values `(p, g)` on
 /// orbits on one side of it (all of one sign), extrapolated in the direction `direction` (the
 /// sign of `p_G - p`) as the module documentation says: from the point nearest the zero and
 /// the first one back whose `s` (`|g|` or `sqrt(|g|)`) is at least twice as large, and for the
-/// error from that one and the next such. `None` without such a pair or where the zero would
-/// lie behind the nearest point.
+/// error from that one and the next such. Without a point of twice the `s`, from the one with
+/// the largest `s`, with the whole distance extrapolated over as the error (no second pair).
+/// `None` without a point of larger `s` or where the zero would lie behind the nearest
+/// point.
 pub(crate) fn extrapolated_zero(
     points: &[(f64, f64)],
     direction: f64,
@@ -103,7 +120,7 @@ pub(crate) fn extrapolated_zero(
     // Nearest the zero first.
     sorted.sort_by(|x, y| (direction * y.0).total_cmp(&(direction * x.0)));
     let nearest = *sorted.first()?;
-    let back = back_of(vanishing, &sorted, 0)?;
+    let back = back_of(vanishing, &sorted, 0).or_else(|| largest_back(vanishing, &sorted))?;
     let zero = zero_through(vanishing, nearest, sorted[back]);
     let distance = direction * (zero - nearest.0);
     if distance.is_nan() || distance < 0.0 || direction * (nearest.0 - sorted[back].0) <= 0.0 {
@@ -165,6 +182,24 @@ mod tests {
         assert!(actual < 1e-9, "zero {} off by {actual}", zero.parameter);
         assert!(zero.error >= actual, "error {} below {actual}", zero.error);
         assert_eq!(zero.nearest, p_g + 1e-5);
+    }
+
+    /// Points within a factor of 2 of each other in `sqrt(|g|)` (a branch that crept towards
+    /// the zero): the zero from the nearest point and the one of largest `sqrt(|g|)`, with an
+    /// error that covers the whole distance extrapolated over.
+    #[test]
+    fn extrapolates_from_points_within_a_factor_of_two() {
+        let p_g = 2.0;
+        let g = |p: f64| -(p_g - p).powi(2) * (1.0 + (p_g - p));
+        let points: Vec<(f64, f64)> = [1.5e-6, 1.2e-6, 1.0e-6, 9e-7, 8e-7]
+            .iter()
+            .map(|d| (p_g - d, g(p_g - d)))
+            .collect();
+        let zero = extrapolated_zero(&points, 1.0, Vanishing::Quadratically).unwrap();
+        let actual = (zero.parameter - p_g).abs();
+        assert!(actual < 1e-11, "zero {} off by {actual}", zero.parameter);
+        assert!(zero.error >= 8e-7, "error {}", zero.error);
+        assert_eq!(zero.nearest, p_g - 8e-7);
     }
 
     /// Values that do not fall towards the far side give no zero.

@@ -92,17 +92,19 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                     ..
                 }
             );
-            let extrapolated = match near_side_vanishing(test) {
+            let extrapolates = match near_side_vanishing(test) {
                 Some(vanishing)
                     if jumped
                         && self.settings.hysteretic_grazing
                         && (vanishing == Vanishing::Quadratically
                             || (release && location.high.is_none())) =>
                 {
-                    self.extrapolated_zero(segment, test, vanishing)
+                    Some(vanishing)
                 }
                 _ => None,
             };
+            let extrapolated =
+                extrapolates.and_then(|vanishing| self.extrapolated_zero(segment, test, vanishing));
             let kind = match *test {
                 StructureTest::Extremum {
                     kind: ExtremumKind::Minimum,
@@ -144,6 +146,14 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 special.state = nearest.u.rows(0, n).into_owned();
                 special.orbit_parameter = nearest.parameter();
                 special.multipliers = nearest.multipliers.clone();
+            } else if extrapolates.is_some() {
+                // No zero to extrapolate: the location's bracket ends where Newton stopped
+                // converging, not at the zero, which lies somewhere up to the far end.
+                let special = &mut point.1;
+                let far = segment.get(1).parameter();
+                special.bracket = (special.bracket.0.min(far), special.bracket.1.max(far));
+                special.precision = special.bracket.1 - special.bracket.0;
+                special.converged = false;
             }
             found.push(point);
         }
