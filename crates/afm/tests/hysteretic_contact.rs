@@ -219,6 +219,40 @@ fn adhesive_approach_diagram_jumps_to_contact() {
     }
 }
 
+/// No `fold` at the jumps of a JKR approach: the built-in `biolever-adhesive` (default largest
+/// step, 0.04 nm) reports `G1`, `G2`, `G3` only, and `biolever-sticky --a0 12 --max-step 0.02`
+/// no `fold` next to its `pull-off` at 10.1143 nm. Neither branch turns in `Z` there (the
+/// points on both sides are monotone, and the orbits past the jump exist up to within 5e-10 nm
+/// of the `pull-off`); before, the trials next to the jump took their tangents' orientation from
+/// the jump's secant and a `fold` was located where that flipped the sign of `t_Z`: 7e-10 nm
+/// from `G2` (8.8492558068 nm) and at 10.11411566 nm, moving by 2.5e-4 nm with the step size.
+#[test]
+fn jkr_approach_reports_no_fold_at_its_jumps() {
+    for (case, a0, max_step) in [
+        ("biolever-adhesive", None, None),
+        ("biolever-sticky", Some(12.0), Some(0.02)),
+    ] {
+        let mut case = afm::builtin_case(case).unwrap();
+        if let Some(a0) = a0 {
+            case.free_amplitude_nm = a0;
+        }
+        let model = TappingModel::from_case(&case).unwrap();
+        let defaults = DiagramSettings::approach(&model);
+        let settings = DiagramSettings {
+            max_step: max_step.unwrap_or(defaults.max_step),
+            ..defaults
+        };
+        let diagram = approach_diagram(&model, &settings).unwrap();
+        let labels: Vec<&str> = diagram
+            .special_points
+            .iter()
+            .map(|p| p.label.as_str())
+            .collect();
+        assert!(!labels.contains(&"fold"), "{}: {labels:?}", case.name);
+        assert!(labels.contains(&"G2"), "{}: {labels:?}", case.name);
+    }
+}
+
 /// A regime map through JKR (`drumroll map --case biolever-adhesive --vary quality-factor-1`):
 /// the `G3` curve of the attached orbits over `Q_1 = 1.0 .. 1.4`, at `Q_1` = 1.1 and 1.3 and
 /// the case's 1.2, agrees with the `G3` of an independent approach diagram of the case

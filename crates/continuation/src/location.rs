@@ -38,7 +38,9 @@ pub(crate) struct Sample {
     pub u: DVector<f64>,
     /// The period map at `u`.
     pub map: PeriodMap,
-    /// Unit tangent oriented like the tangent at `A` (NaN entries if singular).
+    /// Unit tangent (NaN entries if singular), oriented along the step's direction; in natural
+    /// mode like the tangent of the end the trial was shot from, so that the orientation is
+    /// continued along each side of a corner and never taken from the corner's secant.
     pub tangent: DVector<f64>,
     /// Floquet multipliers at `u`.
     pub multipliers: Vec<Complex<f64>>,
@@ -71,6 +73,10 @@ impl Sample {
         self.u[self.u.len() - 1]
     }
 }
+
+/// A corrected trial orbit `(x, p)`, its period map, and the direction its tangent is oriented
+/// along.
+type OrientedTrial = (DVector<f64>, PeriodMap, DVector<f64>);
 
 /// The result of locating one sign change.
 #[derive(Debug, Clone)]
@@ -279,9 +285,10 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             self.shoot_at(sigma)?
         } else {
             self.correct_at(sigma)?
+                .map(|(u, map)| (u, map, self.reference.clone()))
         };
-        Ok(found.map(|(u, map)| {
-            let sample = Sample::new(sigma, u, map, &self.reference);
+        Ok(found.map(|(u, map, reference)| {
+            let sample = Sample::new(sigma, u, map, &reference);
             let mut samples = self.samples.borrow_mut();
             samples.push(sample);
             samples.len() - 1
@@ -330,8 +337,9 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
 
     /// Shooting at the fixed parameter of `sigma`, from the states extrapolated along the
     /// tangents at `A`, then at `B` where `B` is an orbit (each shot given up when it stalls,
-    /// [`NEWTON_STALL`]: a trial past the structure change, with no orbit near its guess).
-    fn shoot_at(&self, sigma: f64) -> Result<Option<(DVector<f64>, PeriodMap)>, ContinuationError> {
+    /// [`NEWTON_STALL`]: a trial past the structure change, with no orbit near its guess); with
+    /// the tangent of the end it was shot from, which orients the trial's tangent.
+    fn shoot_at(&self, sigma: f64) -> Result<Option<OrientedTrial>, ContinuationError> {
         let n = self.u_a.len() - 1;
         let p = self.parameter_at(sigma);
         let ends = if self.far_is_orbit {
@@ -376,7 +384,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
                 let mut u = DVector::zeros(n + 1);
                 u.rows_mut(0, n).copy_from(&result.state);
                 u[n] = p;
-                return Ok(Some((u, result.period_map)));
+                return Ok(Some((u, result.period_map, end.tangent.clone())));
             }
         }
         Ok(None)

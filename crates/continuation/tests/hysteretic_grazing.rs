@@ -100,3 +100,97 @@ fn the_branch_ends_at_the_exact_grazing_in_fewer_maps_than_by_halving() {
     );
     println!("maps: halved {halved_maps}, cut {cut_maps}; grazing {halved:e}, {cut:e}");
 }
+
+/// [`JumpAtGrazing`] with a second state `y` slaved to `p` whose attached fixed point lies far
+/// off the free one: free, `P(x, y; p) = (a x + (1 - a) p, a y - (1 - a) 10 p)` (fixed point
+/// `x = p`, `y = -10 p`: grazing at `p = 0`); attached (`x < 0`), `x` shifted by `J` and `y` by
+/// `-Y`, `P = (a x + (1 - a) (p + J), a y - (1 - a) (10 p + Y))` (fixed point `x = p + J`,
+/// `y = -10 p - Y`: attached orbits for `p < -J`). `x` and `y` are straight lines in `p` on both
+/// branches, so `Z` turns nowhere: the fold test `t_p` has one sign along each.
+struct JumpAcrossTheTangent {
+    contraction: f64,
+    jump_x: f64,
+    jump_y: f64,
+}
+
+impl PeriodicProblem for JumpAcrossTheTangent {
+    fn dim(&self) -> usize {
+        2
+    }
+
+    fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError> {
+        let a = self.contraction;
+        let attached = x[0] < 0.0;
+        let (shift_x, shift_y) = if attached {
+            (self.jump_x, self.jump_y)
+        } else {
+            (0.0, 0.0)
+        };
+        Ok(PeriodMap {
+            image: DVector::from_vec(vec![
+                a * x[0] + (1.0 - a) * (p + shift_x),
+                a * x[1] - (1.0 - a) * (10.0 * p + shift_y),
+            ]),
+            monodromy: DMatrix::from_diagonal_element(2, 2, a),
+            parameter_derivative: DVector::from_vec(vec![1.0 - a, -10.0 * (1.0 - a)]),
+            structure: OrbitStructure {
+                minima: vec![(0.5, x[0])],
+                maxima: vec![],
+                impacts: usize::from(attached),
+                duration: 1.0,
+                permanent_contact: false,
+                release_maxima: vec![],
+            },
+        })
+    }
+}
+
+/// The branch of free orbits from `p = 1` downwards jumps at the grazing `p = 0` to the attached
+/// orbits (the corner jump's shot at the largest step, `p = -0.1`), whose `y` lies 100 below:
+/// the jump's secant points against the free branch's tangent in `y`, and the attached orbit's
+/// tangent, oriented along that secant, points up in `p`. No `fold` is reported (`Z` turns on
+/// neither branch), the grazing is. Before, the trials next to the grazing took their tangents'
+/// orientation from the secant too, so `t_p` flipped between the last free orbit and them: a
+/// `fold` located there, converged.
+#[test]
+fn no_fold_at_the_jump_of_a_hysteretic_grazing() {
+    let problem = JumpAcrossTheTangent {
+        contraction: 0.5,
+        jump_x: 0.01,
+        jump_y: 100.0,
+    };
+    let settings = ContinuationSettings {
+        initial_step: 0.05,
+        max_step: 0.1,
+        direction: ParameterDirection::Decreasing,
+        parameter_min: -1.0,
+        hysteretic_grazing: true,
+        ..ContinuationSettings::default()
+    };
+    // Stop at the first attached orbit, past the jump.
+    let branch = Continuation::new(&problem, &[1.0, -10.0], 1.0, settings)
+        .expect("start converges")
+        .stop_when(|point| point.parameter < -0.05)
+        .run();
+    assert_eq!(branch.stop, StopReason::UserStop, "{:?}", branch.error);
+    let last = branch.points.last().expect("points");
+    assert!(
+        (last.state[1] - (-10.0 * last.parameter - 100.0)).abs() < 1e-6,
+        "the jump reached the attached orbit: {last:?}"
+    );
+    let kinds: Vec<(SpecialPointKind, f64)> = branch
+        .special_points
+        .iter()
+        .map(|s| (s.kind, s.parameter))
+        .collect();
+    assert!(
+        !kinds.iter().any(|(k, _)| *k == SpecialPointKind::Fold),
+        "{kinds:?}"
+    );
+    assert!(
+        kinds
+            .iter()
+            .any(|(k, p)| *k == SpecialPointKind::Grazing && p.abs() < 1e-6),
+        "{kinds:?}"
+    );
+}

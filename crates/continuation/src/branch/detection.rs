@@ -51,7 +51,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let breaks =
             self.locate_structure_changes(segment, structure, index, jumped, &mut found)?;
         if smooth_tests {
-            self.locate_smooth_changes(segment, &breaks, index, &mut found)?;
+            self.locate_smooth_changes(segment, &breaks, index, jumped, &mut found)?;
         }
         found.sort_by(|x, y| x.0.total_cmp(&y.0));
         Ok(found.into_iter().map(|(_, s)| s).collect())
@@ -198,12 +198,16 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// `detect_bifurcations`, period doubling and Neimark-Sacker, into `found`: within the
     /// intervals between the structure brackets `breaks` where the test changes sign
     /// continuously, else (a sign change across a structure change) at that bracket, not
-    /// converged.
+    /// converged; except a fold across the jump of a hysteretic grazing (`jumped` on a branch
+    /// whose period map jumps there), where the two sides are different branches and the far
+    /// one's tangent is oriented along the jump's secant, so the sign of `t_p` across it tells
+    /// nothing of a turn.
     fn locate_smooth_changes(
         &self,
         segment: &Segment<'_, P>,
         breaks: &[(usize, usize)],
         index: usize,
+        jumped: bool,
         found: &mut Vec<(f64, SpecialPoint)>,
     ) -> Result<(), ContinuationError> {
         let tolerance = self.settings.location_tolerance;
@@ -261,6 +265,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 }
                 None => {
                     // The sign change happens across a structure change (a jump).
+                    if kind == SpecialPointKind::Fold && jumped && self.settings.hysteretic_grazing
+                    {
+                        continue;
+                    }
                     let Some(&(_, l, h)) = cuts.iter().find(|&&(_, l, h)| {
                         sign(test(&segment.get(l))) != sign(test(&segment.get(h)))
                     }) else {
