@@ -6,7 +6,10 @@
 use super::Continuation;
 use crate::error::ContinuationError;
 use crate::extrapolated_zero::{extrapolated_zero, ExtrapolatedZero, Vanishing};
+use nalgebra::DMatrix;
+
 use crate::location::{Location, Sample, Segment};
+use crate::problem::OrbitStructure;
 use crate::problem::PeriodicProblem;
 use crate::special_point::{SpecialPoint, SpecialPointKind};
 use crate::test_function::{
@@ -146,7 +149,19 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 special.state = nearest.u.rows(0, n).into_owned();
                 special.orbit_parameter = nearest.parameter();
                 special.multipliers = nearest.multipliers.clone();
-            } else if extrapolates.is_some() {
+            } else if let Some(error) = self.orbit_error_in_parameter(segment, test, &location) {
+                // Where the located orbit's own error reaches outside the bracket, the bracket's
+                // ends (orbits with about the same error) are widened by it; within it, the
+                // bracket is at least twice that error wide already.
+                let special = &mut point.1;
+                let (low, high) = special.bracket;
+                if special.parameter - error < low || special.parameter + error > high {
+                    special.bracket = (low - error, high + error);
+                    special.precision = special.bracket.1 - special.bracket.0;
+                    special.converged = special.converged && special.precision <= tolerance;
+                }
+            }
+            if extrapolated.is_none() && extrapolates.is_some() {
                 // No zero to extrapolate: the location's bracket ends where Newton stopped
                 // converging, not at the zero, which lies somewhere up to the far end.
                 let special = &mut point.1;
@@ -158,6 +173,54 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             found.push(point);
         }
         Ok(breaks)
+    }
+
+    /// How far in the parameter the located orbit's own error moves the zero of `test`
+    /// (parameter units): the orbit's error at its fixed parameter, `dx = (I - M)^{-1} (P(x) -
+    /// x)` (the Newton step its residual leaves undone, `M` the monodromy), carried into the
+    /// test by period maps at `x + dx` and `x - dx` (the smaller change of the two, among those
+    /// whose orbit has the located one's impacts and extrema: at a grazing one of them can
+    /// cross the surface, where the structure changes and a hysteretic law's force jumps in),
+    /// divided by the test's slope in the parameter from the located orbit to the segment's
+    /// start (or, at the start itself, its end). `None` where any of these is not available.
+    fn orbit_error_in_parameter(
+        &self,
+        segment: &Segment<'_, P>,
+        test: &StructureTest,
+        location: &Location,
+    ) -> Option<f64> {
+        let point = location.point.as_ref()?;
+        let n = point.u.len() - 1;
+        let x = point.u.rows(0, n);
+        let residual = &point.map.image - x;
+        let step = (DMatrix::identity(n, n) - &point.map.monodromy)
+            .lu()
+            .solve(&residual)?;
+        let g = test.value(point.sigma, &point.map.structure);
+        let shape = |s: &OrbitStructure| {
+            (
+                s.impacts,
+                s.minima.len(),
+                s.maxima.len(),
+                s.release_maxima.len(),
+            )
+        };
+        let mut dg = f64::INFINITY;
+        for moved in [x + &step, x - &step] {
+            let Ok(map) = self.problem.period_map(moved.as_slice(), point.parameter()) else {
+                continue;
+            };
+            if shape(&map.structure) == shape(&point.map.structure) {
+                dg = dg.min((test.value(point.sigma, &map.structure) - g).abs());
+            }
+        }
+        let other = [segment.get(0), segment.get(1)]
+            .into_iter()
+            .find(|s| s.parameter() != point.parameter())?;
+        let slope = (test.value(other.sigma, &other.map.structure) - g).abs()
+            / (other.parameter() - point.parameter()).abs();
+        let error = dg / slope;
+        error.is_finite().then_some(error)
     }
 
     /// The zero of a structure test that vanishes as `vanishing` says on the segment's near
