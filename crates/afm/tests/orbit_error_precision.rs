@@ -45,7 +45,8 @@ fn g1(diagram: &BifurcationDiagram) -> Option<&DiagramSpecialPoint> {
 /// The capillary meniscus in air (`rectangular-air-mica-humid --max-step 0.02`, where the free
 /// orbit's `G1` lands 8.0e-9 nm below the exact 20 nm, its free flight exact): the approach's
 /// `G1` bracket holds the exact separation of first contact (to its rounding, 1e-12 nm).
-/// Before, the bracket was 2.6e-10 nm wide and did not; measured now 1.6e-8 nm (not converged).
+/// A bracket of the location alone (2.6e-10 nm wide) misses it; measured 1.6e-8 nm (not
+/// converged).
 #[test]
 fn capillary_g1_bracket_holds_the_free_orbits_first_contact() {
     let (model, approach, _) = approach_and_retract("rectangular-air-mica-humid", Some(0.02));
@@ -65,8 +66,8 @@ fn capillary_g1_bracket_holds_the_free_orbits_first_contact() {
 
 /// The Hertz sphere in air (`silicon-air-polymer`, built-in settings), whose approach and
 /// retract locate the same `G1` of the same branch 4.1e-9 nm apart: their brackets overlap.
-/// Before, they were 1.4e-13 and 1.6e-10 nm wide and did not; measured now 8.8e-10 and 8.5e-9
-/// nm (the retract's not converged).
+/// Brackets of the locations alone (1.4e-13 and 1.6e-10 nm wide) do not; measured 8.8e-10 and
+/// 8.5e-9 nm (the retract's not converged).
 #[test]
 fn hertz_in_air_g1_brackets_of_approach_and_retract_overlap() {
     let (_, approach, retract) = approach_and_retract("silicon-air-polymer", None);

@@ -149,8 +149,8 @@ impl PeriodicProblem for JumpAcrossTheTangent {
 /// orbits (the corner jump's shot at the largest step, `p = -0.1`), whose `y` lies 100 below:
 /// the jump's secant points against the free branch's tangent in `y`, and the attached orbit's
 /// tangent, oriented along that secant, points up in `p`. No `fold` is reported (`Z` turns on
-/// neither branch), the grazing is. Before, the trials next to the grazing took their tangents'
-/// orientation from the secant too, so `t_p` flipped between the last free orbit and them: a
+/// neither branch), the grazing is. Trials next to the grazing that took their tangents'
+/// orientation from the secant too would flip `t_p` between the last free orbit and them: a
 /// `fold` located there, converged.
 #[test]
 fn no_fold_at_the_jump_of_a_hysteretic_grazing() {
