@@ -5,32 +5,10 @@
 //! different steps within its stated precision (a location that ends where Newton stops
 //! converging misses it by up to 1e-7 nm, a distance that moves with the steps).
 
-use afm::{approach_diagram, builtin_case, diagram, BifurcationDiagram, TappingModel};
-use afm::{DiagramSettings, DiagramSpecialPoint};
+mod approach_retract;
 
-/// The approach of `biolever-adhesive` with free amplitude `a0` (nm; the case's own is 10) and
-/// largest step `max_step`, then the retract from its lowest point with the same largest step
-/// (as `drumroll continue --case biolever-adhesive --a0 A0 --retract --max-step S`).
-fn adhesive_retract(a0: f64, max_step: f64) -> BifurcationDiagram {
-    let mut case = builtin_case("biolever-adhesive").unwrap();
-    case.free_amplitude_nm = a0;
-    let model = TappingModel::from_case(&case).unwrap();
-    let approach_settings = DiagramSettings {
-        max_step,
-        ..DiagramSettings::approach(&model)
-    };
-    let approach = approach_diagram(&model, &approach_settings).unwrap();
-    let lowest = approach
-        .points
-        .iter()
-        .min_by(|a, b| a.z_nm.total_cmp(&b.z_nm))
-        .unwrap();
-    let retract_settings = DiagramSettings {
-        max_step,
-        ..DiagramSettings::retract(&model)
-    };
-    diagram(&model, &lowest.state, lowest.z_nm, &retract_settings).unwrap()
-}
+use afm::{BifurcationDiagram, DiagramSpecialPoint};
+use approach_retract::retract;
 
 /// The zero of `sqrt(-g)` by a least-squares parabola in `Z` through the retract's own branch
 /// points below `z_g` whose shallowest impact's gap minimum `g` (the one that grazes) lies in
@@ -99,7 +77,7 @@ fn adhesive_retract_g1_agrees_between_step_sizes() {
     let located: Vec<(DiagramSpecialPoint, f64)> = [0.02, 0.025]
         .iter()
         .map(|&step| {
-            let retract = adhesive_retract(10.0, step);
+            let retract = retract("biolever-adhesive", 10.0, step);
             let g1 = retract
                 .special_points
                 .iter()
@@ -146,7 +124,7 @@ fn adhesive_retract_g1_agrees_between_step_sizes() {
 /// no point of twice the last one's `sqrt(-g)` is at hand) lies 5e-7 nm short.
 #[test]
 fn adhesive_retract_g3_of_a_creeping_branch_is_within_its_bracket() {
-    let retract = adhesive_retract(8.0, 0.025);
+    let retract = retract("biolever-adhesive", 8.0, 0.025);
     let g3 = retract
         .special_points
         .iter()

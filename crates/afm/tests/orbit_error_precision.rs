@@ -6,36 +6,10 @@
 //! contact of the closed-form free orbit, `TappingModel::grazing_separation_nm`; elsewhere the
 //! same grazing located from both sides (approach and retract) is.
 
-use afm::{approach_diagram, builtin_case, diagram, BifurcationDiagram, DiagramSettings};
-use afm::{DiagramSpecialPoint, TappingModel};
+mod approach_retract;
 
-/// The approach of built-in `case` with largest step `max_step` (its default where `None`),
-/// and the retract from its lowest point (as `drumroll continue --case C --retract
-/// [--max-step S]`).
-fn approach_and_retract(
-    case: &str,
-    max_step: Option<f64>,
-) -> (TappingModel, BifurcationDiagram, BifurcationDiagram) {
-    let model = TappingModel::from_case(&builtin_case(case).unwrap()).unwrap();
-    let defaults = DiagramSettings::approach(&model);
-    let settings = DiagramSettings {
-        max_step: max_step.unwrap_or(defaults.max_step),
-        ..defaults
-    };
-    let approach = approach_diagram(&model, &settings).unwrap();
-    let lowest = approach
-        .points
-        .iter()
-        .min_by(|a, b| a.z_nm.total_cmp(&b.z_nm))
-        .unwrap();
-    let retract_settings = DiagramSettings {
-        max_step: settings.max_step,
-        max_points: settings.max_points,
-        ..DiagramSettings::retract(&model)
-    };
-    let retract = diagram(&model, &lowest.state, lowest.z_nm, &retract_settings).unwrap();
-    (model, approach, retract)
-}
+use afm::{BifurcationDiagram, DiagramSpecialPoint};
+use approach_retract::{approach_and_retract, model};
 
 /// The `G1` of a diagram.
 fn g1(diagram: &BifurcationDiagram) -> Option<&DiagramSpecialPoint> {
@@ -49,7 +23,8 @@ fn g1(diagram: &BifurcationDiagram) -> Option<&DiagramSpecialPoint> {
 /// converged).
 #[test]
 fn capillary_g1_bracket_holds_the_free_orbits_first_contact() {
-    let (model, approach, _) = approach_and_retract("rectangular-air-mica-humid", Some(0.02));
+    let model = model("rectangular-air-mica-humid", None);
+    let (approach, _) = approach_and_retract(&model, Some(0.02));
     let exact = model.grazing_separation_nm();
     let point = g1(&approach).expect("G1");
     println!(
@@ -70,7 +45,7 @@ fn capillary_g1_bracket_holds_the_free_orbits_first_contact() {
 /// 8.5e-9 nm (the retract's not converged).
 #[test]
 fn hertz_in_air_g1_brackets_of_approach_and_retract_overlap() {
-    let (_, approach, retract) = approach_and_retract("silicon-air-polymer", None);
+    let (approach, retract) = approach_and_retract(&model("silicon-air-polymer", None), None);
     let (a, r) = (g1(&approach).expect("G1"), g1(&retract).expect("G1"));
     println!(
         "approach G1 {} {:?} {:e}, retract G1 {} {:?} {:e}",

@@ -4,32 +4,10 @@
 //! stated precision; and where the continuation only turned back after a corner jump (its
 //! tangent oriented backwards) no branch end is labelled and the branch goes on.
 
-use afm::{approach_diagram, builtin_case, diagram, BifurcationDiagram, TappingModel};
-use afm::{DiagramSettings, DiagramSpecialPoint};
+mod approach_retract;
 
-/// The approach of `case` with free amplitude `a0` (nm) and largest step `max_step`, then the
-/// retract from its lowest point with the same largest step (as `drumroll continue --retract
-/// --a0 A0 --max-step S`).
-fn retract(case: &str, a0: f64, max_step: f64) -> BifurcationDiagram {
-    let mut case = builtin_case(case).unwrap();
-    case.free_amplitude_nm = a0;
-    let model = TappingModel::from_case(&case).unwrap();
-    let approach_settings = DiagramSettings {
-        max_step,
-        ..DiagramSettings::approach(&model)
-    };
-    let approach = approach_diagram(&model, &approach_settings).unwrap();
-    let lowest = approach
-        .points
-        .iter()
-        .min_by(|a, b| a.z_nm.total_cmp(&b.z_nm))
-        .unwrap();
-    let retract_settings = DiagramSettings {
-        max_step,
-        ..DiagramSettings::retract(&model)
-    };
-    diagram(&model, &lowest.state, lowest.z_nm, &retract_settings).unwrap()
-}
+use afm::{BifurcationDiagram, DiagramSpecialPoint};
+use approach_retract::retract;
 
 /// The special point labelled `label` with the highest `Z`.
 fn highest<'a>(diagram: &'a BifurcationDiagram, label: &str) -> &'a DiagramSpecialPoint {
