@@ -226,7 +226,9 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// The zero of a structure test that vanishes as `vanishing` says on the segment's near
     /// side, extrapolated from its values on the orbits of that side: the segment's (its start
     /// and the location's converged trials) and the branch's points before it
-    /// ([`extrapolated_zero`]); with the index of the segment's orbit nearest it.
+    /// ([`extrapolated_zero`]); with the index of the segment's orbit nearest it. `None` where
+    /// no zero can be extrapolated or it falls outside the interval from that orbit to the
+    /// segment's far end.
     fn extrapolated_zero(
         &self,
         segment: &Segment<'_, P>,
@@ -249,6 +251,15 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             .filter(|&(_, g)| near(g))
             .collect();
         let zero = extrapolated_zero(&points, direction, vanishing)?;
+        // The zero lies between the near side's nearest orbit and the segment's far end, where
+        // the structure has changed: a line that reaches zero outside that interval does not
+        // describe the test there (a branch whose extremum turns before it vanishes).
+        let far = segment.get(1).parameter();
+        if (zero.parameter - zero.nearest) * direction < 0.0
+            || (far - zero.parameter) * direction < 0.0
+        {
+            return None;
+        }
 
         let nearest = on_segment
             .iter()
