@@ -29,6 +29,8 @@
 //! rather than halved, and the steps after it are aimed the same way
 //! (`branch/hysteretic_break.rs`), so that the minimum step is reached in a few steps.
 
+use std::collections::VecDeque;
+
 use nalgebra::{Complex, DVector};
 
 use crate::corrector::tangent;
@@ -131,7 +133,7 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// towards a hysteretic grazing extrapolates its test function from the last of them and
     /// the current point (`branch/hysteretic_break.rs`), and the zero of a grazing test that
     /// Newton's method does not reach is extrapolated from them (`extrapolated_zero.rs`).
-    recent_structures: Vec<(f64, OrbitStructure)>,
+    recent_structures: VecDeque<(f64, OrbitStructure)>,
     /// The test function of the hysteretic grazing the step was last cut towards, at which the
     /// steps after it are aimed (`branch/hysteretic_break.rs`); `None` otherwise.
     grazing_test: Option<StructureTest>,
@@ -205,7 +207,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             stop_predicate: None,
             current,
             previous: None,
-            recent_structures: Vec::new(),
+            recent_structures: VecDeque::new(),
             grazing_test: None,
             start: Some(first),
             produced: 0,

@@ -238,7 +238,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
         let on_segment = segment.values(&value);
         let (_, p_a, g_a) = *on_segment.first()?;
-        let direction = (segment.get(1).parameter() - p_a).signum();
+        let far = segment.get(1).parameter();
+        let direction = (far - p_a).signum();
         let near = |g: f64| g.is_finite() && g != 0.0 && (g < 0.0) == (g_a < 0.0);
         let points: Vec<(f64, f64)> = on_segment
             .iter()
@@ -250,14 +251,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             )
             .filter(|&(_, g)| near(g))
             .collect();
+        // Never behind the nearest orbit ([`extrapolated_zero`]); nor past the segment's far
+        // end, where the structure has changed: a line that reaches zero there does not
+        // describe the test (a branch whose extremum turns before it vanishes).
         let zero = extrapolated_zero(&points, direction, vanishing)?;
-        // The zero lies between the near side's nearest orbit and the segment's far end, where
-        // the structure has changed: a line that reaches zero outside that interval does not
-        // describe the test there (a branch whose extremum turns before it vanishes).
-        let far = segment.get(1).parameter();
-        if (zero.parameter - zero.nearest) * direction < 0.0
-            || (far - zero.parameter) * direction < 0.0
-        {
+        if (far - zero.parameter) * direction < 0.0 {
             return None;
         }
 

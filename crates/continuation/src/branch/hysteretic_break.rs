@@ -87,7 +87,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let Some(test) = self.grazing_test.take() else {
             return;
         };
-        let Some((p_prev, previous)) = self.recent_structures.last() else {
+        let Some((p_prev, previous)) = self.recent_structures.back() else {
             return;
         };
         let n = self.problem.dim();
@@ -121,7 +121,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         };
         let secant = self
             .recent_structures
-            .last()
+            .back()
             .and_then(|(p_prev, previous)| {
                 let value_prev = test.value(0.0, previous);
                 let approaching = value_prev.is_finite()

@@ -328,10 +328,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             self.recent_structures.clear();
         } else {
             if self.recent_structures.len() == RECENT_STRUCTURES {
-                self.recent_structures.remove(0);
+                self.recent_structures.pop_front();
             }
             self.recent_structures
-                .push((accepted.parameter(), accepted.map.structure.clone()));
+                .push_back((accepted.parameter(), accepted.map.structure.clone()));
         }
         self.previous = if jumped {
             None
