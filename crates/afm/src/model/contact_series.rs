@@ -339,7 +339,7 @@ const JKR_MARGIN: f64 = 1.0;
 /// `sum_{j=1}^{m-1} x_j x_{m-j}` (`m >= 1`), the sum's terms paired by its symmetry `j <-> m -
 /// j`: twice `sum_{j=1}^{h} x_j x_{m-j}` (`h = floor((m - 1)/2)`), plus `x_{m/2}^2` for even `m`
 /// (as in [`update_root`]).
-#[inline]
+#[inline(always)]
 fn inner_square_sum(x: &[f64], m: usize) -> f64 {
     let h = (m - 1) / 2;
     let mut sum = 2.0 * convolution(&x[1..=h], &x[m - h..m]);
@@ -372,7 +372,7 @@ fn square_coefficient(x: &[f64], k: usize) -> f64 {
 /// `divisor`, from [`JkrContact::root_and_slope`]), which the later coefficients divide by.
 /// `false` where the divisor is below [`JKR_MARGIN`] `k` (next to, on or past pull-off) or the
 /// root is not finite.
-#[inline]
+#[inline(always)]
 fn update_jkr_root(
     law: &JkrContact,
     [b, p, c]: [&mut [f64]; 3],
