@@ -239,6 +239,20 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
         self
     }
 
+    /// Whether cached sample `index` lies on the far side of the segment's jump: its state
+    /// nearer (Euclidean norm) to the far end's state than to the near end's. Across the jump of
+    /// a hysteretic grazing the two ends are orbits of different families, far apart in state
+    /// while their parameters differ little, and a trial shot at a parameter between them can
+    /// converge onto either family; this says which.
+    pub(crate) fn nearer_far_end(&self, index: usize) -> bool {
+        let n = self.u_a.len() - 1;
+        let samples = self.samples.borrow();
+        let x = samples[index].u.rows(0, n);
+        let from_near = (x - self.u_a.rows(0, n)).norm();
+        let from_far = (x - self.u_a.rows(0, n) - self.delta.rows(0, n)).norm();
+        from_far < from_near
+    }
+
     /// Parameter at `sigma`: linear in natural mode, else that of the cached sample at
     /// exactly `sigma` (NaN if none).
     fn parameter_at(&self, sigma: f64) -> f64 {

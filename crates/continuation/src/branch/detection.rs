@@ -137,6 +137,23 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 }
             };
             breaks.push((location.low.unwrap_or(0), location.high.unwrap_or(1)));
+            // Across the jump of a hysteretic grazing, a merge, split or impact count located
+            // between an orbit of the near family and one of the far family is the jump itself
+            // (the far family's structure), not a change along either branch: the grazing
+            // that causes the jump is the point reported there.
+            let between_families = match (location.low, location.high) {
+                (Some(low), Some(high)) => {
+                    segment.nearer_far_end(low) != segment.nearer_far_end(high)
+                }
+                _ => false,
+            };
+            if jumped
+                && self.settings.hysteretic_grazing
+                && between_families
+                && !matches!(kind, SpecialPointKind::Grazing | SpecialPointKind::PullOff)
+            {
+                continue;
+            }
             let mut point = self.special_point(segment, kind, &location, location.converged, index);
             if let Some((zero, nearest)) = extrapolated {
                 let nearest = segment.get(nearest);
@@ -270,10 +287,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// `detect_bifurcations`, period doubling and Neimark-Sacker, into `found`: within the
     /// intervals between the structure brackets `breaks` where the test changes sign
     /// continuously, else (a sign change across a structure change) at that bracket, not
-    /// converged; except a fold across the jump of a hysteretic grazing (`jumped` on a branch
-    /// whose period map jumps there), where the two sides are different branches and the far
-    /// one's tangent is oriented along the jump's secant, so the sign of `t_p` across it tells
-    /// nothing of a turn.
+    /// converged; except across the jump of a hysteretic grazing (`jumped` on a branch whose
+    /// period map jumps there), where the two sides are different families of orbits (the far
+    /// one's tangent oriented along the jump's secant) and trials between them converge onto
+    /// either: there a test is located only between two orbits of one family
+    /// ([`Segment::nearer_far_end`]), and a sign change across the jump is not reported.
     fn locate_smooth_changes(
         &self,
         segment: &Segment<'_, P>,
@@ -297,6 +315,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             }));
         }
         let sign = |g: f64| g < 0.0;
+        let across_families = jumped && self.settings.hysteretic_grazing;
         let a0 = segment.get(0);
         let b1 = segment.get(1);
         for (kind, test) in smooth {
@@ -325,9 +344,14 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 lo = h;
             }
             intervals.push((lo, 1));
+            // Across the jump of a hysteretic grazing an interval is continuous only between
+            // orbits of one family (trials at parameters between the ends converge onto either).
             let continuous = intervals.iter().copied().find(|&(l, h)| {
                 let (gl, gh) = (test(&segment.get(l)), test(&segment.get(h)));
-                gl.is_finite() && gh.is_finite() && sign(gl) != sign(gh)
+                gl.is_finite()
+                    && gh.is_finite()
+                    && sign(gl) != sign(gh)
+                    && !(across_families && segment.nearer_far_end(l) != segment.nearer_far_end(h))
             });
             let (kind, location) = match continuous {
                 Some((l, h)) => {
@@ -336,9 +360,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                     (kind, location)
                 }
                 None => {
-                    // The sign change happens across a structure change (a jump).
-                    if kind == SpecialPointKind::Fold && jumped && self.settings.hysteretic_grazing
-                    {
+                    // The sign change happens across a structure change (a jump); across the
+                    // jump of a hysteretic grazing it is between two families of orbits and
+                    // tells nothing of either.
+                    if across_families {
                         continue;
                     }
                     let Some(&(_, l, h)) = cuts.iter().find(|&&(_, l, h)| {
