@@ -32,8 +32,8 @@ pub mod theory;
 pub mod validation;
 
 pub use diagram::bifurcation_diagram::{
-    approach_diagram, approach_diagram_until, diagram, diagram_until, BifurcationDiagram,
-    DiagramPoint, DiagramSettings, DiagramSpecialPoint,
+    approach_diagram, approach_diagram_until, diagram, diagram_until, smallest_max_step_nm,
+    BifurcationDiagram, DiagramPoint, DiagramSettings, DiagramSpecialPoint,
 };
 pub use diagram::quasi_static::{quasi_static_row, QuasiStaticCell, QuasiStaticRow};
 pub use error::AfmError;

@@ -37,7 +37,7 @@ pub struct ContinueArgs {
     /// disables).
     #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
     pub min_amplitude_ratio: f64,
-    /// Largest arclength step, in nm, in (0, A0] (default A0/250: several hundred points per
+    /// Largest arclength step, in nm, in [1e-7, A0] (default A0/250: several hundred points per
     /// diagram).
     #[arg(long, allow_negative_numbers = true)]
     pub max_step: Option<f64>,
@@ -216,7 +216,8 @@ pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<Dia
 }
 
 /// The approach diagram's settings of `model` with the options `--floor` (in `[-A0, Z_G1)`),
-/// `--min-amplitude-ratio` and `--max-step` (in `(0, A0]`) applied, each checked against
+/// `--min-amplitude-ratio` and `--max-step` (in `[1e-7, A0]`: [`afm::smallest_max_step_nm`])
+/// applied, each checked against
 /// [`crate::option_ranges`] (errors name the option and its range); shared by `continue` and
 /// `map`.
 pub fn approach_settings(
@@ -238,7 +239,11 @@ pub fn approach_settings(
     }
     settings.min_amplitude_ratio = min_amplitude_ratio;
     if let Some(step) = max_step {
-        OptionRange::new("--max-step", Interval::positive(a0, "nm")).check(step)?;
+        OptionRange::new(
+            "--max-step",
+            Interval::closed(afm::smallest_max_step_nm(), a0, "nm"),
+        )
+        .check(step)?;
         settings.max_step = step;
     }
     Ok(settings)

@@ -220,7 +220,7 @@ fn csv_and_svg_are_written_whole() {
 
 #[test]
 fn bad_options_are_refused_with_a_message_naming_the_option_and_its_range() {
-    let cases: [(&[&str], &[&str]); 5] = [
+    let cases: [(&[&str], &[&str]); 6] = [
         // First contact of the Biolever is 10.0115 nm: a floor above it is refused.
         (
             &["--case", "biolever-mica", "--floor", "12"],
@@ -238,7 +238,13 @@ fn bad_options_are_refused_with_a_message_naming_the_option_and_its_range() {
         ),
         (
             &["--case", "biolever-mica", "--max-step", "0"],
-            &["--max-step 0: allowed (0, 10] nm"],
+            &["--max-step 0: allowed [1e-7, 10] nm"],
+        ),
+        // Below 1e-7 nm the first step (a tenth of it) would fall below the continuation's
+        // smallest step: named as the option's range, not as an internal setting.
+        (
+            &["--case", "biolever-mica", "--max-step", "1e-9"],
+            &["--max-step 1e-9: allowed [1e-7, 10] nm"],
         ),
         (
             &["--case", "biolever-mica", "--csv", "diagram.txt"],

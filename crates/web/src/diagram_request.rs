@@ -15,7 +15,7 @@ use crate::case_request::CaseRequest;
 
 /// The page's request of a diagram: the case and `drumroll continue`'s options (same names
 /// and ranges: `floor_nm` in `[-A0, Z_G1)` nm, default `0.05 A0`; `min_amplitude_ratio` in
-/// `[0, 1)`, default 0.3; `max_step_nm` in `(0, A0]`, default `A0/250`; `max_points` in
+/// `[0, 1)`, default 0.3; `max_step_nm` in `[1e-7, A0]`, default `A0/250`; `max_points` in
 /// `[2, 10000000]`, default 20000; `retract`, default false).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -22,6 +22,15 @@ use crate::orbit::steady_orbit::{
     period_one_after_transients, steady_orbit, OrbitStart, SteadyOrbit, SteadyOrbitSettings,
 };
 
+/// The first arclength step of every branch as a fraction of [`DiagramSettings::max_step`].
+const INITIAL_STEP_FRACTION: f64 = 0.1;
+
+/// The smallest [`DiagramSettings::max_step`] (nm): a branch's first step,
+/// `max_step / 10`, must not fall below the continuation's smallest step (1e-8).
+pub fn smallest_max_step_nm() -> f64 {
+    ContinuationSettings::default().min_step / INITIAL_STEP_FRACTION
+}
+
 /// How a diagram is computed. [`DiagramSettings::approach`] and [`DiagramSettings::retract`]
 /// give the defaults; every field is checked by [`DiagramSettings::validate`].
 #[derive(Debug, Clone, PartialEq)]
@@ -41,7 +50,8 @@ pub struct DiagramSettings {
     /// and the repulsive branch beyond it, MODEL.md section 12) is followed on; `>= 0`.
     pub ratio_floor_margin_nm: f64,
     /// Largest arclength step in the `(x, Z)` space, nm and nm/us (default `A0 / 250`, so that
-    /// a diagram from first contact to `A/A0 = 0.3` has several hundred points). `> 0`.
+    /// a diagram from first contact to `A/A0 = 0.3` has several hundred points). At least
+    /// [`smallest_max_step_nm`].
     pub max_step: f64,
     /// Largest number of branch points (default 20000). `>= 2`.
     pub max_points: usize,
@@ -104,11 +114,11 @@ impl DiagramSettings {
                 ">= 0, finite, nm",
             ));
         }
-        if !(self.max_step.is_finite() && self.max_step > 0.0) {
+        if !(self.max_step.is_finite() && self.max_step >= smallest_max_step_nm()) {
             return Err(invalid(
                 "max_step",
                 self.max_step.to_string(),
-                "> 0, finite",
+                &format!(">= {:e}, finite, nm", smallest_max_step_nm()),
             ));
         }
         if self.max_points < 2 {
@@ -557,7 +567,7 @@ fn branch_until(
         ParameterDirection::Increasing => (f64::NEG_INFINITY, settings.z_limit_nm),
     };
     let continuation_settings = ContinuationSettings {
-        initial_step: settings.max_step * 0.1,
+        initial_step: settings.max_step * INITIAL_STEP_FRACTION,
         max_step: settings.max_step,
         direction: settings.direction,
         parameter_min,
