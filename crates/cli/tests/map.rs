@@ -235,7 +235,7 @@ fn bad_input_is_refused_with_a_message_naming_the_option() {
         ),
         (
             &["--vary", "a0", "--from", "12", "--to", "20"],
-            "contains the case's own a0 = 10",
+            "`--from/--to` = 12 .. 20 is invalid; allowed: a range that contains the case's own a0 = 10",
         ),
         (
             &[

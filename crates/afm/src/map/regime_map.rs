@@ -239,14 +239,15 @@ fn check_range(case: &Case, axis: ParameterAxis, s: &RegimeMapSettings) -> Resul
     }
     let own = axis.value(case)?;
     if !(s.from..=s.to).contains(&own) {
-        return Err(bad(
-            "--from/--to",
-            own,
-            format!(
+        return Err(AfmError::InvalidField {
+            file: "command line".into(),
+            field: "--from/--to".into(),
+            value: format!("{} .. {}", s.from, s.to),
+            allowed: format!(
                 "a range that contains the case's own {} = {own} (the curves start there)",
                 axis.name()
             ),
-        ));
+        });
     }
     for &v in &s.at {
         if !(v.is_finite() && (s.from..=s.to).contains(&v)) {
