@@ -324,7 +324,9 @@ const MAX_JUMPS: usize = 16;
 /// continues from it. On a retract, the end of an attached branch that is not a located
 /// grazing is labelled `pull-off`: at a fold of the attached orbits (where `Z` turns back) the
 /// located fold, else the last point (the corrector failed at the continuation's smallest
-/// step), not located: its bracket runs to the grazing extrapolated from the branch. A
+/// step), not located: its bracket runs to the grazing extrapolated from the branch. On an
+/// approach, a branch stuck short of a grazing it ran into (none located there) ends with
+/// that grazing, `pull-off` or the next `G<n>`, not located, bracketed the same way. A
 /// branch whose `Z` turned back with no fold located in the step (the tangent's orientation
 /// reversed after a corner jump) is no end: the branch goes on from its last point, on the
 /// approach as on the retract.
@@ -370,28 +372,58 @@ pub fn diagram_until(
         if sign * (z_jump - settings.z_limit_nm) >= 0.0 {
             break;
         }
+        // A branch stuck short of a grazing ends there, between its last point and the
+        // grazing's farthest extrapolation (no farther than the jump).
+        let stuck = match &end {
+            Some(BranchEnd::Stuck(Some(grazing))) => {
+                let beyond = if sign > 0.0 {
+                    grazing.z_nm.min(z_jump)
+                } else {
+                    grazing.z_nm.max(z_jump)
+                };
+                Some((grazing.release, beyond))
+            }
+            _ => None,
+        };
+        // A grazing the continuation located within 1e-6 nm of the last point, or between it
+        // and that end's far side, is already this end's.
+        let far = stuck.map_or(last.z_nm, |(_, beyond)| beyond);
+        let (low, high) = (last.z_nm.min(far) - 1e-6, last.z_nm.max(far) + 1e-6);
         let grazing_at_end = diagram
             .special_points
-            .last()
-            .is_some_and(|p| is_grazing(&p.label) && (p.z_nm - last.z_nm).abs() < 1e-6);
-        // On a retract, an attached branch ends where the orbit can no longer stay attached.
-        if !grazing_at_end && sign > 0.0 && last.impacts_per_orbit > 0 {
+            .iter()
+            .any(|p| is_grazing(&p.label) && low <= p.z_nm && p.z_nm <= high);
+        let end_observables = |system: &mut TappingModel| {
             system.set_parameter(last.z_nm);
-            let observables = orbit_observables(
-                &system,
+            orbit_observables(
+                system,
                 &last.state,
                 &settings.orbit.integration,
                 settings.orbit.harmonics,
-            )?;
-            let point = match &end {
-                Some(BranchEnd::Fold(fold)) => {
-                    pull_off_at_fold(fold, observables.impacts_per_window())
-                }
-                Some(BranchEnd::Stuck(Some(grazing))) => {
-                    branch_end_point("pull-off", &last, &observables, grazing.min(z_jump))
-                }
-                _ => branch_end_point("pull-off", &last, &observables, z_jump),
+            )
+        };
+        // On a retract, an attached branch ends where the orbit can no longer stay attached.
+        if !grazing_at_end && sign > 0.0 && last.impacts_per_orbit > 0 {
+            let observables = end_observables(&mut system)?;
+            let impacts = observables.impacts_per_window();
+            let point = match (&end, stuck) {
+                (Some(BranchEnd::Fold(fold)), _) => pull_off_at_fold(fold, impacts),
+                (_, Some((_, beyond))) => branch_end_point("pull-off", &last, beyond, (impacts, 0)),
+                _ => branch_end_point("pull-off", &last, z_jump, (impacts, 0)),
             };
+            diagram.special_points.push(point);
+        }
+        // On an approach, a branch stuck short of the grazing it ran into ends there, not
+        // located: a `pull-off` of the release surface or the next `G<n>`.
+        if let (false, true, Some((release, beyond))) = (grazing_at_end, sign < 0.0, stuck) {
+            let observables = end_observables(&mut system)?;
+            let impacts = observables.impacts_per_window();
+            let (label, after) = if release {
+                (String::from("pull-off"), impacts)
+            } else {
+                (format!("G{}", impacts + 1), impacts + 1)
+            };
+            let point = branch_end_point(&label, &last, beyond, (impacts, after));
             diagram.special_points.push(point);
         }
         let Some((z_jump, orbit)) =
@@ -504,16 +536,17 @@ fn settle_on_period_one(
     None
 }
 
-/// The special point `label` at the last point `last` of a retract's branch that ends there
-/// unlocated (a hysteretic law's pull-off where the corrector failed at the smallest step):
-/// the end lies between `last` and `beyond_nm` (nm; the grazing the branch was running into,
-/// extrapolated, or where the diagram jumps to), which is its bracket; its width is the
-/// precision, converged only within the location tolerance (1e-9 nm).
+/// The special point `label` at the last point `last` of a branch that ends there unlocated
+/// (a hysteretic law's grazing or pull-off where the corrector failed at the smallest step),
+/// with `impacts_before` and `impacts_after` impacts per period: the end lies between `last`
+/// and `beyond_nm` (nm; the grazing the branch was running into, extrapolated, or where the
+/// diagram jumps to), which is its bracket; its width is the precision, converged only within
+/// the location tolerance (1e-9 nm).
 fn branch_end_point(
     label: &str,
     last: &DiagramPoint,
-    observables: &OrbitObservables,
     beyond_nm: f64,
+    (impacts_before, impacts_after): (usize, usize),
 ) -> DiagramSpecialPoint {
     let bracket = [last.z_nm.min(beyond_nm), last.z_nm.max(beyond_nm)];
     let precision = bracket[1] - bracket[0];
@@ -522,8 +555,8 @@ fn branch_end_point(
         z_nm: last.z_nm,
         amplitude_ratio: last.amplitude_ratio,
         phase_deg: last.phase_deg,
-        impacts_before: observables.impacts_per_window(),
-        impacts_after: 0,
+        impacts_before,
+        impacts_after,
         bracket_nm: bracket,
         precision_nm: precision,
         converged: precision <= ContinuationSettings::default().location_tolerance,

@@ -20,10 +20,25 @@ pub(crate) enum BranchEnd {
     /// outweigh its `Z` part).
     Reversed,
     /// The corrector failed at the continuation's smallest step with no grazing located there
-    /// (next to a grazing of a hysteretic surface the monodromy grows without bound). The `Z`
-    /// (nm) of the nearest grazing the branch was running into, extrapolated from its last
-    /// points ([`extrapolated_grazing`]), if any.
-    Stuck(Option<f64>),
+    /// (next to a grazing of a hysteretic surface the monodromy grows without bound). The
+    /// nearest grazing the branch was running into, extrapolated from its last points
+    /// ([`extrapolated_grazing`]), if any.
+    Stuck(Option<GrazingAhead>),
+}
+
+/// The grazing a stuck branch was running into, extrapolated from its last points
+/// ([`extrapolated_grazing`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct GrazingAhead {
+    /// The farthest `Z` (nm) the grazing can lie at: where `sqrt(|g|)` of its extremum `g`,
+    /// extrapolated linearly, reaches zero. Exact to first order where `g` vanishes
+    /// quadratically (the side of a hysteretic grazing that crosses the surface, MODEL.md
+    /// section 8), past the zero where it vanishes linearly (`sqrt` is concave there, its
+    /// secant overshoots), so the grazing lies between the last point and this `Z`.
+    pub(crate) z_nm: f64,
+    /// Whether the extremum is a maximum of the release surface (the grazing is a `pull-off`),
+    /// not a gap minimum (a `G<n>`).
+    pub(crate) release: bool,
 }
 
 /// The branch-end `pull-off` (MODEL.md section 8) at the located fold `fold` that ends an
@@ -46,14 +61,14 @@ pub(crate) fn pull_off_at_fold(
 /// residual (1e-10) does not swamp the change of the test functions.
 const SECANT_BASE_NM: f64 = 1e-6;
 
-/// The `Z` (nm) where the branch `points` (last the end) would reach its nearest grazing in
-/// the direction `sign` of `Z`: every gap minimum and every maximum of the release surface
-/// (MODEL.md section 8: `G<n>`, `pull-off`) of the last point whose value approaches zero is
-/// extrapolated to zero along the secant in `Z` from the latest earlier point with the same
-/// numbers of extrema at least [`SECANT_BASE_NM`] away (else the farthest such point), and
-/// the nearest zero ahead is returned. An estimate, linear in `Z`: `None` where no extremum
-/// approaches zero.
-pub(crate) fn extrapolated_grazing(points: &[BranchPoint], sign: f64) -> Option<f64> {
+/// The grazing the branch `points` (last the end) was running into in the direction `sign` of
+/// `Z`: every gap minimum and every maximum of the release surface (MODEL.md section 8: `G<n>`,
+/// `pull-off`) of the last point whose value approaches zero is extrapolated to zero along the
+/// secant of `sqrt(|g|)` in `Z` from the latest earlier point with the same numbers of extrema
+/// at least [`SECANT_BASE_NM`] away (else the farthest such point), and the nearest zero ahead
+/// is returned ([`GrazingAhead::z_nm`]: the farthest the grazing can lie). `None` where no
+/// extremum approaches zero.
+pub(crate) fn extrapolated_grazing(points: &[BranchPoint], sign: f64) -> Option<GrazingAhead> {
     let (last, earlier) = points.split_last()?;
     let same_counts = |s: &OrbitStructure| {
         s.minima.len() == last.structure.minima.len()
@@ -72,19 +87,26 @@ pub(crate) fn extrapolated_grazing(points: &[BranchPoint], sign: f64) -> Option<
         }
     }
     let base = base?;
-    let pairs = |s: &OrbitStructure| -> Vec<f64> {
+    // Each extremum's value, with whether it is the release surface's.
+    let extrema = |s: &OrbitStructure| -> Vec<(f64, bool)> {
         s.minima
             .iter()
-            .chain(&s.release_maxima)
-            .map(|&(_, value)| value)
+            .map(|&(_, value)| (value, false))
+            .chain(s.release_maxima.iter().map(|&(_, value)| (value, true)))
             .collect()
     };
     let (p_a, p_b) = (base.parameter, last.parameter);
-    pairs(&base.structure)
+    extrema(&base.structure)
         .into_iter()
-        .zip(pairs(&last.structure))
-        .filter(|&(v_a, v_b)| (v_a < 0.0) == (v_b < 0.0) && v_b.abs() < v_a.abs())
-        .map(|(v_a, v_b)| p_b + v_b * (p_b - p_a) / (v_a - v_b))
-        .filter(|z| z.is_finite() && sign * (z - p_b) > 0.0)
-        .min_by(|x, y| (sign * (x - p_b)).total_cmp(&(sign * (y - p_b))))
+        .zip(extrema(&last.structure))
+        .filter(|&((v_a, _), (v_b, _))| (v_a < 0.0) == (v_b < 0.0) && v_b.abs() < v_a.abs())
+        .map(|((v_a, _), (v_b, release))| {
+            let (s_a, s_b) = (v_a.abs().sqrt(), v_b.abs().sqrt());
+            GrazingAhead {
+                z_nm: p_b + s_b * (p_b - p_a) / (s_a - s_b),
+                release,
+            }
+        })
+        .filter(|g| g.z_nm.is_finite() && sign * (g.z_nm - p_b) > 0.0)
+        .min_by(|x, y| (sign * (x.z_nm - p_b)).total_cmp(&(sign * (y.z_nm - p_b))))
 }
