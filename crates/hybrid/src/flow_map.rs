@@ -170,6 +170,7 @@ where
     if !duration.is_finite() || duration < 0.0 || !t_end.is_finite() {
         return Err(HybridError::InvalidEndTime { t: t0, t_end });
     }
+    let (event_count, extremum_count) = workspace.result_counts;
     let mut solver = Solver::with_workspace(
         system,
         t0,
@@ -181,8 +182,8 @@ where
     if let Some(mode) = mode {
         solver.set_mode(mode);
     }
-    let mut events = Vec::new();
-    let mut extrema = Vec::new();
+    let mut events = Vec::with_capacity(event_count);
+    let mut extrema = Vec::with_capacity(extremum_count);
     loop {
         let outcome = solver.step(t_end)?;
         extrema.extend_from_slice(solver.step_extrema());
@@ -193,6 +194,7 @@ where
             StepOutcome::EndTime => break,
         }
     }
+    let result_counts = (events.len(), extrema.len());
     let map = FlowMap {
         state: solver.state().to_vec(),
         transition: solver.transition().clone(),
@@ -203,5 +205,6 @@ where
         mode: solver.mode(),
     };
     *workspace = solver.into_workspace();
+    workspace.result_counts = result_counts;
     Ok(map)
 }

@@ -25,6 +25,10 @@ use crate::variational_field::VariationalField;
 #[derive(Default)]
 pub struct SolverWorkspace {
     pub(crate) buffers: Option<Buffers>,
+    /// The numbers of events and of extrema of the last flow map run in this workspace
+    /// ([`crate::flow_map_in`]): the capacities its next result's vectors start with (the maps
+    /// of one branch or Newton iteration have about as many), so they do not grow step by step.
+    pub(crate) result_counts: (usize, usize),
 }
 
 /// A clone is an empty workspace: the buffers hold no results, so a copy of the storage would
