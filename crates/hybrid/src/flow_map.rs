@@ -170,7 +170,10 @@ where
     if !duration.is_finite() || duration < 0.0 || !t_end.is_finite() {
         return Err(HybridError::InvalidEndTime { t: t0, t_end });
     }
-    let (event_count, extremum_count) = workspace.result_counts;
+    let (event_count, extremum_count) = workspace
+        .buffers
+        .as_ref()
+        .map_or((0, 0), |buffers| buffers.result_counts);
     let mut solver = Solver::with_workspace(
         system,
         t0,
@@ -205,6 +208,8 @@ where
         mode: solver.mode(),
     };
     *workspace = solver.into_workspace();
-    workspace.result_counts = result_counts;
+    if let Some(buffers) = workspace.buffers.as_mut() {
+        buffers.result_counts = result_counts;
+    }
     Ok(map)
 }

@@ -295,10 +295,10 @@ impl TappingModel {
     }
 
     /// Mode `i`'s steady response to a bimodal drive's second drive at `t`, `[q, q']` (nm,
-    /// nm/us); zero for another drive. A `match`, not `Option::map_or`, whose closure (the
-    /// sine and cosine of `steady_state`) made it an out-of-line call of 12 instructions
-    /// per mode and per step even without a second drive.
-    #[inline]
+    /// nm/us); zero for another drive. Always inlined (without a second drive it is a test
+    /// and two zeros): as `Option::map_or` (whose closure holds `steady_state`'s sine and
+    /// cosine) or a plain `match` it was an out-of-line call per mode and per step.
+    #[inline(always)]
     fn second_steady_state(&self, i: usize, t: f64) -> [f64; 2] {
         match &self.second {
             Some(second) => second.oscillators[i].steady_state(t),

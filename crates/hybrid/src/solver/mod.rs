@@ -427,7 +427,6 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
     pub fn into_workspace(self) -> SolverWorkspace {
         SolverWorkspace {
             buffers: Some(self.buffers),
-            result_counts: (0, 0),
         }
     }
 
