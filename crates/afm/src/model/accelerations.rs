@@ -353,9 +353,9 @@ impl TappingModel {
             None,
             Some(hydration),
         ) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) {
             // The Hertz sphere with the hydration force: in contact Hertz plus the constant
             // `F_h(0)`, outside the hydration force's own series.
@@ -374,9 +374,9 @@ impl TappingModel {
             });
         }
         if let (ContactLaw::Capillary(capillary), None, None) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) {
             // Inside contact the meniscus is attached (it forms at the `Down` crossing of
             // `d = 0`): the Hertz sphere minus `F_m`. Outside contact the force is a constant
@@ -384,7 +384,7 @@ impl TappingModel {
             let HertzShape {
                 effective_modulus_gpa,
                 tip: HertzTip::Sphere { radius_nm },
-            } = capillary.hertz
+            } = &capillary.hertz
             else {
                 return None;
             };
@@ -398,18 +398,18 @@ impl TappingModel {
             );
         }
         if let (ContactLaw::Jkr(law), None, None) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) {
             // Attached, on both sides of d = 0 (MODEL.md section 9, JKR); detached the tip
             // flies freely (the exact flow).
-            return Self::is_attached(mode).then_some(SeriesForce::Jkr { law });
+            return Self::is_attached(mode).then_some(SeriesForce::Jkr { law: *law });
         }
         let (ContactLaw::Dmt(dmt), None, None) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) else {
             return None;
         };
