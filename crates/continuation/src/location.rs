@@ -473,7 +473,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             }
         }
         let (il, ih) = (self.index_of(bl), self.index_of(bh));
-        let value_at = |index: Option<usize>| index.map_or(failure_value, |i| test(&self.sample_ref(i)));
+        let value_at =
+            |index: Option<usize>| index.map_or(failure_value, |i| test(&self.sample_ref(i)));
         let (gl, gh) = (value_at(il), value_at(ih));
         let (pl, ph) = (self.parameter_at(bl), self.parameter_at(bh));
         let opposite = (gl == 0.0 || gh == 0.0 || (gl < 0.0) != (gh < 0.0))
