@@ -283,9 +283,22 @@ impl<S: Parametrised> HybridPeriodicProblem<S> {
         let system = self.system.borrow();
         let k = system.contact_surface();
         let duration = self.periods as f64 * system.period();
+        // The contact surface's extrema, and its impacts with a virtual minimum: the sizes of
+        // the structure's lists (allocated once each instead of grown).
+        let on_contact = |kind| {
+            flow.extrema
+                .iter()
+                .filter(|e| e.surface == k && e.kind == kind)
+                .count()
+        };
+        let virtual_minima = flow
+            .events
+            .iter()
+            .filter(|e| e.surface == k && e.direction == Direction::Down && e.reset)
+            .count();
         let mut structure = OrbitStructure {
-            minima: Vec::new(),
-            maxima: Vec::new(),
+            minima: Vec::with_capacity(on_contact(ExtremumKind::Minimum) + virtual_minima),
+            maxima: Vec::with_capacity(on_contact(ExtremumKind::Maximum)),
             impacts: 0,
             permanent_contact: false,
             duration,

@@ -18,7 +18,7 @@
 //! regula falsi with the Anderson-Bjorck modification, which follows the near side's secant,
 //! rather than the Illinois method.
 
-use std::cell::{Cell, RefCell};
+use std::cell::{Cell, Ref, RefCell};
 
 use nalgebra::{Complex, DVector};
 use roots::{find_root_regula_falsi, Convergency, SearchError};
@@ -283,6 +283,18 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
         self.samples.borrow()[index].clone()
     }
 
+    /// Sample `index`, borrowed: read in place instead of cloned (its period map, tangent and
+    /// multipliers are eight heap vectors). The borrow must end before the segment corrects a
+    /// new orbit ([`Segment::sample`] adds it to the cache).
+    pub(crate) fn sample_ref(&self, index: usize) -> Ref<'_, Sample> {
+        Ref::map(self.samples.borrow(), |samples| &samples[index])
+    }
+
+    /// The segment's far end `b` (`sigma = 1`, the sample it was built with), taken out of it.
+    pub(crate) fn into_far_end(self) -> Sample {
+        self.samples.into_inner().swap_remove(1)
+    }
+
     /// Index of the cached sample at exactly `sigma`.
     fn index_of(&self, sigma: f64) -> Option<usize> {
         self.samples.borrow().iter().position(|s| s.sigma == sigma)
@@ -356,23 +368,22 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     fn shoot_at(&self, sigma: f64) -> Result<Option<OrientedTrial>, ContinuationError> {
         let n = self.u_a.len() - 1;
         let p = self.parameter_at(sigma);
-        let ends = if self.far_is_orbit {
-            vec![self.get(0), self.get(1)]
-        } else {
-            vec![self.get(0)]
-        };
+        let ends: &[usize] = if self.far_is_orbit { &[0, 1] } else { &[0] };
         let settings = NewtonSettings {
             max_iterations: self.settings.max_iterations * 4,
             ..self.settings.clone()
         };
-        for end in &ends {
-            let tp = end.tangent[n];
-            let slope = if tp.abs() > 1e-12 && tp.is_finite() {
-                (p - end.parameter()) / tp
-            } else {
-                0.0
+        for &end_index in ends {
+            let guess = {
+                let end = self.sample_ref(end_index);
+                let tp = end.tangent[n];
+                let slope = if tp.abs() > 1e-12 && tp.is_finite() {
+                    (p - end.parameter()) / tp
+                } else {
+                    0.0
+                };
+                end.u.rows(0, n) + slope * end.tangent.rows(0, n)
             };
-            let guess = end.u.rows(0, n) + slope * end.tangent.rows(0, n);
             let result = match shoot_checked(
                 self.problem,
                 guess.as_slice(),
@@ -398,7 +409,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
                 let mut u = DVector::zeros(n + 1);
                 u.rows_mut(0, n).copy_from(&result.state);
                 u[n] = p;
-                return Ok(Some((u, result.period_map, end.tangent.clone())));
+                let tangent = self.sample_ref(end_index).tangent.clone();
+                return Ok(Some((u, result.period_map, tangent)));
             }
         }
         Ok(None)
@@ -416,7 +428,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<Location, ContinuationError> {
-        let (s_low, s_high) = (self.get(low).sigma, self.get(high).sigma);
+        let (s_low, s_high) = (self.sample_ref(low).sigma, self.sample_ref(high).sigma);
         let before = self.trials.get();
         let bracket = Cell::new((s_low, s_high));
         let error: RefCell<Option<ContinuationError>> = RefCell::new(None);
@@ -475,7 +487,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             }
         }
         let (il, ih) = (self.index_of(bl), self.index_of(bh));
-        let value_at = |index: Option<usize>| index.map_or(failure_value, |i| test(&self.get(i)));
+        let value_at =
+            |index: Option<usize>| index.map_or(failure_value, |i| test(&self.sample_ref(i)));
         let (gl, gh) = (value_at(il), value_at(ih));
         let (pl, ph) = (self.parameter_at(bl), self.parameter_at(bh));
         let opposite = (gl == 0.0 || gh == 0.0 || (gl < 0.0) != (gh < 0.0))

@@ -73,6 +73,7 @@ pub(crate) fn stays_above<const D: usize>(power: &[f64; D], floor: f64) -> bool 
 
 /// The sign (`1` or `-1`) the polynomial with power-basis coefficients `power` is proven to
 /// keep strictly on all of `[0, 1]`, if its Bernstein coefficients prove one; `None` if not.
+#[inline(always)]
 pub(crate) fn strict_sign<const D: usize>(power: &[f64; D]) -> Option<f64> {
     let margin = rounding_margin(power);
     // A dominant constant term proves the sign without the conversion (every Bernstein

@@ -170,6 +170,10 @@ where
     if !duration.is_finite() || duration < 0.0 || !t_end.is_finite() {
         return Err(HybridError::InvalidEndTime { t: t0, t_end });
     }
+    let (event_count, extremum_count) = workspace
+        .buffers
+        .as_ref()
+        .map_or((0, 0), |buffers| buffers.result_counts);
     let mut solver = Solver::with_workspace(
         system,
         t0,
@@ -181,8 +185,8 @@ where
     if let Some(mode) = mode {
         solver.set_mode(mode);
     }
-    let mut events = Vec::new();
-    let mut extrema = Vec::new();
+    let mut events = Vec::with_capacity(event_count);
+    let mut extrema = Vec::with_capacity(extremum_count);
     loop {
         let outcome = solver.step(t_end)?;
         extrema.extend_from_slice(solver.step_extrema());
@@ -193,6 +197,7 @@ where
             StepOutcome::EndTime => break,
         }
     }
+    let result_counts = (events.len(), extrema.len());
     let map = FlowMap {
         state: solver.state().to_vec(),
         transition: solver.transition().clone(),
@@ -203,5 +208,8 @@ where
         mode: solver.mode(),
     };
     *workspace = solver.into_workspace();
+    if let Some(buffers) = workspace.buffers.as_mut() {
+        buffers.result_counts = result_counts;
+    }
     Ok(map)
 }

@@ -94,6 +94,10 @@ pub(crate) struct Buffers {
     pub affine_gradients: Vec<f64>,
     /// `dh_k/dt` at fixed state of every surface when all are affine.
     pub affine_drifts: Vec<f64>,
+    /// The numbers of events and of extrema of the last flow map run on these buffers
+    /// ([`crate::flow_map_in`]): the capacities its next result's vectors start with (the maps
+    /// of one branch or Newton iteration have about as many), so they do not grow step by step.
+    pub result_counts: (usize, usize),
 }
 
 impl Buffers {
@@ -151,6 +155,7 @@ impl Buffers {
             product: DMatrix::zeros(n, n),
             affine_gradients: vec![0.0; surfaces * n],
             affine_drifts: vec![0.0; surfaces],
+            result_counts: (0, 0),
         }
     }
 

@@ -283,6 +283,7 @@ impl TipSampleForce {
 
     /// The force and slopes on one side: inside contact (`inside`), with the contact law
     /// zeroed when `clipped`, or outside, for a recovered sample (`rho = 0`).
+    #[inline]
     pub fn in_region(
         &self,
         inside: bool,
@@ -298,6 +299,7 @@ impl TipSampleForce {
     /// (for a standard linear solid at `max(d, d_c)`: constant between its rest surface and
     /// its unrecovered surface) and their value on the contact surface, `F(d_c)`, inside (held
     /// constant).
+    #[inline]
     pub fn in_region_at(
         &self,
         inside: bool,

@@ -295,12 +295,15 @@ impl TappingModel {
     }
 
     /// Mode `i`'s steady response to a bimodal drive's second drive at `t`, `[q, q']` (nm,
-    /// nm/us); zero for another drive.
-    #[inline]
+    /// nm/us); zero for another drive. Always inlined (without a second drive it is a test
+    /// and two zeros): as `Option::map_or` (whose closure holds `steady_state`'s sine and
+    /// cosine) or a plain `match` it was an out-of-line call per mode and per step.
+    #[inline(always)]
     fn second_steady_state(&self, i: usize, t: f64) -> [f64; 2] {
-        self.second
-            .as_ref()
-            .map_or([0.0, 0.0], |second| second.oscillators[i].steady_state(t))
+        match &self.second {
+            Some(second) => second.oscillators[i].steady_state(t),
+            None => [0.0, 0.0],
+        }
     }
 
     /// The drives of the Taylor series: `w`, an acoustic drive's base amplitude, a bimodal
@@ -350,9 +353,9 @@ impl TappingModel {
             None,
             Some(hydration),
         ) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) {
             // The Hertz sphere with the hydration force: in contact Hertz plus the constant
             // `F_h(0)`, outside the hydration force's own series.
@@ -371,9 +374,9 @@ impl TappingModel {
             });
         }
         if let (ContactLaw::Capillary(capillary), None, None) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) {
             // Inside contact the meniscus is attached (it forms at the `Down` crossing of
             // `d = 0`): the Hertz sphere minus `F_m`. Outside contact the force is a constant
@@ -381,7 +384,7 @@ impl TappingModel {
             let HertzShape {
                 effective_modulus_gpa,
                 tip: HertzTip::Sphere { radius_nm },
-            } = capillary.hertz
+            } = &capillary.hertz
             else {
                 return None;
             };
@@ -395,18 +398,18 @@ impl TappingModel {
             );
         }
         if let (ContactLaw::Jkr(law), None, None) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) {
             // Attached, on both sides of d = 0 (MODEL.md section 9, JKR); detached the tip
             // flies freely (the exact flow).
-            return Self::is_attached(mode).then_some(SeriesForce::Jkr { law });
+            return Self::is_attached(mode).then_some(SeriesForce::Jkr { law: *law });
         }
         let (ContactLaw::Dmt(dmt), None, None) = (
-            self.force.law,
-            self.force.double_layer,
-            self.force.hydration,
+            &self.force.law,
+            &self.force.double_layer,
+            &self.force.hydration,
         ) else {
             return None;
         };
@@ -711,10 +714,10 @@ impl SwitchingStructure for TappingModel {
         let w = self.drive.angular_frequency;
         let (sin, cos) = phase::sin_cos(w * t0);
         // The base's `|y_base''| <= w^2 |Y|` (acoustic drive, MODEL.md section 14).
-        let base = self
-            .base
-            .as_ref()
-            .map_or(0.0, |base| w * w * base.amplitude_nm.abs());
+        let base = match &self.base {
+            Some(base) => w * w * base.amplitude_nm.abs(),
+            None => 0.0,
+        };
         let bound = base
             + self
                 .modes

@@ -78,7 +78,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
             // Across a corner, a failed trial lies past the structure change (B side).
             let failure = if jumped {
-                value(&segment.get(1))
+                value(&segment.sample_ref(1))
             } else {
                 f64::NAN
             };
@@ -156,7 +156,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             }
             let mut point = self.special_point(segment, kind, &location, location.converged, index);
             if let Some((zero, nearest)) = extrapolated {
-                let nearest = segment.get(nearest);
+                let nearest = segment.sample_ref(nearest);
                 let n = nearest.u.len() - 1;
                 let special = &mut point.1;
                 special.parameter = zero.parameter;
@@ -182,7 +182,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 // No zero to extrapolate: the location's bracket ends where Newton stopped
                 // converging, not at the zero, which lies somewhere up to the far end.
                 let special = &mut point.1;
-                let far = segment.get(1).parameter();
+                let far = segment.sample_ref(1).parameter();
                 special.bracket = (special.bracket.0.min(far), special.bracket.1.max(far));
                 special.precision = special.bracket.1 - special.bracket.0;
                 special.converged = false;
@@ -231,8 +231,9 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 dg = dg.min((test.value(point.sigma, &map.structure) - g).abs());
             }
         }
-        let other = [segment.get(0), segment.get(1)]
+        let other = [0, 1]
             .into_iter()
+            .map(|index| segment.sample_ref(index))
             .find(|s| s.parameter() != point.parameter())?;
         let slope = (test.value(other.sigma, &other.map.structure) - g).abs()
             / (other.parameter() - point.parameter()).abs();
@@ -255,7 +256,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
         let on_segment = segment.values(&value);
         let (_, p_a, g_a) = *on_segment.first()?;
-        let far = segment.get(1).parameter();
+        let far = segment.sample_ref(1).parameter();
         let direction = (far - p_a).signum();
         let near = |g: f64| g.is_finite() && g != 0.0 && (g < 0.0) == (g_a < 0.0);
         let points: Vec<(f64, f64)> = on_segment
@@ -316,25 +317,24 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         }
         let sign = |g: f64| g < 0.0;
         let across_families = jumped && self.settings.hysteretic_grazing;
-        let a0 = segment.get(0);
-        let b1 = segment.get(1);
         for (kind, test) in smooth {
-            let (ga, gb) = (test(&a0), test(&b1));
+            // The ends are borrowed only here: the location below adds orbits to the segment.
+            let (ga, gb) = (test(&segment.sample_ref(0)), test(&segment.sample_ref(1)));
             if !(ga.is_finite() && gb.is_finite()) || sign(ga) == sign(gb) {
                 continue;
             }
             // A Neimark-Sacker test's sign change between two ends without a complex pair is a
             // neutral saddle, which the location below would find and drop.
             if kind == SpecialPointKind::NeimarkSacker
-                && !has_complex_pair(&a0.multipliers)
-                && !has_complex_pair(&b1.multipliers)
+                && !has_complex_pair(&segment.sample_ref(0).multipliers)
+                && !has_complex_pair(&segment.sample_ref(1).multipliers)
             {
                 continue;
             }
             // Intervals between the structure brackets, in sigma order.
             let mut cuts: Vec<(f64, usize, usize)> = breaks
                 .iter()
-                .map(|&(l, h)| (segment.get(l).sigma, l, h))
+                .map(|&(l, h)| (segment.sample_ref(l).sigma, l, h))
                 .collect();
             cuts.sort_by(|x, y| x.0.total_cmp(&y.0));
             let mut intervals = Vec::new();
@@ -347,7 +347,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             // Across the jump of a hysteretic grazing an interval is continuous only between
             // orbits of one family (trials at parameters between the ends converge onto either).
             let continuous = intervals.iter().copied().find(|&(l, h)| {
-                let (gl, gh) = (test(&segment.get(l)), test(&segment.get(h)));
+                let (gl, gh) = (test(&segment.sample_ref(l)), test(&segment.sample_ref(h)));
                 gl.is_finite()
                     && gh.is_finite()
                     && sign(gl) != sign(gh)
@@ -367,7 +367,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                         continue;
                     }
                     let Some(&(_, l, h)) = cuts.iter().find(|&&(_, l, h)| {
-                        sign(test(&segment.get(l))) != sign(test(&segment.get(h)))
+                        sign(test(&segment.sample_ref(l))) != sign(test(&segment.sample_ref(h)))
                     }) else {
                         continue;
                     };
@@ -375,7 +375,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                         point: Some(segment.get(l)),
                         low: Some(l),
                         high: Some(h),
-                        parameters: (segment.get(l).parameter(), segment.get(h).parameter()),
+                        parameters: (
+                            segment.sample_ref(l).parameter(),
+                            segment.sample_ref(h).parameter(),
+                        ),
                         converged: false,
                         iterations: 0,
                     };
@@ -407,10 +410,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         converged: bool,
         index: usize,
     ) -> (f64, SpecialPoint) {
-        let low = segment.get(location.low.unwrap_or(0));
-        let high = segment.get(location.high.unwrap_or(1));
+        let low = segment.sample_ref(location.low.unwrap_or(0));
+        let high = segment.sample_ref(location.high.unwrap_or(1));
         let (pl, ph) = location.parameters;
-        let point = location.point.clone().unwrap_or_else(|| low.clone());
+        let point = location.point.as_ref().unwrap_or(&*low);
         let n = point.u.len() - 1;
         // A merge into, or a split out of, contact throughout the period has its own name.
         let kind = match kind {
@@ -438,8 +441,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                     | SpecialPointKind::PullOff
             )
         {
-            impacts_before = segment.get(0).map.structure.impacts;
-            impacts_after = segment.get(1).map.structure.impacts;
+            impacts_before = segment.sample_ref(0).map.structure.impacts;
+            impacts_after = segment.sample_ref(1).map.structure.impacts;
         }
         (
             point.sigma,

@@ -292,12 +292,13 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let segment = Segment::new(
             self.problem,
             a,
-            b.clone(),
+            b,
             reference,
             self.settings.corrector.clone(),
             jumped,
         );
         let special = self.locate_all(&segment, structure, index, jumped, true)?;
+        let b = segment.into_far_end();
         let covered = if jumped {
             (&b.u - &self.current.u).norm()
         } else {
@@ -331,7 +332,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 self.recent_structures.pop_front();
             }
             self.recent_structures
-                .push_back((accepted.parameter(), accepted.map.structure.clone()));
+                .push_back((accepted.parameter(), accepted.map.structure));
         }
         self.previous = if jumped {
             None
