@@ -874,23 +874,48 @@ fn jkr_slope_recurrence(
     derivative: &mut [f64],
 ) {
     let p = derivative.len();
-    let mut ratio = [0.0; MAX_ORDER];
     let (r, k) = (law.tip_radius_nm, law.adhesion_root());
     // `D_m` for m >= 1, each formed once.
     let mut scaled_cube = [0.0; MAX_ORDER];
     for (scaled, c) in scaled_cube[..p].iter_mut().zip(&cube[..p]) {
         *scaled = 4.0 * c / r;
     }
+    // The ratio's coefficients highest power first (`ratio_i` at `MAX_ORDER - 1 - i`), so that
+    // both sums below run forward through both their series.
+    let mut reversed = [0.0; MAX_ORDER];
     for m in 0..p {
         // The sum `sum_{j=1}^{m} D_j ratio_{m-j}` added in the order j = 1, ..., m from -0.0.
-        ratio[m] = if m == 0 {
+        let ratio = if m == 0 {
             (divisor - 2.0 * k) / divisor
         } else {
-            let below = convolution(&scaled_cube[1..=m], &ratio[..m]);
+            let below = ordered_dot(&scaled_cube[1..=m], &reversed[MAX_ORDER - m..]);
             (scaled_cube[m] - below) / divisor
         };
-        derivative[m] = convolution(&square[..=m], &ratio[..=m]);
+        reversed[MAX_ORDER - 1 - m] = ratio;
+        derivative[m] = ordered_dot(&square[..=m], &reversed[MAX_ORDER - 1 - m..]);
     }
+}
+
+/// `sum_j a_j b_j` over the length of `a` (`b` at least as long), the products formed four at a
+/// time and added one by one in the order `j = 0, 1, ...` from `-0.0`: the same bits as
+/// [`convolution`] of `a` with `b` reversed, without reversing lanes.
+#[inline(always)]
+fn ordered_dot(a: &[f64], b: &[f64]) -> f64 {
+    let b = &b[..a.len()];
+    let mut sum = -0.0;
+    let (a_blocks, b_blocks) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (a_rest, b_rest) = (a_blocks.remainder(), b_blocks.remainder());
+    for (x, y) in a_blocks.zip(b_blocks) {
+        let products = [x[0] * y[0], x[1] * y[1], x[2] * y[2], x[3] * y[3]];
+        sum += products[0];
+        sum += products[1];
+        sum += products[2];
+        sum += products[3];
+    }
+    for (x, y) in a_rest.iter().zip(b_rest) {
+        sum += x * y;
+    }
+    sum
 }
 
 /// The coefficients of the tangent recurrence of [`contact_tangent_series`].
