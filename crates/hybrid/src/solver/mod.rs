@@ -120,12 +120,11 @@
 //!   (afm's JKR series run on the time clock only), whose tangents would be summed at the
 //!   branch point. In such a mode Runge-Kutta steps make the whole approach: after the last
 //!   series step, a step in time at most `SERIES_HANDOVER_FRACTION` of the way to the crossing
-//!   its series predicted; then steps on the square-root clock, each located by continuing the last one up to its
-//!   reference (past it, the continuation in `sigma` retraces the approach); and the step that
-//!   reaches the crossing so located lands on it, on the clock centred there. That location,
-//!   extrapolated far in `sigma`, may fall short of the crossing, and a landing that ends short
-//!   would leave the branch point at its end: a landing whose end is still on the mode's side
-//!   of the surface is not accepted, and a probe just past the crossing takes its place.
+//!   its series predicted; then steps on the square-root clock, each located by continuing the
+//!   last one up to its reference (past it, the continuation in `sigma` retraces the approach);
+//!   and the step that reaches the crossing so located probes rather than lands (that location,
+//!   extrapolated far in `sigma`, may fall short of the crossing, leaving the branch point at
+//!   the landing's end).
 //!
 //! # Taylor-series steps
 //!

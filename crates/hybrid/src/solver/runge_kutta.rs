@@ -4,7 +4,7 @@
 use crate::clock::Clock;
 use crate::dop853::Dop853;
 use crate::error::HybridError;
-use crate::system::{side_sign, HybridSystem, Mode};
+use crate::system::{HybridSystem, Mode};
 
 use super::crossing_search::crossing_fraction;
 use super::predictors::{predict_crossing, resolvable};
@@ -45,10 +45,6 @@ struct Attempts {
     rejected: bool,
     /// Whether the last attempt gave a non-finite error.
     non_finite: bool,
-    /// A landing on a crossing of surface `k` located by continuing a square-root step, not yet
-    /// seen to reach it: `(k, distance)`, the located distance for the probe that replaces the
-    /// landing if it ends short of the crossing.
-    unverified_landing: Option<(usize, f64)>,
 }
 
 /// One attempt: its clock step, end time, whether it ends at `t_end`, and its error (accepted
@@ -96,7 +92,6 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             previous: None,
             rejected: false,
             non_finite: false,
-            unverified_landing: None,
         };
         self.aim_at_crossing(t_end, half_power, &mut attempts);
         attempts.sigma0 = attempts.clock.sigma(t0);
@@ -106,17 +101,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
         let trial = loop {
             self.check_attempt(&attempts)?;
             let trial = self.attempt(t_end, &attempts);
-            let unverified = attempts.unverified_landing.take();
             if trial.error.is_finite() && trial.error <= 1.0 {
-                match unverified {
-                    Some((k, distance)) if self.ends_short_of(k, trial.t1) => {
-                        self.statistics.rejected_steps += 1;
-                        attempts.rejected = true;
-                        self.probe_instead(base_clock, distance, &mut attempts);
-                        continue;
-                    }
-                    _ => break trial,
-                }
+                break trial;
             }
             self.statistics.rejected_steps += 1;
             attempts.rejected = true;
@@ -215,20 +201,13 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
             } else {
                 None
             };
-            // Located by a series expanded before it: too coarse to land on. After a series, a
+            // Located by continuing a square-root step centred ahead (`continue_last_step`), or
+            // by a series expanded before it: too coarse to land on (a landing that ends short
+            // of the crossing leaves the tangents' branch point at its end). After a series, a
             // step in time at most `SERIES_HANDOVER_FRACTION` of the way (not a probe from afar,
             // which the crossing's square root rejects, nor a square-root clock centred on the
             // series' estimate: tried, it left the adhesive retract's period doublings 7e-9 nm
-            // off; where the series saw no crossing within its look-ahead, the same fraction of
-            // the quadratic's distance was tried: it spares a rejected attempt in 2 of 3
-            // pull-offs of `biolever-sticky` but moved located period doublings by up to 1e-9
-            // nm, beyond their spread under the step size on main). Located by continuing a
-            // square-root step centred ahead (`continue_last_step`): the step that reaches it
-            // lands on it, on the square-root clock centred there, and is verified: a landing
-            // that ends short of the crossing would leave the tangents' branch point at its end
-            // (where the located crossing fell short), so it is not accepted and a probe just
-            // past the crossing replaces it (`Solver::probe_instead`); a landing that holds the
-            // crossing is redone onto the crossing located in it (`Solver::redo_onto_crossing`).
+            // off); after a continued square-root step, the step that reaches it probes.
             let continued_root_clock = divergent
                 && matches!(self.clock, Clock::SquareRoot { reference } if reference > t0);
             match located {
@@ -243,12 +222,8 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                         && h >= t_cross - t0
                         && t_cross - t0 <= max_step =>
                 {
-                    let target = (t_cross - t0) * (1.0 + ROOT_OVERSHOOT);
-                    let reference = t0 + target;
-                    attempts.clock = Clock::SquareRoot { reference };
-                    attempts.crossing_target = Some(reference);
-                    attempts.h = target;
-                    attempts.unverified_landing = Some((k, t_cross - t0));
+                    attempts.h = ((t_cross - t0) * (1.0 + PROBE_OVERSHOOT)).min(max_step);
+                    attempts.landing = Some(t_cross - t0);
                 }
                 Some(t_cross) if resolvable(t_cross - t0, t0) && t_cross - t0 <= max_step => {
                     let target = (t_cross - t0) * (1.0 + ROOT_OVERSHOOT);
@@ -274,29 +249,6 @@ impl<'a, S: HybridSystem + ?Sized> Solver<'a, S> {
                 attempts.h = h.min(APPROACH_FRACTION * s);
             }
         }
-    }
-
-    /// Whether the accepted attempt ending at `t1` (state in `z_new`) ends on the mode's side of
-    /// surface `k`, short of the crossing it was to land just past.
-    fn ends_short_of(&self, k: usize, t1: f64) -> bool {
-        let n = self.n;
-        side_sign(self.mode, k) * self.system.switching(k, t1, &self.buffers.z_new[..n]) >= 0.0
-    }
-
-    /// Instead of a landing that ended short of the crossing located `distance` ahead (by
-    /// continuing a square-root step): a probe on `base_clock`, just past it, whose dense output
-    /// locates it if the crossing's kink makes it fail.
-    fn probe_instead(&mut self, base_clock: Clock, distance: f64, attempts: &mut Attempts) {
-        let (mode, t0) = (self.mode, self.t);
-        attempts.clock = base_clock;
-        attempts.sigma0 = base_clock.sigma(t0);
-        attempts.stage0 =
-            self.prepare_first_stage(mode, base_clock, attempts.sigma0, attempts.stage0);
-        attempts.crossing_target = None;
-        attempts.h = (distance * (1.0 + PROBE_OVERSHOOT)).min(self.settings.max_step);
-        attempts.landing = Some(distance);
-        attempts.landing_tried = true;
-        attempts.previous = None;
     }
 
     /// Refuse a further attempt: too many steps, or a step too short to advance time (after a
