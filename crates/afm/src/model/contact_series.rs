@@ -793,18 +793,7 @@ pub(crate) fn contact_tangent_series(
             let square = &root[LEN..LEN + p];
             let cube = &root[2 * LEN..2 * LEN + p];
             let divisor = root[3 * LEN];
-            let mut ratio = [0.0; MAX_ORDER];
-            let (r, k) = (law.tip_radius_nm, law.adhesion_root());
-            for m in 0..p {
-                // D_0 = d delta/db, N_0 = D_0 - 2 k; D_m = N_m = 4 c_m / R for m >= 1.
-                ratio[m] = if m == 0 {
-                    (divisor - 2.0 * k) / divisor
-                } else {
-                    let below: f64 = (1..=m).map(|j| 4.0 * cube[j] / r * ratio[m - j]).sum();
-                    (4.0 * cube[m] / r - below) / divisor
-                };
-                derivative[m] = convolution(&square[..=m], &ratio[..=m]);
-            }
+            jkr_slope_series(&law, square, cube, divisor, &mut derivative[..p]);
             (-2.0 * law.effective_modulus_gpa, &derivative[..p])
         }
         SeriesForce::Hydration {
@@ -839,6 +828,94 @@ pub(crate) fn contact_tangent_series(
         parameter_column,
     };
     recurrence.run_all(columns, tangents.coefficients_mut(), gaps);
+}
+
+/// The series of JKR's `-dF/ddelta / (-2 E*) = p N / D` to the length of `derivative` (module
+/// docs, [`contact_tangent_series`]: `N = 4 c/R - 3 k`, `D = d delta/db = 4 c/R - k`), from the
+/// state recurrence's `p = b^2` (`square`), `c = b^3` (`cube`) and `D_0` (`divisor`), compiled
+/// for the CPU's AVX where it has it (the same operations in the same order: the same bits).
+fn jkr_slope_series(
+    law: &JkrContact,
+    square: &[f64],
+    cube: &[f64],
+    divisor: f64,
+    derivative: &mut [f64],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the CPU has AVX, checked just above.
+        unsafe { jkr_slope_series_avx(law, square, cube, divisor, derivative) };
+        return;
+    }
+    jkr_slope_recurrence(law, square, cube, divisor, derivative);
+}
+
+/// [`jkr_slope_recurrence`] compiled with AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn jkr_slope_series_avx(
+    law: &JkrContact,
+    square: &[f64],
+    cube: &[f64],
+    divisor: f64,
+    derivative: &mut [f64],
+) {
+    jkr_slope_recurrence(law, square, cube, divisor, derivative);
+}
+
+/// The recurrence of [`jkr_slope_series`]: the ratio `N / D` by series division (`D_m = N_m =
+/// 4 c_m / R` for `m >= 1`, `N_0 = D_0 - 2 k`), then its product with `p`.
+#[inline(always)]
+fn jkr_slope_recurrence(
+    law: &JkrContact,
+    square: &[f64],
+    cube: &[f64],
+    divisor: f64,
+    derivative: &mut [f64],
+) {
+    let p = derivative.len();
+    let (r, k) = (law.tip_radius_nm, law.adhesion_root());
+    // `D_m` for m >= 1, each formed once.
+    let mut scaled_cube = [0.0; MAX_ORDER];
+    for (scaled, c) in scaled_cube[..p].iter_mut().zip(&cube[..p]) {
+        *scaled = 4.0 * c / r;
+    }
+    // The ratio's coefficients highest power first (`ratio_i` at `MAX_ORDER - 1 - i`), so that
+    // both sums below run forward through both their series.
+    let mut reversed = [0.0; MAX_ORDER];
+    for m in 0..p {
+        // The sum `sum_{j=1}^{m} D_j ratio_{m-j}` added in the order j = 1, ..., m from -0.0.
+        let ratio = if m == 0 {
+            (divisor - 2.0 * k) / divisor
+        } else {
+            let below = ordered_dot(&scaled_cube[1..=m], &reversed[MAX_ORDER - m..]);
+            (scaled_cube[m] - below) / divisor
+        };
+        reversed[MAX_ORDER - 1 - m] = ratio;
+        derivative[m] = ordered_dot(&square[..=m], &reversed[MAX_ORDER - 1 - m..]);
+    }
+}
+
+/// `sum_j a_j b_j` over the length of `a` (`b` at least as long), the products formed four at a
+/// time and added one by one in the order `j = 0, 1, ...` from `-0.0`: the same bits as
+/// [`convolution`] of `a` with `b` reversed, without reversing lanes.
+#[inline(always)]
+fn ordered_dot(a: &[f64], b: &[f64]) -> f64 {
+    let b = &b[..a.len()];
+    let mut sum = -0.0;
+    let (a_blocks, b_blocks) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (a_rest, b_rest) = (a_blocks.remainder(), b_blocks.remainder());
+    for (x, y) in a_blocks.zip(b_blocks) {
+        let products = [x[0] * y[0], x[1] * y[1], x[2] * y[2], x[3] * y[3]];
+        sum += products[0];
+        sum += products[1];
+        sum += products[2];
+        sum += products[3];
+    }
+    for (x, y) in a_rest.iter().zip(b_rest) {
+        sum += x * y;
+    }
+    sum
 }
 
 /// The coefficients of the tangent recurrence of [`contact_tangent_series`].
