@@ -7,7 +7,10 @@
 //! point lies within its precision, so the same diagram continued with another largest step
 //! must have a point of the same label within the two precisions.
 
-use afm::{approach_diagram, builtin_case, BifurcationDiagram, DiagramSettings, TappingModel};
+mod approach_retract;
+
+use afm::{builtin_case, BifurcationDiagram, TappingModel};
+use approach_retract::approach;
 
 /// The location tolerance of the continuation (nm): two converged locations of one point may
 /// differ by their precisions plus this much.
@@ -24,12 +27,7 @@ fn sticky_approach(
     let mut case = builtin_case("biolever-sticky").unwrap();
     case.free_amplitude_nm = a0_nm;
     case.drive_frequency_khz = drive_khz;
-    let model = TappingModel::from_case(&case).unwrap();
-    let mut settings = DiagramSettings::approach(&model);
-    if let Some(step) = max_step {
-        settings.max_step = step;
-    }
-    approach_diagram(&model, &settings).unwrap()
+    approach(&TappingModel::from_case(&case).unwrap(), max_step)
 }
 
 /// Every converged special point of `a` has a point of the same label in `b` within the sum

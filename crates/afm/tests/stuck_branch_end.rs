@@ -5,19 +5,15 @@
 //! retract reported it, and an approach jumped with no point at all (`biolever-sticky` with
 //! A0 = 6 nm at 1.4945 nm, with A0 = 8 nm at largest step 0.02 at 5.5114 nm).
 
-use afm::{approach_diagram, builtin_case, BifurcationDiagram, DiagramSettings, TappingModel};
+mod approach_retract;
+
+use afm::BifurcationDiagram;
+use approach_retract::{approach, model};
 
 /// The approach diagram of `biolever-sticky` with free amplitude `a0_nm` (nm) and largest step
 /// `max_step` (nm, `None`: the default).
 fn sticky_approach(a0_nm: f64, max_step: Option<f64>) -> BifurcationDiagram {
-    let mut case = builtin_case("biolever-sticky").unwrap();
-    case.free_amplitude_nm = a0_nm;
-    let model = TappingModel::from_case(&case).unwrap();
-    let mut settings = DiagramSettings::approach(&model);
-    if let Some(step) = max_step {
-        settings.max_step = step;
-    }
-    approach_diagram(&model, &settings).unwrap()
+    approach(&model("biolever-sticky", Some(a0_nm)), max_step)
 }
 
 /// The consecutive points `(z_before, z_after)` (nm) between which `A/A0` changes by more than

@@ -16,18 +16,24 @@ pub fn model(case: &str, a0: Option<f64>) -> TappingModel {
 }
 
 /// The approach of `model` with largest step `max_step` (nm; the default `A0 / 250` where
+/// `None`).
+pub fn approach(model: &TappingModel, max_step: Option<f64>) -> BifurcationDiagram {
+    let defaults = DiagramSettings::approach(model);
+    let settings = DiagramSettings {
+        max_step: max_step.unwrap_or(defaults.max_step),
+        ..defaults
+    };
+    approach_diagram(model, &settings).unwrap()
+}
+
+/// The approach of `model` with largest step `max_step` (nm; the default `A0 / 250` where
 /// `None`), and the retract from its lowest point with the same largest step.
 pub fn approach_and_retract(
     model: &TappingModel,
     max_step: Option<f64>,
 ) -> (BifurcationDiagram, BifurcationDiagram) {
-    let defaults = DiagramSettings::approach(model);
-    let max_step = max_step.unwrap_or(defaults.max_step);
-    let approach_settings = DiagramSettings {
-        max_step,
-        ..defaults
-    };
-    let approach = approach_diagram(model, &approach_settings).unwrap();
+    let approach = approach(model, max_step);
+    let max_step = max_step.unwrap_or(DiagramSettings::approach(model).max_step);
     let lowest = approach
         .points
         .iter()
