@@ -267,6 +267,30 @@ pub fn line_json(line: &ScanLine) -> Value {
     })
 }
 
+/// A PI setting's error named by the option that sets it (`--scan-rate 1e9: allowed ...`), as
+/// every other option's is; other errors as they are.
+fn pi_option_error(error: afm::AfmError) -> anyhow::Error {
+    if let afm::AfmError::InvalidField {
+        file,
+        field,
+        value,
+        allowed,
+    } = &error
+    {
+        let option = match field.as_str() {
+            "gain_p" => Some("--gain-p"),
+            "gain_i_per_ms" => Some("--gain-i"),
+            "scan_rate_nm_per_s" => Some("--scan-rate"),
+            "lockin_time_constant_ms" => Some("--lockin-time-constant"),
+            _ => None,
+        };
+        if let (Some(option), "PI settings") = (option, file.as_str()) {
+            return anyhow::anyhow!("{option} {value}: allowed {allowed}");
+        }
+    }
+    error.into()
+}
+
 /// The pixels of the scan of `line` with the cantilever, drive and A0 of `case`, `settings`
 /// and the PI options of `args`, and the `inputs` object of the output; `progress` is told
 /// the pixels done after each and stops the scan by answering `true`. Shared with the Python
@@ -287,7 +311,8 @@ pub fn scan_pixels(
         ),
         Feedback::Pi => {
             let pi = args.pi(case)?;
-            let pixels = pi_scan_until(case, line, settings, &pi, progress)?;
+            let pixels =
+                pi_scan_until(case, line, settings, &pi, progress).map_err(pi_option_error)?;
             (
                 pixels,
                 pi.integration.clone(),
