@@ -217,9 +217,8 @@ pub fn diagram_settings(args: &ContinueArgs, model: &TappingModel) -> Result<Dia
 
 /// The approach diagram's settings of `model` with the options `--floor` (in `[-A0, Z_G1)`),
 /// `--min-amplitude-ratio` and `--max-step` (in `[1e-7, A0]`: [`afm::smallest_max_step_nm`])
-/// applied, each checked against
-/// [`crate::option_ranges`] (errors name the option and its range); shared by `continue` and
-/// `map`.
+/// applied, each checked against [`crate::option_ranges`] (errors name the option and its
+/// range); shared by `continue` and `map`.
 pub fn approach_settings(
     model: &TappingModel,
     floor: Option<f64>,

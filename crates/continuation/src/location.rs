@@ -244,13 +244,19 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     /// a hysteretic grazing the two ends are orbits of different families, far apart in state
     /// while their parameters differ little, and a trial shot at a parameter between them can
     /// converge onto either family; this says which.
-    pub(crate) fn nearer_far_end(&self, index: usize) -> bool {
+    fn nearer_far_end(&self, index: usize) -> bool {
         let n = self.u_a.len() - 1;
         let samples = self.samples.borrow();
         let x = samples[index].u.rows(0, n);
         let from_near = (x - self.u_a.rows(0, n)).norm();
         let from_far = (x - self.u_a.rows(0, n) - self.delta.rows(0, n)).norm();
         from_far < from_near
+    }
+
+    /// Whether cached samples `a` and `b` lie on different sides of the segment's jump, one
+    /// nearer its near end, the other nearer its far end ([`Segment::nearer_far_end`]).
+    pub(crate) fn across_jump(&self, a: usize, b: usize) -> bool {
+        self.nearer_far_end(a) != self.nearer_far_end(b)
     }
 
     /// Parameter at `sigma`: linear in natural mode, else that of the cached sample at

@@ -73,6 +73,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     ) -> Result<Vec<(usize, usize)>, ContinuationError> {
         let tolerance = self.settings.location_tolerance;
         let max_iterations = self.settings.location_max_iterations;
+        let across_families = jumped && self.settings.hysteretic_grazing;
         let mut breaks: Vec<(usize, usize)> = Vec::new();
         for test in structure {
             let value = |s: &Sample| test.value(s.sigma, &s.map.structure);
@@ -97,8 +98,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             );
             let extrapolates = match near_side_vanishing(test) {
                 Some(vanishing)
-                    if jumped
-                        && self.settings.hysteretic_grazing
+                    if across_families
                         && (vanishing == Vanishing::Quadratically
                             || (release && location.high.is_none())) =>
                 {
@@ -141,16 +141,12 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             // between an orbit of the near family and one of the far family is the jump itself
             // (the far family's structure), not a change along either branch: the grazing
             // that causes the jump is the point reported there.
-            let between_families = match (location.low, location.high) {
-                (Some(low), Some(high)) => {
-                    segment.nearer_far_end(low) != segment.nearer_far_end(high)
-                }
-                _ => false,
-            };
-            if jumped
-                && self.settings.hysteretic_grazing
-                && between_families
+            if across_families
                 && !matches!(kind, SpecialPointKind::Grazing | SpecialPointKind::PullOff)
+                && location
+                    .low
+                    .zip(location.high)
+                    .is_some_and(|(low, high)| segment.across_jump(low, high))
             {
                 continue;
             }
@@ -292,7 +288,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// period map jumps there), where the two sides are different families of orbits (the far
     /// one's tangent oriented along the jump's secant) and trials between them converge onto
     /// either: there a test is located only between two orbits of one family
-    /// ([`Segment::nearer_far_end`]), and a sign change across the jump is not reported.
+    /// ([`Segment::across_jump`]), and a sign change across the jump is not reported.
     fn locate_smooth_changes(
         &self,
         segment: &Segment<'_, P>,
@@ -351,7 +347,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 gl.is_finite()
                     && gh.is_finite()
                     && sign(gl) != sign(gh)
-                    && !(across_families && segment.nearer_far_end(l) != segment.nearer_far_end(h))
+                    && !(across_families && segment.across_jump(l, h))
             });
             let (kind, location) = match continuous {
                 Some((l, h)) => {
