@@ -9,8 +9,11 @@ use afm::{
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde_json::json;
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
 
 use crate::continue_figure::{contrast_figure, figure, CaseDiagrams, PanelQuantity};
 use crate::diagram_json::DiagramJson;
@@ -77,6 +80,11 @@ pub struct ContinueArgs {
     /// highest harmonic --panels draws).
     #[arg(long, default_value_t = crate::approach::DEFAULT_HARMONICS, allow_negative_numbers = true)]
     pub harmonics: i64,
+    /// With several --case: how many cases are computed at once, one per thread (default: one
+    /// per core). The output does not depend on it: each case is printed, in the order given,
+    /// as soon as it and the cases before it are done.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// One case's approach, its optional retract and their bistable ranges.
@@ -96,13 +104,18 @@ pub struct Continued {
     pub warning: Option<String>,
 }
 
-/// Run `drumroll continue`: each `--case` in turn (tables or JSON lines printed as they are
-/// computed), then the CSV (one case) and the figure.
+/// Run `drumroll continue`: every `--case`'s model built and its options checked first, the
+/// cases then computed on up to `--threads` threads ([`continue_cases`]), each printed (tables
+/// or JSON lines) in the order given as soon as it and those before it are done; then the CSV
+/// (one case) and the figure.
 pub fn run(args: &ContinueArgs) -> Result<()> {
     // The options that need no model, checked before the output paths and the models.
     option_ranges::MIN_AMPLITUDE_RATIO.check(args.min_amplitude_ratio)?;
     option_ranges::MAX_POINTS.count(args.max_points)?;
     option_ranges::HARMONICS.count(args.harmonics)?;
+    if args.threads == Some(0) {
+        bail!("--threads 0: allowed 1 or more");
+    }
     let panels = args
         .panels
         .as_deref()
@@ -125,18 +138,33 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             cases.len()
         );
     }
-    let several = cases.len() > 1;
+    // Every case's model and model-dependent options (--floor, --max-step) before any
+    // computation, so that a bad input is reported at once, not after the cases before it.
+    let models = cases
+        .into_iter()
+        .map(model_of)
+        .collect::<Result<Vec<_>>>()?;
+    let several = models.len() > 1;
+    for (case, model) in &models {
+        let checked = diagram_settings(args, model);
+        if several {
+            checked.with_context(|| format!("case `{}`", case.name))?;
+        } else {
+            checked?;
+        }
+    }
     let mut drawn = Vec::new();
     let mut unfinished = Vec::new();
     let mut progress = Progress::new(
-        cases.len() as u64,
-        "{wide_bar} {pos}/{len} cases, now {msg}, {eta} left",
+        models.len() as u64,
+        "{wide_bar} {pos}/{len} cases, last {msg}, {eta} left",
     );
-    for (done, case) in cases.into_iter().enumerate() {
-        progress.update(done as u64, || case.name.clone());
-        let (case, model) = model_of(case)?;
-        let continued = continue_case(args, &case, &model)?;
-        print_report(args, &case, &model, &continued)?;
+    continue_cases(args, &models, |done, (case, model), continued| {
+        progress.update(done as u64 + 1, || case.name.clone());
+        if let Some(warning) = &continued.warning {
+            eprintln!("warning: {warning}");
+        }
+        print_report(args, case, model, &continued)?;
         if let Some(path) = &csv_path {
             write_atomically(path, continued_csv(&continued)?.as_bytes())?;
         }
@@ -148,12 +176,13 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             });
         }
         drawn.push(CaseDiagrams {
-            case,
-            model,
+            case: case.clone(),
+            model: model.clone(),
             approach: continued.approach,
             retract: continued.retract,
         });
-    }
+        Ok(())
+    })?;
     progress.finish();
     if let Some(plot) = plot {
         let svg = match &panels {
@@ -177,6 +206,70 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         String::new()
     };
     Err(Incomplete(format!("{}{hint}", unfinished.join("; "))).into())
+}
+
+/// Compute the approach (and retract) of every case of `models` with `continue`'s options
+/// `args`, up to `args.threads` cases at once (default: one thread per core, at most one per
+/// case), and hand each to `report` in the order of `models` (its index, the case and model,
+/// the result) as soon as it and every case before it are done. The first error in that order
+/// (a case's continuation, or `report`'s) is returned after the cases before it were reported;
+/// the cases still running are then interrupted ([`afm::diagram_until`]'s predicate) and
+/// dropped. Each case's computation is that of one thread alone, so the results do not depend
+/// on the number of threads; with one thread the cases run on the calling thread.
+fn continue_cases<F>(
+    args: &ContinueArgs,
+    models: &[(Case, TappingModel)],
+    mut report: F,
+) -> Result<()>
+where
+    F: FnMut(usize, &(Case, TappingModel), Continued) -> Result<()>,
+{
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let threads = args.threads.unwrap_or(cores).clamp(1, models.len().max(1));
+    if threads == 1 {
+        // One at a time, on this thread (its stack, no thread started).
+        for (index, (case, model)) in models.iter().enumerate() {
+            let continued = continue_case_until(args, case, model, &mut || false)?;
+            report(index, &models[index], continued)?;
+        }
+        return Ok(());
+    }
+    let next = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    let (sender, receiver) = mpsc::channel::<(usize, Result<Continued>)>();
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            let sender = sender.clone();
+            let (next, stop) = (&next, &stop);
+            scope.spawn(move || loop {
+                let index = next.fetch_add(1, Ordering::Relaxed);
+                if index >= models.len() || stop.load(Ordering::Relaxed) {
+                    break;
+                }
+                let (case, model) = &models[index];
+                let continued =
+                    continue_case_until(args, case, model, &mut || stop.load(Ordering::Relaxed));
+                if sender.send((index, continued)).is_err() {
+                    break;
+                }
+            });
+        }
+        drop(sender);
+        let mut waiting = BTreeMap::new();
+        let mut reported = 0;
+        let outcome = receiver.iter().try_for_each(|(index, continued)| {
+            waiting.insert(index, continued);
+            while let Some(continued) = waiting.remove(&reported) {
+                report(reported, &models[reported], continued?)?;
+                reported += 1;
+            }
+            Ok(())
+        });
+        if outcome.is_err() {
+            stop.store(true, Ordering::Relaxed);
+        }
+        outcome
+    })
 }
 
 /// `None` when every branch reached its requested end, else which did not and why (the run
@@ -246,16 +339,6 @@ pub fn approach_settings(
         settings.max_step = step;
     }
     Ok(settings)
-}
-
-/// The approach (and retract) of one case; the film-range warning, if any, printed on
-/// stderr.
-fn continue_case(args: &ContinueArgs, case: &Case, model: &TappingModel) -> Result<Continued> {
-    let continued = continue_case_until(args, case, model, &mut || false)?;
-    if let Some(warning) = &continued.warning {
-        eprintln!("warning: {warning}");
-    }
-    Ok(continued)
 }
 
 /// The approach (and retract) of one case with `continue`'s options `args`; `interrupted` is

@@ -352,3 +352,68 @@ fn maclever_on_mica_retract_reports_the_bistable_range_between_the_folds() {
         state_distance(&end_a, &end_b)
     );
 }
+
+/// Run `drumroll continue <args> --json -q`: its exit success, stdout and stderr.
+fn continue_lines(args: &[&str]) -> (bool, String, String) {
+    let output = drumroll()
+        .arg("continue")
+        .args(args)
+        .args(["--json", "-q"])
+        .output()
+        .expect("runs");
+    (
+        output.status.success(),
+        String::from_utf8(output.stdout).expect("UTF-8"),
+        String::from_utf8(output.stderr).expect("UTF-8"),
+    )
+}
+
+#[test]
+fn several_cases_on_several_threads_print_each_case_as_alone_in_the_order_given() {
+    // The reference: each case computed by a run of its own (one thread).
+    let alone: Vec<String> = ["biolever-soft", "maclever-soft"]
+        .iter()
+        .map(|case| {
+            let (ok, out, err) = continue_lines(&["--case", case]);
+            assert!(ok, "{err}");
+            out
+        })
+        .collect();
+    // Given in the reverse of the order they finish in on two threads (the MAClever's diagram
+    // is the cheaper), on one thread, two and three (more threads than cases).
+    for threads in ["1", "2", "3"] {
+        let (ok, out, err) = continue_lines(&[
+            "--case",
+            "biolever-soft",
+            "--case",
+            "maclever-soft",
+            "--threads",
+            threads,
+        ]);
+        assert!(ok, "{err}");
+        assert_eq!(out, alone.concat(), "--threads {threads}");
+    }
+    let (ok, out, err) = continue_lines(&["--case", "maclever-soft", "--threads", "0"]);
+    assert!(!ok && out.is_empty());
+    assert!(err.contains("--threads 0: allowed 1 or more"), "{err}");
+}
+
+#[test]
+fn a_bad_option_for_a_later_case_is_refused_before_any_case_is_computed() {
+    // --floor 15 nm is inside the MAClever's range (Z_G1 = 19.999 nm), not the Biolever's
+    // (Z_G1 = 10.012 nm): the run stops before printing the MAClever's diagram.
+    let (ok, out, err) = continue_lines(&[
+        "--case",
+        "maclever-soft",
+        "--case",
+        "biolever-soft",
+        "--floor",
+        "15",
+    ]);
+    assert!(!ok);
+    assert!(out.is_empty(), "nothing printed: {out}");
+    assert!(
+        err.contains("case `biolever-soft`") && err.contains("--floor 15: allowed [-10, 10.01"),
+        "{err}"
+    );
+}

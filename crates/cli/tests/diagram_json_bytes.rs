@@ -90,6 +90,7 @@ fn args(floor: Option<f64>, max_points: i64, retract: bool) -> ContinueArgs {
         overlay: false,
         panels: None,
         harmonics: drumroll::approach::DEFAULT_HARMONICS,
+        threads: None,
     }
 }
 

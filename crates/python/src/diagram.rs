@@ -174,6 +174,7 @@ pub fn compute_diagram(
         overlay: false,
         panels: None,
         harmonics: options.harmonics,
+        threads: None,
     };
     let (json, warning) = without_gil(
         py,

@@ -84,6 +84,7 @@ impl DiagramRequest {
             overlay: false,
             panels: None,
             harmonics: drumroll::approach::DEFAULT_HARMONICS,
+            threads: None,
         }
     }
 
