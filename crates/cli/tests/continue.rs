@@ -269,28 +269,35 @@ fn bad_options_are_refused_with_a_message_naming_the_option_and_its_range() {
 #[test]
 fn maclever_on_mica_retract_reports_the_bistable_range_between_the_folds() {
     let diagram = continue_json(&["--case", "maclever-mica", "--retract"]);
-    let folds: Vec<f64> = diagram["special_points"]
-        .as_array()
-        .expect("special points")
-        .iter()
-        .filter(|s| s["label"] == "fold")
-        .map(|s| number(&s["z_nm"]))
-        .collect();
+    // Each fold's Z and stated precision (its bracket's width, nm).
+    let folds_of = |branch: &Value| -> Vec<(f64, f64)> {
+        branch["special_points"]
+            .as_array()
+            .expect("special points")
+            .iter()
+            .filter(|s| s["label"] == "fold")
+            .map(|s| (number(&s["z_nm"]), number(&s["precision_nm"])))
+            .collect()
+    };
+    let folds = folds_of(&diagram);
     assert_eq!(folds.len(), 2, "two folds on the approach");
-    let (fold_low, fold_high) = (folds[0].min(folds[1]), folds[0].max(folds[1]));
-    // The retract meets the same folds (located independently along its own points).
-    let retract_folds: Vec<f64> = diagram["retract"]["special_points"]
-        .as_array()
-        .expect("retract special points")
-        .iter()
-        .filter(|s| s["label"] == "fold")
-        .map(|s| number(&s["z_nm"]))
-        .collect();
+    let (fold_low, fold_high) = (folds[0].0.min(folds[1].0), folds[0].0.max(folds[1].0));
+    // The retract meets the same folds, located independently along its own points: each
+    // within the two locations' stated precisions of the approach's (half of each bracket,
+    // which carries the located orbit's own Newton error), and within 2e-9 nm.
+    let retract_folds = folds_of(&diagram["retract"]);
     assert_eq!(retract_folds.len(), 2);
-    for z in retract_folds {
+    for (z, precision) in retract_folds {
+        let (z_a, precision_a) = folds
+            .iter()
+            .copied()
+            .min_by(|a, b| (a.0 - z).abs().total_cmp(&(b.0 - z).abs()))
+            .expect("a fold");
+        let stated = 0.5 * (precision + precision_a);
         assert!(
-            (z - fold_low).abs() < 2e-9 || (z - fold_high).abs() < 2e-9,
-            "retract fold at {z} nm"
+            (z - z_a).abs() <= stated && stated < 2e-9,
+            "retract fold at {z} nm (precision {precision:.1e}) against the approach's {z_a} \
+             nm ({precision_a:.1e})"
         );
     }
     let ranges = diagram["bistable_ranges_nm"].as_array().expect("ranges");
@@ -415,5 +422,56 @@ fn a_bad_option_for_a_later_case_is_refused_before_any_case_is_computed() {
     assert!(
         err.contains("case `biolever-soft`") && err.contains("--floor 15: allowed [-10, 10.01"),
         "{err}"
+    );
+}
+
+#[test]
+fn silicon_in_air_locates_each_fold_and_grazing_alike_on_approach_and_retract() {
+    // The attractive-repulsive bistability of the silicon cantilever in air: two folds and G1,
+    // each met by the approach and again by the retract, located independently along each
+    // branch's own points. Next to a fold `M - I` is nearly singular, so an orbit within
+    // Newton's residual tolerance can sit 1e-8 nm off in Z (the two locations of the lower
+    // fold differed by 3.2e-8 nm while each stated 1e-12): each location must agree with the
+    // other within the two stated precisions (half of each bracket), and be converged (to the
+    // 1e-9 nm location tolerance).
+    let diagram = continue_json(&["--case", "silicon-air-polymer", "--retract"]);
+    let located = |branch: &Value| -> Vec<(String, f64, f64, bool)> {
+        branch["special_points"]
+            .as_array()
+            .expect("special points")
+            .iter()
+            .map(|s| {
+                (
+                    s["label"].as_str().expect("label").to_string(),
+                    number(&s["z_nm"]),
+                    number(&s["precision_nm"]),
+                    s["converged"].as_bool().expect("converged"),
+                )
+            })
+            .collect()
+    };
+    let approach = located(&diagram);
+    let retract = located(&diagram["retract"]);
+    let mut matched = 0;
+    for (label, z, precision, converged) in &approach {
+        assert!(converged, "approach {label} at {z} nm not converged");
+        let Some((_, z_r, precision_r, converged_r)) = retract
+            .iter()
+            .find(|(l, z_r, _, _)| l == label && (z_r - z).abs() < 1e-6)
+        else {
+            continue;
+        };
+        assert!(converged_r, "retract {label} at {z_r} nm not converged");
+        let stated = 0.5 * (precision + precision_r);
+        assert!(
+            (z - z_r).abs() <= stated,
+            "{label}: approach {z} nm ({precision:.1e}) against retract {z_r} nm \
+             ({precision_r:.1e})"
+        );
+        matched += 1;
+    }
+    assert_eq!(
+        matched, 3,
+        "two folds and G1 on both branches: {approach:?} {retract:?}"
     );
 }

@@ -178,6 +178,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 far,
                 a.tangent.clone(),
                 self.settings.corrector.clone(),
+                self.settings.location_tolerance,
                 true,
             )
             .with_far_trajectory();

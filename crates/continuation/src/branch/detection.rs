@@ -4,9 +4,10 @@
 //! then the smooth tests (fold, period doubling, Neimark-Sacker) between their brackets.
 
 use super::Continuation;
+use crate::corrector::bordered;
 use crate::error::ContinuationError;
 use crate::extrapolated_zero::{extrapolated_zero, ExtrapolatedZero, Vanishing};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 use crate::location::{Location, Sample, Segment};
 use crate::problem::OrbitStructure;
@@ -163,16 +164,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 special.orbit_parameter = nearest.parameter();
                 special.multipliers = nearest.multipliers.clone();
             } else if let Some(error) = self.orbit_error_in_parameter(segment, test, &location) {
-                // Where the located orbit's own error reaches outside the bracket, the bracket's
-                // ends (orbits with about the same error) are widened by it; within it, the
-                // bracket is at least twice that error wide already.
-                let special = &mut point.1;
-                let (low, high) = special.bracket;
-                if special.parameter - error < low || special.parameter + error > high {
-                    special.bracket = (low - error, high + error);
-                    special.precision = special.bracket.1 - special.bracket.0;
-                    special.converged = special.converged && special.precision <= tolerance;
-                }
+                widen_by_orbit_error(&mut point.1, error, tolerance);
             }
             if extrapolated.is_none() && extrapolates.is_some() {
                 // No zero to extrapolate: the location's bracket ends where Newton stopped
@@ -392,9 +384,57 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 continue;
             }
             let converged = location.converged && continuous.is_some();
-            found.push(self.special_point(segment, kind, &location, converged, index));
+            let mut point = self.special_point(segment, kind, &location, converged, index);
+            if continuous.is_some() {
+                if let Some(error) = self.smooth_orbit_error_in_parameter(segment, test, &location)
+                {
+                    widen_by_orbit_error(&mut point.1, error, tolerance);
+                }
+            }
+            found.push(point);
         }
         Ok(())
+    }
+
+    /// How far in the parameter the located orbit's own error moves the zero of the smooth
+    /// test `test` (parameter units): the step `du = (dx, dp)` that Newton's bordered system
+    /// `[M - I, dP/dp; t^T] du = -[P(x; p) - x; 0]` leaves undone at the located point `u` (`t`
+    /// its unit tangent: `du` is orthogonal to the branch, so `u + du` lies on the branch at
+    /// the same arclength to first order), `|dp| + |g(u + du) - g(u)| / |dg/dp|`, with `g(u +
+    /// du)` from a period map, tangent and multipliers at `u + du` and the slope `dg/dp` from
+    /// the located point to the segment's start (or, at the start itself, its end). At a fold
+    /// (`g = t_p`, whose slope in `p` is unbounded there) this is `|dp|`: the fold's parameter
+    /// to first order. `None` where any of these is not available.
+    fn smooth_orbit_error_in_parameter(
+        &self,
+        segment: &Segment<'_, P>,
+        test: SampleTest,
+        location: &Location,
+    ) -> Option<f64> {
+        let point = location.point.as_ref()?;
+        let n = point.u.len() - 1;
+        if point.tangent.iter().any(|t| !t.is_finite()) {
+            return None;
+        }
+        let mut rhs = DVector::zeros(n + 1);
+        for i in 0..n {
+            rhs[i] = point.u[i] - point.map.image[i];
+        }
+        let step = bordered(&point.map, &point.tangent).lu().solve(&rhs)?;
+        let moved = &point.u + &step;
+        let map = self
+            .problem
+            .period_map(&moved.as_slice()[..n], moved[n])
+            .ok()?;
+        let corrected = Sample::new(point.sigma, moved, map, &point.tangent);
+        let g = test(point);
+        let other = [0, 1]
+            .into_iter()
+            .map(|index| segment.sample_ref(index))
+            .find(|s| s.parameter() != point.parameter())?;
+        let slope = (test(&other) - g).abs() / (other.parameter() - point.parameter()).abs();
+        let error = step[n].abs() + (test(&corrected) - g).abs() / slope;
+        error.is_finite().then_some(error)
     }
 
     /// Assemble a special point from a location.
@@ -458,5 +498,18 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 branch_index: index,
             },
         )
+    }
+}
+
+/// Widen a located point's bracket by its orbit's own error `error` (parameter units) where
+/// that error reaches outside the bracket (the bracket's ends, orbits with about the same
+/// error, each moved out by it; within it, the bracket is at least twice that error wide
+/// already), its precision the new width and `converged` kept only within `tolerance`.
+fn widen_by_orbit_error(special: &mut SpecialPoint, error: f64, tolerance: f64) {
+    let (low, high) = special.bracket;
+    if special.parameter - error < low || special.parameter + error > high {
+        special.bracket = (low - error, high + error);
+        special.precision = special.bracket.1 - special.bracket.0;
+        special.converged = special.converged && special.precision <= tolerance;
     }
 }

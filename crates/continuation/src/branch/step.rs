@@ -295,6 +295,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             b,
             reference,
             self.settings.corrector.clone(),
+            self.settings.location_tolerance,
             jumped,
         );
         let special = self.locate_all(&segment, structure, index, jumped, true)?;
