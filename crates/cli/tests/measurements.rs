@@ -175,3 +175,52 @@ fn fit_refuses_bad_parameter_lists() {
         assert!(stderr.contains(message), "{list}: {stderr}");
     }
 }
+
+/// The fit's Jacobian columns and the detection of the transitions run in parallel (rayon)
+/// with the serial result: a short fit (one evaluation's patience; the calibration and the
+/// modulus, whose columns are central differences of two followed branches each) prints the
+/// same bytes on one thread and on two (`RAYON_NUM_THREADS`), and so does a fit whose step
+/// leaves the tip radius's range (the error, on stderr, with the same exit code).
+#[test]
+fn fit_is_the_same_on_one_thread_and_on_two() {
+    let soft = fixture("biolever-soft-synthetic.csv");
+    let maclever = fixture("maclever-mica-synthetic.csv");
+    let fits: [&[&str]; 2] = [
+        &[
+            "fit",
+            "--data",
+            &soft,
+            "--case",
+            "biolever-soft",
+            "--fit",
+            "amplitude-calibration,sample-modulus",
+            "--max-evaluations",
+            "1",
+            "--json",
+        ],
+        &[
+            "fit",
+            "--data",
+            &maclever,
+            "--case",
+            "maclever-mica",
+            "--fit",
+            "amplitude-calibration,tip-radius",
+            "--json",
+        ],
+    ];
+    for (args, succeeds) in fits.iter().zip([true, false]) {
+        let on = |threads: &str| {
+            let output = drumroll()
+                .args(*args)
+                .env("RAYON_NUM_THREADS", threads)
+                .output()
+                .expect("runs");
+            (output.status.code(), output.stdout, output.stderr)
+        };
+        let one = on("1");
+        assert_eq!(one.0 == Some(0), succeeds, "{args:?}: exit {:?}", one.0);
+        let two = on("2");
+        assert!(one == two, "{args:?}: 1 and 2 threads differ");
+    }
+}
