@@ -177,10 +177,11 @@ fn fit_refuses_bad_parameter_lists() {
 }
 
 /// The fit's Jacobian columns and the detection of the transitions run in parallel (rayon)
-/// with the serial result: a short fit (one evaluation's patience; the calibration and the
-/// modulus, whose columns are central differences of two followed branches each) prints the
-/// same bytes on one thread and on two (`RAYON_NUM_THREADS`), and so does a fit whose step
-/// leaves the tip radius's range (the error, on stderr, with the same exit code).
+/// with the serial result: a short fit (one evaluation's patience; the calibration, fitted as
+/// the model's `A0`, whose column is the central difference of two followed branches, and the
+/// reported `A0`) prints the same bytes on one thread and on two (`RAYON_NUM_THREADS`), and so
+/// does a fit whose step leaves the tip radius's range (the error, on stderr, with the same
+/// exit code).
 #[test]
 fn fit_is_the_same_on_one_thread_and_on_two() {
     let soft = fixture("biolever-soft-synthetic.csv");
@@ -193,7 +194,7 @@ fn fit_is_the_same_on_one_thread_and_on_two() {
             "--case",
             "biolever-soft",
             "--fit",
-            "amplitude-calibration,sample-modulus",
+            "amplitude-calibration",
             "--max-evaluations",
             "1",
             "--json",
