@@ -1,37 +1,50 @@
 //! Benchmark of a regime map (issue 23): the Biolever on mica over the free amplitude
 //! `A0 = 5 .. 20 nm`, every `G_n`, fold and period-doubling curve of its approach diagram with
 //! at least 100 points each, against one approach diagram (what `drumroll continue` computes),
-//! both timed in the same run on the calling thread's CPU clock.
+//! both timed in the same run: wall time, and the CPU time of all the process's threads (the
+//! map's curves run in parallel on rayon's; `RAYON_NUM_THREADS=1` runs them on one).
 //!
 //! Target: the map in under 1 s on one core and at most 5 times one diagram.
 //!
 //! Run with `cargo bench -p afm --bench regime_map`; `-- --repetitions N` (default 3) sets the
 //! repetitions, whose median is reported.
 
+use std::time::Instant;
+
 use afm::{
     approach_diagram, builtin_case, regime_map, DiagramSettings, ParameterAxis, RegimeMapSettings,
     TappingModel,
 };
 
-/// The calling thread's CPU time so far, seconds (Linux `/proc/thread-self/schedstat`).
-fn thread_cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|text| text.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(f64::NAN, |ns| ns * 1e-9)
+/// The CPU time so far of every thread of this process, seconds (the sum of Linux
+/// `/proc/self/task/*/schedstat`): the calling thread and rayon's, which the regime map's
+/// curves and the fit's Jacobian run on (rayon's threads live as long as the process).
+fn process_cpu_seconds() -> Option<f64> {
+    let mut nanoseconds = 0.0;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let text = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        nanoseconds += text.split_whitespace().next()?.parse::<f64>().ok()?;
+    }
+    Some(nanoseconds * 1e-9)
 }
 
-/// Median CPU time of `repetitions` calls of `f`, seconds.
-fn median_seconds<F: FnMut()>(repetitions: usize, mut f: F) -> f64 {
-    let mut times: Vec<f64> = (0..repetitions)
-        .map(|_| {
-            let start = thread_cpu_seconds();
-            f();
-            thread_cpu_seconds() - start
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[repetitions / 2]
+/// Median (wall, CPU) seconds of `repetitions` calls of `f` (CPU NaN where `/proc` cannot
+/// be read).
+fn median_seconds<F: FnMut()>(repetitions: usize, mut f: F) -> (f64, f64) {
+    let mut wall = Vec::new();
+    let mut cpu = Vec::new();
+    for _ in 0..repetitions {
+        let (start, start_cpu) = (Instant::now(), process_cpu_seconds());
+        f();
+        wall.push(start.elapsed().as_secs_f64());
+        cpu.push(match (start_cpu, process_cpu_seconds()) {
+            (Some(a), Some(b)) => b - a,
+            _ => f64::NAN,
+        });
+    }
+    wall.sort_by(f64::total_cmp);
+    cpu.sort_by(f64::total_cmp);
+    (wall[repetitions / 2], cpu[repetitions / 2])
 }
 
 fn main() {
@@ -71,18 +84,21 @@ fn main() {
             point.label, point.curve, point.parameter, point.z_nm, point.precision
         );
     }
-    let diagram_s = median_seconds(repetitions, || {
+    let (diagram_wall, diagram_s) = median_seconds(repetitions, || {
         approach_diagram(&model, &diagram_settings).expect("diagram");
     });
-    let map_s = median_seconds(repetitions, || {
+    let (map_wall, map_s) = median_seconds(repetitions, || {
         regime_map(&case, ParameterAxis::FreeAmplitude, &settings).expect("map");
     });
     println!(
-        "one approach diagram: {:.1} ms; regime map A0 = 5..20 nm ({} curves, {} points): {:.1} ms; ratio {:.2} (CPU time of this thread, median of {repetitions})",
+        "one approach diagram: {:.1} ms; regime map A0 = 5..20 nm ({} curves, {} points): {:.1} ms; ratio {:.2} (CPU time of the process's threads, median of {repetitions}); wall {:.1} ms and {:.1} ms on {} threads",
         diagram_s * 1e3,
         map.curves.len(),
         map.curves.iter().map(|c| c.points.len()).sum::<usize>(),
         map_s * 1e3,
-        map_s / diagram_s
+        map_s / diagram_s,
+        diagram_wall * 1e3,
+        map_wall * 1e3,
+        rayon::current_num_threads()
     );
 }

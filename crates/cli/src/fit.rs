@@ -156,12 +156,20 @@ pub fn run(args: &FitArgs) -> Result<()> {
     let measurement = args.measurement.read(args.model.a0)?;
     let mut settings = FitSettings::new(parameters);
     settings.max_evaluations = args.max_evaluations;
-    let result = fit_measurement(&case, &measurement, &settings)?;
-    let detection = detect_transitions(
-        &measurement.approach,
-        measurement.a0_nm,
-        &DetectionSettings::default(),
-    )?;
+    // The fit and the detection of the measured transitions are independent: both run at
+    // once (rayon), the fit's error first, as when they ran one after the other.
+    let (result, detection) = rayon::join(
+        || fit_measurement(&case, &measurement, &settings),
+        || {
+            detect_transitions(
+                &measurement.approach,
+                measurement.a0_nm,
+                &DetectionSettings::default(),
+            )
+        },
+    );
+    let result = result?;
+    let detection = detection?;
     let object = fit_json(&case.name, &measurement, &result, &detection);
     for warning in &result.warnings {
         eprintln!("drumroll: warning: {warning}");

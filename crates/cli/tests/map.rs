@@ -322,3 +322,56 @@ fn grid_file_cells_are_drawn_under_the_curves() {
         "{stderr}"
     );
 }
+
+/// The curves are continued in parallel (rayon) with the result of the serial loop: the
+/// bimodal Biolever's folds and period doublings over `A0 = 10 .. 11 nm` give the same bytes on
+/// one thread and on two (`RAYON_NUM_THREADS`). Its seed approach has more fold and
+/// period-doubling points than the map has curves (`continue` finds ten; the curves of two
+/// pairs pass through both points of the pair at the case's own `A0 = 10`, so the second of
+/// each pair is skipped), so the parallel run must also skip what the serial one skips.
+#[test]
+fn map_is_the_same_on_one_thread_and_on_two() {
+    let args = [
+        "map",
+        "--case",
+        "biolever-mica-bimodal",
+        "--vary",
+        "a0",
+        "--from",
+        "10",
+        "--to",
+        "11",
+        "--points",
+        "4",
+        "--labels",
+        "fold,period-doubling",
+        "--json",
+    ];
+    let on = |threads: &str| {
+        let output = drumroll()
+            .args(args)
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .expect("runs");
+        assert!(
+            output.status.success(),
+            "{threads} threads: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        output.stdout
+    };
+    let one = on("1");
+    assert!(one == on("2"), "the maps on 1 and 2 threads differ");
+    let map: Value = serde_json::from_slice(&one).expect("one JSON object");
+    let seeds = json_of(&["continue", "--case", "biolever-mica-bimodal"])["special_points"]
+        .as_array()
+        .expect("special points")
+        .iter()
+        .filter(|p| p["label"] == "fold" || p["label"] == "period-doubling")
+        .count();
+    let curves = map["curves"].as_array().expect("curves").len();
+    assert!(
+        curves < seeds,
+        "{curves} curves from {seeds} seeds: none skipped"
+    );
+}

@@ -175,3 +175,56 @@ fn fit_refuses_bad_parameter_lists() {
         assert!(stderr.contains(message), "{list}: {stderr}");
     }
 }
+
+/// The fit's Jacobian columns, the detection of the transitions alongside it, and inside the
+/// detection the candidates' scores and the kinks' onsets and bootstrap replicates run in
+/// parallel (rayon) with the serial result: the soft fixture's detection (three transitions,
+/// kinks among them), a short fit (one evaluation's patience; the calibration, fitted as the
+/// model's `A0`, whose column is the central difference of two followed branches, and the
+/// reported `A0`) print the same bytes on one thread and on two (`RAYON_NUM_THREADS`), and so
+/// does a fit whose step leaves the tip radius's range (the error, on stderr, with the same
+/// exit code).
+#[test]
+fn detect_and_fit_are_the_same_on_one_thread_and_on_two() {
+    let soft = fixture("biolever-soft-synthetic.csv");
+    let maclever = fixture("maclever-mica-synthetic.csv");
+    let fits: [&[&str]; 3] = [
+        &["detect", "--data", &soft, "--json"],
+        &[
+            "fit",
+            "--data",
+            &soft,
+            "--case",
+            "biolever-soft",
+            "--fit",
+            "amplitude-calibration",
+            "--max-evaluations",
+            "1",
+            "--json",
+        ],
+        &[
+            "fit",
+            "--data",
+            &maclever,
+            "--case",
+            "maclever-mica",
+            "--fit",
+            "amplitude-calibration,tip-radius",
+            "--json",
+        ],
+    ];
+    for (args, succeeds) in fits.iter().zip([true, true, false]) {
+        let on = |threads: &str| {
+            let output = drumroll()
+                .args(*args)
+                .env("RAYON_NUM_THREADS", threads)
+                .output()
+                .expect("runs");
+            (output.status.code(), output.stdout, output.stderr)
+        };
+        let one = on("1");
+        assert_eq!(one.0 == Some(0), succeeds, "{args:?}: exit {:?}", one.0);
+        let two = on("2");
+        assert!(one == two, "{args:?}: 1 and 2 threads differ");
+    }
+}

@@ -5,6 +5,7 @@
 use nalgebra::{DMatrix, DVector};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
+use rayon::prelude::*;
 
 use crate::fit::synthetic::gaussian;
 use crate::fit::window_models::{
@@ -44,7 +45,9 @@ pub(crate) fn kink_onset(signals: &Signals, g: usize, scale: Scale) -> (f64, f64
         let high = z[range.start + PROFILE_MARGIN];
         let low = z[range.end - 1 - PROFILE_MARGIN];
         let steps = 200;
+        // The grid's onsets in parallel (rayon), collected in grid order.
         let profile: Vec<(f64, f64)> = (0..=steps)
+            .into_par_iter()
             .map(|s| {
                 let c = high + (low - high) * s as f64 / steps as f64;
                 let chi2 = KINK_PROFILE_ROUNDING
@@ -132,7 +135,7 @@ fn bootstrap_spread(
         .map(|s| high + (low - high) * s as f64 / steps as f64)
         .collect();
     let bases: Vec<Vec<DMatrix<f64>>> = grid
-        .iter()
+        .par_iter()
         .map(|&onset| {
             KINK_ROUNDING
                 .iter()
@@ -142,30 +145,42 @@ fn bootstrap_spread(
                 .collect()
         })
         .collect();
+    // The replicates drawn in order from the one seeded generator, then located in parallel
+    // (rayon) and summed in replicate order.
     let mut rng = StdRng::seed_from_u64(seed);
-    let mut sum2 = 0.0;
-    for _ in 0..BOOTSTRAP_REPLICATES {
-        let replicate: Vec<DVector<f64>> = fitted
-            .iter()
-            .map(|f| f.map(|v| v + gaussian(&mut rng)))
-            .collect();
-        let mut best = (f64::NEG_INFINITY, c);
-        for (onset, row) in grid.iter().zip(&bases) {
-            // The largest explained sum of squares is the smallest residual.
-            let explained = row
+    let replicates: Vec<Vec<DVector<f64>>> = (0..BOOTSTRAP_REPLICATES)
+        .map(|_| {
+            fitted
                 .iter()
-                .map(|u| {
-                    replicate
-                        .iter()
-                        .map(|y| (u.transpose() * y).norm_squared())
-                        .sum::<f64>()
-                })
-                .fold(f64::NEG_INFINITY, f64::max);
-            if explained > best.0 {
-                best = (explained, *onset);
+                .map(|f| f.map(|v| v + gaussian(&mut rng)))
+                .collect()
+        })
+        .collect();
+    let onsets: Vec<f64> = replicates
+        .par_iter()
+        .map(|replicate| {
+            let mut best = (f64::NEG_INFINITY, c);
+            for (onset, row) in grid.iter().zip(&bases) {
+                // The largest explained sum of squares is the smallest residual.
+                let explained = row
+                    .iter()
+                    .map(|u| {
+                        replicate
+                            .iter()
+                            .map(|y| (u.transpose() * y).norm_squared())
+                            .sum::<f64>()
+                    })
+                    .fold(f64::NEG_INFINITY, f64::max);
+                if explained > best.0 {
+                    best = (explained, *onset);
+                }
             }
-        }
-        sum2 += (best.1 - c).powi(2);
+            best.1
+        })
+        .collect();
+    let mut sum2 = 0.0;
+    for onset in onsets {
+        sum2 += (onset - c).powi(2);
     }
     (sum2 / BOOTSTRAP_REPLICATES as f64).sqrt()
 }

@@ -6,11 +6,12 @@
 
 use std::cell::RefCell;
 use std::collections::HashMap;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex, PoisonError};
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::storage::Owned;
 use nalgebra::{DMatrix, DVector, Dyn};
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::diagram::bifurcation_diagram::{approach_diagram, DiagramPoint, DiagramSettings};
@@ -244,10 +245,12 @@ pub struct FitResult {
 }
 
 /// The cached followed branches, by the model's parameter values (bit patterns).
-type BranchCache = HashMap<Vec<u64>, Rc<FollowedBranch>>;
+type BranchCache = HashMap<Vec<u64>, Arc<FollowedBranch>>;
 
-/// The least-squares problem: residuals of amplitude (weighted by its noise) then of phase.
-struct Problem<'a> {
+/// The weighted residuals, amplitude (over its noise) then phase, as a function of the varied
+/// quantities `theta`, and their Jacobian; the followed branches are cached, and shared by the
+/// threads that evaluate the Jacobian's central differences.
+struct Residuals<'a> {
     case: &'a Case,
     points: &'a [MeasuredPoint],
     parameters: Vec<Internal>,
@@ -255,8 +258,14 @@ struct Problem<'a> {
     sigma: [f64; 2],
     step: f64,
     z_floor: f64,
+    cache: Mutex<BranchCache>,
+}
+
+/// The least-squares problem Levenberg-Marquardt sees: the residuals at its current `theta`,
+/// the first error met kept (the trait's residuals and Jacobian can only say `None`).
+struct Problem<'a> {
+    residuals: Residuals<'a>,
     theta: DVector<f64>,
-    cache: RefCell<BranchCache>,
     failure: RefCell<Option<AfmError>>,
 }
 
@@ -280,7 +289,7 @@ struct Values {
     case: Vec<(ParameterAxis, f64)>,
 }
 
-impl Problem<'_> {
+impl Residuals<'_> {
     fn values(&self, theta: &DVector<f64>) -> Values {
         let mut values = Values {
             z_offset: self.fixed.z_offset,
@@ -301,12 +310,19 @@ impl Problem<'_> {
         values
     }
 
-    /// The followed branch of the model at `values` (cached).
-    fn branch(&self, values: &Values) -> Result<Rc<FollowedBranch>, AfmError> {
+    /// The followed branch of the model at `values` (cached; computed outside the cache's
+    /// lock, so threads asking for different branches compute them at the same time).
+    fn branch(&self, values: &Values) -> Result<Arc<FollowedBranch>, AfmError> {
         let mut key: Vec<u64> = vec![values.model_a0.to_bits()];
         key.extend(values.case.iter().map(|(_, v)| v.to_bits()));
-        if let Some(branch) = self.cache.borrow().get(&key) {
-            return Ok(branch.clone());
+        let cached = self
+            .cache
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .get(&key)
+            .cloned();
+        if let Some(branch) = cached {
+            return Ok(branch);
         }
         let mut case = self.case.clone();
         case.free_amplitude_nm = values.model_a0;
@@ -320,8 +336,8 @@ impl Problem<'_> {
         settings.z_limit_nm = self
             .z_floor
             .clamp(-0.95 * a0, 0.9 * model.grazing_separation_nm());
-        let branch = Rc::new(FollowedBranch::new(approach_diagram(&model, &settings)?));
-        let mut cache = self.cache.borrow_mut();
+        let branch = Arc::new(FollowedBranch::new(approach_diagram(&model, &settings)?));
+        let mut cache = self.cache.lock().unwrap_or_else(PoisonError::into_inner);
         if cache.len() > 64 {
             cache.clear();
         }
@@ -344,49 +360,76 @@ impl Problem<'_> {
         Ok(r)
     }
 
+    /// The Jacobian of the residuals at `theta`, its columns computed in parallel (a model
+    /// parameter's central differences are two followed branches); the first failing column's
+    /// error, in parameter order.
     fn jacobian_at(&self, theta: &DVector<f64>) -> Result<DMatrix<f64>, AfmError> {
-        let n = self.points.len();
         let values = self.values(theta);
         let branch = self.branch(&values)?;
-        let mut jacobian = DMatrix::zeros(2 * n, self.parameters.len());
-        for (k, p) in self.parameters.iter().enumerate() {
-            match p {
-                Internal::ZOffset => {
-                    for (i, point) in self.points.iter().enumerate() {
-                        let z = point.z_nm - values.z_offset;
-                        let ratio = branch.value(z, |d| d.amplitude_ratio).slope;
-                        let phase = branch.value(z, |d| d.phase_deg).slope;
-                        jacobian[(i, k)] = values.reported_a0 * ratio / self.sigma[0];
-                        jacobian[(n + i, k)] = phase / self.sigma[1];
-                    }
-                }
-                Internal::PhaseOffset => {
-                    for i in 0..n {
-                        jacobian[(n + i, k)] = -1.0 / self.sigma[1];
-                    }
-                }
-                Internal::ReportedAmplitude => {
-                    // d/d(ln A0_rep) of (A_i - A0_rep ratio_i) / sigma, exact.
-                    for (i, point) in self.points.iter().enumerate() {
-                        let z = point.z_nm - values.z_offset;
-                        let ratio = branch.value(z, |d| d.amplitude_ratio).value;
-                        jacobian[(i, k)] = -values.reported_a0 * ratio / self.sigma[0];
-                    }
-                }
-                Internal::ModelAmplitude | Internal::Case(_) => {
-                    // Central differences in the logarithm.
-                    let mut up = theta.clone();
-                    up[k] += self.step;
-                    let mut down = theta.clone();
-                    down[k] -= self.step;
-                    let r = self.residuals_at(&up)? - self.residuals_at(&down)?;
-                    jacobian.set_column(k, &(r / (2.0 * self.step)));
-                }
-            }
+        let columns: Vec<Result<DVector<f64>, AfmError>> = (0..self.parameters.len())
+            .into_par_iter()
+            .map(|k| self.jacobian_column(k, theta, &values, &branch))
+            .collect();
+        let mut jacobian = DMatrix::zeros(2 * self.points.len(), self.parameters.len());
+        for (k, column) in columns.into_iter().enumerate() {
+            jacobian.set_column(k, &column?);
         }
         Ok(jacobian)
     }
 
+    /// Column `k` of the Jacobian at `theta` (whose values and followed branch are `values`
+    /// and `branch`): exact for the offsets and the reported amplitude, central differences
+    /// in the logarithm for the model's parameters (`(r(up) - r(down)) / (2 step)`, both
+    /// branches at once; the `up` one's error first).
+    fn jacobian_column(
+        &self,
+        k: usize,
+        theta: &DVector<f64>,
+        values: &Values,
+        branch: &FollowedBranch,
+    ) -> Result<DVector<f64>, AfmError> {
+        let n = self.points.len();
+        let mut column = DVector::zeros(2 * n);
+        match self.parameters[k] {
+            Internal::ZOffset => {
+                for (i, point) in self.points.iter().enumerate() {
+                    let z = point.z_nm - values.z_offset;
+                    let ratio = branch.value(z, |d| d.amplitude_ratio).slope;
+                    let phase = branch.value(z, |d| d.phase_deg).slope;
+                    column[i] = values.reported_a0 * ratio / self.sigma[0];
+                    column[n + i] = phase / self.sigma[1];
+                }
+            }
+            Internal::PhaseOffset => {
+                for i in 0..n {
+                    column[n + i] = -1.0 / self.sigma[1];
+                }
+            }
+            Internal::ReportedAmplitude => {
+                // d/d(ln A0_rep) of (A_i - A0_rep ratio_i) / sigma, exact.
+                for (i, point) in self.points.iter().enumerate() {
+                    let z = point.z_nm - values.z_offset;
+                    let ratio = branch.value(z, |d| d.amplitude_ratio).value;
+                    column[i] = -values.reported_a0 * ratio / self.sigma[0];
+                }
+            }
+            Internal::ModelAmplitude | Internal::Case(_) => {
+                // Central differences in the logarithm.
+                let mut up = theta.clone();
+                up[k] += self.step;
+                let mut down = theta.clone();
+                down[k] -= self.step;
+                let (up, down) =
+                    rayon::join(|| self.residuals_at(&up), || self.residuals_at(&down));
+                let r = up? - down?;
+                column = r / (2.0 * self.step);
+            }
+        }
+        Ok(column)
+    }
+}
+
+impl Problem<'_> {
     fn note(&self, error: AfmError) {
         let mut failure = self.failure.borrow_mut();
         if failure.is_none() {
@@ -409,13 +452,17 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        self.residuals_at(&self.theta)
+        self.residuals
+            .residuals_at(&self.theta)
             .map_err(|e| self.note(e))
             .ok()
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        self.jacobian_at(&self.theta).map_err(|e| self.note(e)).ok()
+        self.residuals
+            .jacobian_at(&self.theta)
+            .map_err(|e| self.note(e))
+            .ok()
     }
 }
 
@@ -462,7 +509,7 @@ pub fn fit_measurement(
         noise_sigma(&phases).max(1e-6),
     ];
     // Starting values from the case's model.
-    let initial_problem = Problem {
+    let initial_problem = Residuals {
         case,
         points,
         parameters: Vec::new(),
@@ -475,9 +522,7 @@ pub fn fit_measurement(
         sigma,
         step: settings.difference_step,
         z_floor: 0.0,
-        theta: DVector::zeros(0),
-        cache: RefCell::new(HashMap::new()),
-        failure: RefCell::new(None),
+        cache: Mutex::new(HashMap::new()),
     };
     let start_values = Values {
         z_offset: 0.0,
@@ -529,20 +574,22 @@ pub fn fit_measurement(
         .collect();
     let z_floor = zs.iter().copied().fold(f64::INFINITY, f64::min) - z_offset - 0.15 * a0;
     let problem = Problem {
-        case,
-        points,
-        parameters: internal,
-        fixed,
-        sigma,
-        step: settings.difference_step,
-        z_floor,
+        residuals: Residuals {
+            case,
+            points,
+            parameters: internal,
+            fixed,
+            sigma,
+            step: settings.difference_step,
+            z_floor,
+            cache: Mutex::new(HashMap::new()),
+        },
         theta: theta.clone(),
-        cache: RefCell::new(HashMap::new()),
         failure: RefCell::new(None),
     };
     let patience = settings
         .max_evaluations
-        .div_ceil(problem.parameters.len() + 1)
+        .div_ceil(problem.residuals.parameters.len() + 1)
         .max(1);
     let (problem, report) = LevenbergMarquardt::new()
         .with_patience(patience)
@@ -555,6 +602,7 @@ pub fn fit_measurement(
         }
     }
     let theta = problem.theta.clone();
+    let problem = problem.residuals;
     let residuals = problem.residuals_at(&theta)?;
     let jacobian = problem.jacobian_at(&theta)?;
     let n = points.len();

@@ -17,6 +17,7 @@
 //! uncertainty the larger of the profile's and a parametric bootstrap's.
 
 use nalgebra::DVector;
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::AfmError;
@@ -169,6 +170,10 @@ fn candidate_score(signals: &Signals, g: usize, scale: Scale) -> (f64, Transitio
 
 /// Detect transitions on a curve sorted by decreasing `Z` (an approach) or increasing `Z`.
 ///
+/// The candidates' scores, the transitions' onsets and their profiles and bootstrap replicates
+/// are computed in parallel on rayon's current pool; the result does not depend on the number
+/// of threads.
+///
 /// # Errors
 /// [`AfmError::InvalidField`] for bad settings or fewer than `4 w` rows.
 pub fn detect_transitions(
@@ -229,8 +234,9 @@ pub fn detect_transitions(
         // Per candidate: the larger alternative's statistic, its kind and its single-test tail
         // probability (kink: chi^2 with 4 degrees of freedom, the hinge and the free curvature
         // for each signal; jump: chi^2 with 2).
+        // In parallel (rayon), collected in candidate order.
         let scores: Vec<(f64, TransitionKind, f64)> = candidates
-            .iter()
+            .par_iter()
             .map(|&g| candidate_score(&signals, g, *scale))
             .collect();
         // Above the threshold, strongest first; a candidate whose window holds a stronger
@@ -254,8 +260,9 @@ pub fn detect_transitions(
             }
         }
     }
+    // Each transition's onset and values in parallel (rayon), collected in order.
     let mut transitions: Vec<Transition> = chosen
-        .into_iter()
+        .into_par_iter()
         .map(|(g, scale, score, kind, tail)| {
             let w = scale.half_window;
             let range = g + 1 - w..g + w + 1;

@@ -3,3 +3,4 @@
 //! period-doubling points over it.
 pub mod parameter_axis;
 pub mod regime_map;
+mod seed_order;

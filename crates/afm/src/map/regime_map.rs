@@ -34,11 +34,13 @@ use continuation::{
     CurveStop, NewtonSettings, TwoParameterProblem,
 };
 use hybrid::{flow_map, Sensitivity};
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::diagram::bifurcation_diagram::{approach_diagram, BifurcationDiagram, DiagramSettings};
 use crate::error::AfmError;
 use crate::map::parameter_axis::{CaseFamily, ParameterAxis};
+use crate::map::seed_order::continue_in_seed_order;
 use crate::model::case::Case;
 use crate::model::TappingModel;
 use crate::orbit::observables::{orbit_observables, Harmonic, OrbitObservables};
@@ -270,6 +272,10 @@ fn check_range(case: &Case, axis: ParameterAxis, s: &RegimeMapSettings) -> Resul
 
 /// The regime map of `case` along `axis` over `[settings.from, settings.to]`.
 ///
+/// The seed points' curves are continued in parallel on rayon's current pool, and their
+/// points' observables computed in parallel; the result does not depend on the number of
+/// threads (a seed on an earlier kept curve of its kind is skipped, as in seed order).
+///
 /// # Errors
 /// Invalid settings (naming the option), a failed seed diagram, or a failed evaluation of a
 /// point's observables. A curve that cannot start is returned without points, its ends saying
@@ -289,7 +295,9 @@ pub fn regime_map(
     let model = family.model_at(q0)?;
     let seed = approach_diagram(&model, &settings.diagram)?;
     let integration = settings.diagram.orbit.integration.clone();
-    let problem = TwoParameterProblem::new(family.clone(), q0, 1, integration.clone())?;
+    // The problem's inputs checked once, before any curve, as the serial loop did; each curve
+    // builds its own problem from them.
+    let _ = TwoParameterProblem::new(family.clone(), q0, 1, integration.clone())?;
     let targets = settings.at.clone();
     let curve_settings = CurveSettings {
         initial_step: 1e-3 * model.free_amplitude_nm(),
@@ -305,76 +313,94 @@ pub fn regime_map(
         },
         ..CurveSettings::default()
     };
-    let mut curves: Vec<(CodimOneKind, Curve, String)> = Vec::new();
-    for special in &seed.special_points {
-        let Some(kind) = kind_of(&special.label) else {
-            continue;
-        };
-        if let Some(labels) = &settings.labels {
-            if !labels.contains(&special.label) {
-                continue;
-            }
-        }
-        let z = special.z_nm;
-        let known = curves.iter().any(|(k, c, _)| {
-            *k == kind
-                && c.points.iter().any(|p| {
-                    p.second_parameter == q0 && (p.parameter - z).abs() <= 1e-6 * z.abs().max(1.0)
-                })
-        });
-        if known {
-            continue;
-        }
-        let start = CurveStart {
-            state: special.state.clone(),
-            section_time: 0.0,
-            parameter: z,
-            second_parameter: q0,
-        };
-        // A curve that cannot start is kept, empty, with the reason at both ends.
-        let curve = match continue_curve(&problem, kind, &start, &curve_settings) {
-            Ok(curve) => curve,
-            Err(error) => {
+    // The seeds in diagram order; the serial rule skips one whose point lies on an earlier
+    // kept curve of its kind (`seed_order`), the curves run in parallel.
+    let seeds: Vec<(CodimOneKind, &str, CurveStart)> = seed
+        .special_points
+        .iter()
+        .filter(|special| {
+            settings
+                .labels
+                .as_ref()
+                .is_none_or(|labels| labels.contains(&special.label))
+        })
+        .filter_map(|special| {
+            let kind = kind_of(&special.label)?;
+            let start = CurveStart {
+                state: special.state.clone(),
+                section_time: 0.0,
+                parameter: special.z_nm,
+                second_parameter: q0,
+            };
+            Some((kind, special.label.as_str(), start))
+        })
+        .collect();
+    let kinds: Vec<CodimOneKind> = seeds.iter().map(|(kind, _, _)| *kind).collect();
+    let continued = continue_in_seed_order(
+        &kinds,
+        |i| {
+            let (kind, _, start) = &seeds[i];
+            // Each curve has a problem of its own (the members it keeps built are its own).
+            let curve = TwoParameterProblem::new(family.clone(), q0, 1, integration.clone())
+                .and_then(|problem| continue_curve(&problem, *kind, start, &curve_settings));
+            // A curve that cannot start is kept, empty, with the reason at both ends.
+            curve.unwrap_or_else(|error| {
                 let end = CurveEnd {
                     reason: CurveStop::Error,
-                    parameters: (z, q0),
+                    parameters: (start.parameter, q0),
                     error: Some(error),
                 };
                 Curve {
-                    kind,
+                    kind: *kind,
                     points: Vec::new(),
                     start_index: 0,
                     codim2_points: Vec::new(),
                     ends: [end.clone(), end],
                 }
-            }
-        };
-        curves.push((kind, curve, special.label.clone()));
-    }
+            })
+        },
+        |curve, i| {
+            let z = seeds[i].2.parameter;
+            curve.points.iter().any(|p| {
+                p.second_parameter == q0 && (p.parameter - z).abs() <= 1e-6 * z.abs().max(1.0)
+            })
+        },
+    );
+    // The observables of every point, in parallel; the first error in curve order (a curve's
+    // points, then its codimension-two points) stops the map, as serially.
+    let harmonics = settings.diagram.orbit.harmonics;
+    let observed: Vec<_> = continued
+        .par_iter()
+        .map(|(i, curve)| {
+            let (kind, label, _) = &seeds[*i];
+            let map = map_curve(&family, *kind, curve, label, &integration, harmonics);
+            let codim2: Vec<_> = curve
+                .codim2_points
+                .par_iter()
+                .map(|point| {
+                    observe(
+                        &family,
+                        point.second_parameter,
+                        point.parameter,
+                        point.state.as_slice(),
+                        point.section_time,
+                        &integration,
+                        harmonics,
+                    )
+                })
+                .collect();
+            (map, codim2)
+        })
+        .collect();
     let mut map_curves = Vec::new();
     let mut codim2_points = Vec::new();
-    for (kind, curve, label) in &curves {
-        map_curves.push(map_curve(
-            &family,
-            *kind,
-            curve,
-            label,
-            &integration,
-            settings.diagram.orbit.harmonics,
-        )?);
-        for point in &curve.codim2_points {
-            let (state, observables) = observe(
-                &family,
-                point.second_parameter,
-                point.parameter,
-                point.state.as_slice(),
-                point.section_time,
-                &integration,
-                settings.diagram.orbit.harmonics,
-            )?;
+    for ((i, curve), (map, codim2)) in continued.iter().zip(observed) {
+        map_curves.push(map?);
+        for (point, observed) in curve.codim2_points.iter().zip(codim2) {
+            let (state, observables) = observed?;
             codim2_points.push(MapCodim2Point {
                 label: point.kind.label().to_string(),
-                curve: label.clone(),
+                curve: seeds[*i].1.to_string(),
                 parameter: point.second_parameter,
                 z_nm: point.parameter,
                 amplitude_ratio: observables.amplitude_ratio,
@@ -445,7 +471,7 @@ fn end_words(end: &CurveEnd) -> &'static str {
 }
 
 /// The map curve of a continued curve, with the observables of every point (harmonics
-/// `1..=harmonics` of `u`).
+/// `1..=harmonics` of `u`), computed in parallel; the first failing point's error.
 fn map_curve(
     family: &CaseFamily,
     kind: CodimOneKind,
@@ -454,17 +480,24 @@ fn map_curve(
     integration: &hybrid::Settings,
     harmonics: usize,
 ) -> Result<MapCurve, AfmError> {
+    let observed: Vec<_> = curve
+        .points
+        .par_iter()
+        .map(|point| {
+            observe(
+                family,
+                point.second_parameter,
+                point.parameter,
+                point.state.as_slice(),
+                point.section_time,
+                integration,
+                harmonics,
+            )
+        })
+        .collect();
     let mut points = Vec::with_capacity(curve.points.len());
-    for point in &curve.points {
-        let (state, observables) = observe(
-            family,
-            point.second_parameter,
-            point.parameter,
-            point.state.as_slice(),
-            point.section_time,
-            integration,
-            harmonics,
-        )?;
+    for (point, observed) in curve.points.iter().zip(observed) {
+        let (state, observables) = observed?;
         let impacts = point.structure.impacts;
         let after = if kind == CodimOneKind::Grazing {
             impacts + 1
