@@ -141,8 +141,8 @@ impl<F: SystemFamily> TwoParameterProblem<F> {
         Ok(self.periods as f64 * self.members.borrow()[index].1.period())
     }
 
-    /// Index of the member at `q` in the cache, building it if needed (the oldest member
-    /// other than the first is dropped beyond [`CACHED_MEMBERS`]).
+    /// Index of the member at `q` in the cache, building it if needed (beyond
+    /// [`CACHED_MEMBERS`] the oldest member is dropped).
     fn member(&self, q: f64) -> Result<usize, ContinuationError> {
         if let Some(i) = self.members.borrow().iter().position(|(v, _)| *v == q) {
             return Ok(i);
