@@ -80,9 +80,10 @@ pub struct ContinueArgs {
     /// highest harmonic --panels draws).
     #[arg(long, default_value_t = crate::approach::DEFAULT_HARMONICS, allow_negative_numbers = true)]
     pub harmonics: i64,
-    /// With several --case: how many cases are computed at once, one per thread (default: one
-    /// per core). The output does not depend on it: each case is printed, in the order given,
-    /// as soon as it and the cases before it are done.
+    /// With several --case: how many cases are computed at once, one per thread (default: the
+    /// environment's RAYON_NUM_THREADS, else one per core). The output does not depend on it:
+    /// each case is printed, in the order given, as soon as it and the cases before it are
+    /// done.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
 }
@@ -209,9 +210,10 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
 }
 
 /// Compute the approach (and retract) of every case of `models` with `continue`'s options
-/// `args`, up to `args.threads` cases at once (default: one thread per core, at most one per
-/// case), and hand each to `report` in the order of `models` (its index, the case and model,
-/// the result) as soon as it and every case before it are done. The first error in that order
+/// `args`, up to `args.threads` cases at once (default: rayon's thread count,
+/// `RAYON_NUM_THREADS` or one per core; at most one per case), and hand each to `report` in the
+/// order of `models` (its index, the case and model, the result) as soon as it and every case
+/// before it are done. The first error in that order
 /// (a case's continuation, or `report`'s) is returned after the cases before it were reported;
 /// the cases still running are then interrupted ([`afm::diagram_until`]'s predicate) and
 /// dropped. Each case's computation is that of one thread alone, so the results do not depend
@@ -224,8 +226,12 @@ fn continue_cases<F>(
 where
     F: FnMut(usize, &(Case, TappingModel), Continued) -> Result<()>,
 {
-    let cores = std::thread::available_parallelism().map_or(1, usize::from);
-    let threads = args.threads.unwrap_or(cores).clamp(1, models.len().max(1));
+    // By default as many as rayon's pool has (`RAYON_NUM_THREADS`, else one per core), like
+    // `map`, `fit` and `detect`.
+    let threads = args
+        .threads
+        .unwrap_or_else(rayon::current_num_threads)
+        .clamp(1, models.len().max(1));
     if threads == 1 {
         // One at a time, on this thread (its stack, no thread started).
         for (index, (case, model)) in models.iter().enumerate() {
