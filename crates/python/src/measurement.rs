@@ -170,12 +170,19 @@ pub fn fit_case(
     let measured = &measurement.measurement;
     let json = py
         .allow_threads(|| {
-            let result = fit_measurement(&resolved.case, measured, &settings)?;
-            let detection = detect_transitions(
-                &measured.approach,
-                measured.a0_nm,
-                &DetectionSettings::default(),
-            )?;
+            // The fit and the detection are independent: both at once, the fit's error first
+            // (as `drumroll fit`).
+            let (result, detection) = rayon::join(
+                || fit_measurement(&resolved.case, measured, &settings),
+                || {
+                    detect_transitions(
+                        &measured.approach,
+                        measured.a0_nm,
+                        &DetectionSettings::default(),
+                    )
+                },
+            );
+            let (result, detection) = (result?, detection?);
             Ok::<Value, afm::AfmError>(fit_json(&resolved.case.name, measured, &result, &detection))
         })
         .map_err(afm_to_py_err)?;
