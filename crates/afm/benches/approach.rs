@@ -13,14 +13,8 @@
 use afm::{builtin_case, Sweep, SweepSettings, TappingModel};
 use std::time::Instant;
 
-/// CPU time of this thread, seconds, from `/proc/thread-self/schedstat` (Linux; nanosecond
-/// resolution), so that the figure does not depend on other processes sharing the machine;
-/// `None` elsewhere.
-fn thread_cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let nanoseconds: f64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(nanoseconds * 1e-9)
-}
+mod cpu_time;
+use cpu_time::thread_cpu_seconds;
 
 /// The reference: scipy `solve_ivp` with event location, seconds per drive cycle.
 const SCIPY_SECONDS_PER_CYCLE: f64 = 0.024;

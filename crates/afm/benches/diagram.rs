@@ -25,15 +25,8 @@ use continuation::{Continuation, ContinuationSettings, HybridPeriodicProblem, Pa
 use hybrid::{flow_map, Sensitivity};
 use std::time::Instant;
 
-/// The calling thread's time on a CPU so far, seconds, from Linux's
-/// `/proc/thread-self/schedstat` (nanoseconds, first field); `None` elsewhere. On a loaded
-/// machine this is the honest "one core" figure: wall time also counts the time other
-/// processes held the core.
-fn thread_cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let nanoseconds: f64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(nanoseconds * 1e-9)
-}
+mod cpu_time;
+use cpu_time::thread_cpu_seconds;
 
 /// Median wall time of `repetitions` calls of `f`, seconds.
 fn median_seconds<F: FnMut()>(repetitions: usize, mut f: F) -> f64 {

@@ -16,17 +16,8 @@ use afm::{
     TappingModel,
 };
 
-/// The CPU time so far of every thread of this process, seconds (the sum of Linux
-/// `/proc/self/task/*/schedstat`): the calling thread and rayon's, which the regime map's
-/// curves and the fit's Jacobian run on (rayon's threads live as long as the process).
-fn process_cpu_seconds() -> Option<f64> {
-    let mut nanoseconds = 0.0;
-    for task in std::fs::read_dir("/proc/self/task").ok()? {
-        let text = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
-        nanoseconds += text.split_whitespace().next()?.parse::<f64>().ok()?;
-    }
-    Some(nanoseconds * 1e-9)
-}
+mod cpu_time;
+use cpu_time::process_cpu_seconds;
 
 /// Median (wall, CPU) seconds of `repetitions` calls of `f` (CPU NaN where `/proc` cannot
 /// be read).

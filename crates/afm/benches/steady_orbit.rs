@@ -36,12 +36,8 @@ use afm::{
 use hybrid::{flow_map, Sensitivity};
 use std::time::Instant;
 
-/// The calling thread's CPU time so far, seconds (Linux); `None` elsewhere.
-fn thread_cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let nanoseconds: f64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(nanoseconds * 1e-9)
-}
+mod cpu_time;
+use cpu_time::thread_cpu_seconds;
 
 /// Best over 5 batches of the thread CPU time per call of `f` (`calls` per batch),
 /// microseconds; NaN where the thread clock is unavailable.
