@@ -234,9 +234,13 @@ where
         .clamp(1, models.len().max(1));
     if threads == 1 {
         // One at a time, on this thread (its stack, no thread started).
-        for (index, (case, model)) in models.iter().enumerate() {
-            let continued = continue_case_until(args, case, model, &mut || false)?;
-            report(index, &models[index], continued)?;
+        for (index, case_model) in models.iter().enumerate() {
+            let (case, model) = case_model;
+            report(
+                index,
+                case_model,
+                continue_case_until(args, case, model, &mut || false)?,
+            )?;
         }
         return Ok(());
     }

@@ -42,6 +42,24 @@ pub(crate) fn bordered(map: &PeriodMap, row: &DVector<f64>) -> DMatrix<f64> {
     a
 }
 
+/// The Newton update that the point `u = (x, p)` with period map `map` leaves undone on the
+/// hyperplane `row . (u - anchor) = 0`: `du = [M - I, dP/dp; row^T]^{-1} [P(x; p) - x; row . (u
+/// - anchor)]`, the next iterate being `u - du`. `None` where the bordered matrix is singular.
+pub(crate) fn undone_update(
+    map: &PeriodMap,
+    u: &DVector<f64>,
+    row: &DVector<f64>,
+    anchor: &DVector<f64>,
+) -> Option<DVector<f64>> {
+    let n = map.image.len();
+    let mut rhs = DVector::zeros(n + 1);
+    for i in 0..n {
+        rhs[i] = map.image[i] - u[i];
+    }
+    rhs[n] = row.dot(&(u - anchor));
+    bordered(map, row).lu().solve(&rhs)
+}
+
 /// The unit tangent `t` of the branch at a point with period map `map`: `J t = 0`,
 /// `|t| = 1`, oriented so that `t . reference > 0`.
 pub(crate) fn tangent(

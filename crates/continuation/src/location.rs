@@ -23,7 +23,7 @@ use std::cell::{Cell, Ref, RefCell};
 use nalgebra::{Complex, DVector};
 use roots::{find_root_regula_falsi, Convergency, SearchError};
 
-use crate::corrector::{bordered, correct, tangent, Purpose};
+use crate::corrector::{correct, tangent, undone_update, Purpose};
 use crate::error::ContinuationError;
 use crate::floquet::floquet_multipliers;
 use crate::problem::{PeriodMap, PeriodicProblem};
@@ -396,18 +396,10 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
         anchor: &DVector<f64>,
     ) -> (DVector<f64>, PeriodMap) {
         let n = u.len() - 1;
-        let residual_of = |u: &DVector<f64>, map: &PeriodMap| {
-            let mut rhs = DVector::zeros(n + 1);
-            for i in 0..n {
-                rhs[i] = map.image[i] - u[i];
-            }
-            let residual = rhs.rows(0, n).norm();
-            rhs[n] = self.tau.dot(&(u - anchor));
-            (rhs, residual)
-        };
-        let (mut rhs, mut residual) = residual_of(&u, &map);
+        let residual_of = |u: &DVector<f64>, map: &PeriodMap| (&map.image - u.rows(0, n)).norm();
+        let mut residual = residual_of(&u, &map);
         for _ in 0..POLISH_STEPS {
-            let Some(update) = bordered(&map, &self.tau).lu().solve(&rhs) else {
+            let Some(update) = undone_update(&map, &u, &self.tau, anchor) else {
                 break;
             };
             // (A NaN step stops too.)
@@ -420,11 +412,11 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             let Ok(moved_map) = self.problem.period_map(&moved.as_slice()[..n], moved[n]) else {
                 break;
             };
-            let (moved_rhs, moved_residual) = residual_of(&moved, &moved_map);
+            let moved_residual = residual_of(&moved, &moved_map);
             if moved_residual.is_nan() || moved_residual > residual {
                 break;
             }
-            (u, map, rhs, residual) = (moved, moved_map, moved_rhs, moved_residual);
+            (u, map, residual) = (moved, moved_map, moved_residual);
         }
         (u, map)
     }

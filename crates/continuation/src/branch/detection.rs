@@ -4,10 +4,10 @@
 //! then the smooth tests (fold, period doubling, Neimark-Sacker) between their brackets.
 
 use super::Continuation;
-use crate::corrector::bordered;
+use crate::corrector::undone_update;
 use crate::error::ContinuationError;
 use crate::extrapolated_zero::{extrapolated_zero, ExtrapolatedZero, Vanishing};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 use crate::location::{Location, Sample, Segment};
 use crate::problem::OrbitStructure;
@@ -219,12 +219,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 dg = dg.min((test.value(point.sigma, &map.structure) - g).abs());
             }
         }
-        let other = [0, 1]
-            .into_iter()
-            .map(|index| segment.sample_ref(index))
-            .find(|s| s.parameter() != point.parameter())?;
-        let slope = (test.value(other.sigma, &other.map.structure) - g).abs()
-            / (other.parameter() - point.parameter()).abs();
+        let slope = slope_from(segment, point, g, |s| test.value(s.sigma, &s.map.structure))?;
         let error = dg / slope;
         error.is_finite().then_some(error)
     }
@@ -416,23 +411,15 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         if point.tangent.iter().any(|t| !t.is_finite()) {
             return None;
         }
-        let mut rhs = DVector::zeros(n + 1);
-        for i in 0..n {
-            rhs[i] = point.u[i] - point.map.image[i];
-        }
-        let step = bordered(&point.map, &point.tangent).lu().solve(&rhs)?;
-        let moved = &point.u + &step;
+        let step = undone_update(&point.map, &point.u, &point.tangent, &point.u)?;
+        let moved = &point.u - &step;
         let map = self
             .problem
             .period_map(&moved.as_slice()[..n], moved[n])
             .ok()?;
         let corrected = Sample::new(point.sigma, moved, map, &point.tangent);
         let g = test(point);
-        let other = [0, 1]
-            .into_iter()
-            .map(|index| segment.sample_ref(index))
-            .find(|s| s.parameter() != point.parameter())?;
-        let slope = (test(&other) - g).abs() / (other.parameter() - point.parameter()).abs();
+        let slope = slope_from(segment, point, g, test)?;
         let error = step[n].abs() + (test(&corrected) - g).abs() / slope;
         error.is_finite().then_some(error)
     }
@@ -512,4 +499,20 @@ fn widen_by_orbit_error(special: &mut SpecialPoint, error: f64, tolerance: f64) 
         special.precision = special.bracket.1 - special.bracket.0;
         special.converged = special.converged && special.precision <= tolerance;
     }
+}
+
+/// The slope `|dg/dp|` of the test `value` (`g` at the located `point`) from `point` to the
+/// segment's start, or, where the start has `point`'s parameter, to its end (test units per
+/// parameter unit). `None` where both ends have it.
+fn slope_from<P: PeriodicProblem + ?Sized>(
+    segment: &Segment<'_, P>,
+    point: &Sample,
+    g: f64,
+    value: impl Fn(&Sample) -> f64,
+) -> Option<f64> {
+    let other = [0, 1]
+        .into_iter()
+        .map(|index| segment.sample_ref(index))
+        .find(|s| s.parameter() != point.parameter())?;
+    Some((value(&other) - g).abs() / (other.parameter() - point.parameter()).abs())
 }
