@@ -13,8 +13,11 @@ use afm::validation::Interval;
 use afm::{Case, TappingModel};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
+use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 use crate::inputs::orbit_inputs_json;
 use crate::model_args::{apply_overrides, cantilever_of, case_of, check_overrides, named_case};
@@ -404,27 +407,58 @@ pub fn run(args: &ScanArgs) -> Result<()> {
 
 /// `drumroll scan --raster FILE`: every row scanned as a line (the case and settings of the
 /// first row), the pixels tagged with `row` and `y_nm`; `--plot` draws the trace's images.
+///
+/// The rows are independent (each is scanned from the case's own start, MODEL.md section 12),
+/// so they are scanned in parallel on rayon's pool (`RAYON_NUM_THREADS`, else one thread per
+/// core); their pixels are kept in row order, so the output is the same on any number of
+/// threads. The first failing row in row order is reported (rows after a failed one are not
+/// started).
 fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Result<()> {
     let raster = ScanRaster::load(path).with_context(|| format!("--raster {}", path.display()))?;
     let case = args.case(&raster.rows[0])?;
     let settings = args.settings()?;
     let total = (settings.pixels * settings.directions.passes().len() * raster.rows.len()) as u64;
-    let mut progress = Progress::new(
+    let progress = Mutex::new(Progress::new(
         total,
         "{wide_bar} {human_pos}/{human_len} pixels, {eta} left",
-    );
+    ));
+    let pixels_done = AtomicU64::new(0);
+    let first_failed = AtomicUsize::new(usize::MAX);
+    let scanned: Vec<Option<Result<(Vec<ScanPixel>, Value)>>> = raster
+        .rows
+        .par_iter()
+        .enumerate()
+        .map(|(row, line)| {
+            if row > first_failed.load(Ordering::Relaxed) {
+                return None;
+            }
+            let mut row_done = 0;
+            let result = scan_pixels(args, &case, line, &settings, &mut |done| {
+                let added = done.saturating_sub(row_done) as u64;
+                row_done = row_done.max(done);
+                let position = pixels_done.fetch_add(added, Ordering::Relaxed) + added;
+                if let Ok(mut progress) = progress.lock() {
+                    progress.update(position, String::new);
+                }
+                false
+            })
+            .with_context(|| format!("row {row} of --raster {}", path.display()));
+            if result.is_err() {
+                first_failed.fetch_min(row, Ordering::Relaxed);
+            }
+            Some(result)
+        })
+        .collect();
     let mut rows: Vec<Vec<ScanPixel>> = Vec::with_capacity(raster.rows.len());
     let mut inputs = Value::Null;
-    for line in &raster.rows {
-        let before = rows.iter().map(Vec::len).sum::<usize>() as u64;
-        let (pixels, row_inputs) = scan_pixels(args, &case, line, &settings, &mut |done| {
-            progress.update(before + done as u64, String::new);
-            false
-        })?;
+    for result in scanned.into_iter().flatten() {
+        let (pixels, row_inputs) = result?;
         rows.push(pixels);
         inputs = row_inputs;
     }
-    progress.finish();
+    if let Ok(progress) = progress.into_inner() {
+        progress.finish();
+    }
     inputs["options"]["raster"] = json!(path.display().to_string());
     let tagged = |row: usize, pixel: &ScanPixel| {
         let mut value = pixel_json(pixel);

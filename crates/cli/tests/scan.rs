@@ -141,3 +141,102 @@ fn a_raster_scans_every_row_and_draws_the_images() {
     assert_eq!(output.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&output.stderr).contains("rows[1]"));
 }
+
+/// A raster of four rows: two flat mica rows and two whose right half is the humid mica of
+/// a capillary meniscus, where the ideal feedback cannot hold `A/A0 = 0.8` (its approach
+/// branch has no stable orbit there).
+const RASTER_WITH_FAILING_ROWS: &str = r#"{"row_spacing_nm": 10, "rows": [
+    {"segments": [{"from_nm": 0, "to_nm": 100, "height_nm": 0, "sample": "mica"}]},
+    {"segments": [{"from_nm": 0, "to_nm": 50, "height_nm": 0, "sample": "mica"},
+                  {"from_nm": 50, "to_nm": 100, "height_nm": 0, "sample": "mica-humid"}]},
+    {"segments": [{"from_nm": 0, "to_nm": 100, "height_nm": 2, "sample": "soft"}]},
+    {"segments": [{"from_nm": 0, "to_nm": 50, "height_nm": 0, "sample": "mica"},
+                  {"from_nm": 50, "to_nm": 100, "height_nm": 0, "sample": "mica-humid"}]}]}"#;
+
+#[test]
+fn raster_rows_run_in_parallel_as_the_lines_run_alone_and_the_first_failing_row_is_named() {
+    // Every row of a raster is the scan of its line alone (the rows are independent), on one
+    // thread and on several (the rows run in parallel: the bytes must not depend on it).
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let step = r#"{"segments": [{"from_nm": 0, "to_nm": 60, "height_nm": 0, "sample": "mica"},
+        {"from_nm": 60, "to_nm": 120, "height_nm": 3, "sample": "soft"}]}"#;
+    let line = directory.path().join("step.json");
+    std::fs::write(&line, step).expect("line file");
+    let raster = directory.path().join("raster.json");
+    std::fs::write(
+        &raster,
+        format!(r#"{{"row_spacing_nm": 25, "rows": ["step.json", {step}, "step.json"]}}"#),
+    )
+    .expect("raster file");
+    for feedback in ["ideal", "pi"] {
+        let alone = json_of(&[
+            "scan",
+            "--line",
+            line.to_str().unwrap(),
+            "--feedback",
+            feedback,
+            "--pixels",
+            "5",
+        ]);
+        let alone = alone["pixels"].as_array().expect("pixels");
+        let mut outputs = Vec::new();
+        for threads in ["1", "2", "3"] {
+            let output = drumroll()
+                .env("RAYON_NUM_THREADS", threads)
+                .args(["scan", "--raster", raster.to_str().unwrap()])
+                .args(["--feedback", feedback, "--pixels", "5", "--json", "-q"])
+                .output()
+                .expect("runs");
+            assert!(
+                output.status.success(),
+                "{}",
+                String::from_utf8_lossy(&output.stderr)
+            );
+            outputs.push(output.stdout);
+        }
+        assert_eq!(outputs[0], outputs[1], "{feedback}: 1 and 2 threads");
+        assert_eq!(outputs[0], outputs[2], "{feedback}: 1 and 3 threads");
+        let value: serde_json::Value = serde_json::from_slice(&outputs[0]).expect("JSON");
+        let pixels = value["pixels"].as_array().expect("pixels");
+        assert_eq!(pixels.len(), 3 * alone.len());
+        for (index, pixel) in pixels.iter().enumerate() {
+            let (row, column) = (index / alone.len(), index % alone.len());
+            assert_eq!(number(pixel, "row"), row as f64);
+            let mut pixel = pixel.clone();
+            let fields = pixel.as_object_mut().expect("pixel object");
+            fields.remove("row");
+            fields.remove("y_nm");
+            assert_eq!(
+                &pixel, &alone[column],
+                "{feedback}: row {row}, pixel {column}"
+            );
+        }
+    }
+
+    // Rows 1 and 3 fail; the error names row 1 however many threads ran, and nothing is
+    // printed on standard output.
+    let failing = directory.path().join("failing.json");
+    std::fs::write(&failing, RASTER_WITH_FAILING_ROWS).expect("raster file");
+    for threads in ["1", "2", "3"] {
+        let output = drumroll()
+            .env("RAYON_NUM_THREADS", threads)
+            .args([
+                "scan",
+                "--raster",
+                failing.to_str().unwrap(),
+                "--pixels",
+                "4",
+            ])
+            .output()
+            .expect("runs");
+        assert_eq!(output.status.code(), Some(1), "{threads} threads");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            stderr.contains("row 1 of --raster"),
+            "{threads} threads: {stderr}"
+        );
+        assert!(stderr.contains("mica-humid"), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(output.stdout.is_empty(), "{threads} threads printed output");
+    }
+}
