@@ -304,7 +304,7 @@ pub fn scan_pixels(
     line: &ScanLine,
     settings: &ScanSettings,
     progress: &mut dyn FnMut(usize) -> bool,
-) -> Result<(Vec<ScanPixel>, Value)> {
+) -> Result<ScannedLine> {
     let model = TappingModel::from_case(case)?;
     let (pixels, integration, feedback_options) = match args.feedback {
         Feedback::Ideal => (
@@ -405,6 +405,9 @@ pub fn run(args: &ScanArgs) -> Result<()> {
     Ok(())
 }
 
+/// One line's pixels and the `inputs` object of its output ([`scan_pixels`]).
+pub type ScannedLine = (Vec<ScanPixel>, Value);
+
 /// `drumroll scan --raster FILE`: every row scanned as a line (the case and settings of the
 /// first row), the pixels tagged with `row` and `y_nm`; `--plot` draws the trace's images.
 ///
@@ -424,7 +427,7 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
     ));
     let pixels_done = AtomicU64::new(0);
     let first_failed = AtomicUsize::new(usize::MAX);
-    let scanned: Vec<Option<Result<(Vec<ScanPixel>, Value)>>> = raster
+    let scanned: Vec<Option<Result<ScannedLine>>> = raster
         .rows
         .par_iter()
         .enumerate()
