@@ -156,7 +156,8 @@ const RASTER_WITH_FAILING_ROWS: &str = r#"{"row_spacing_nm": 10, "rows": [
 #[test]
 fn raster_rows_run_in_parallel_as_the_lines_run_alone_and_the_first_failing_row_is_named() {
     // Every row of a raster is the scan of its line alone (the rows are independent), on one
-    // thread and on several (the rows run in parallel: the bytes must not depend on it).
+    // thread and on several (the rows, and a line's materials, run in parallel: the bytes
+    // must not depend on it).
     let directory = tempfile::tempdir().expect("temporary directory");
     let step = r#"{"segments": [{"from_nm": 0, "to_nm": 60, "height_nm": 0, "sample": "mica"},
         {"from_nm": 60, "to_nm": 120, "height_nm": 3, "sample": "soft"}]}"#;
@@ -169,15 +170,26 @@ fn raster_rows_run_in_parallel_as_the_lines_run_alone_and_the_first_failing_row_
     )
     .expect("raster file");
     for feedback in ["ideal", "pi"] {
-        let alone = json_of(&[
-            "scan",
-            "--line",
-            line.to_str().unwrap(),
-            "--feedback",
-            feedback,
-            "--pixels",
-            "5",
-        ]);
+        // The line alone, whose materials' branches are computed in parallel: the same bytes
+        // on one thread and on two.
+        let line_outputs: Vec<Vec<u8>> = ["1", "2"]
+            .iter()
+            .map(|threads| {
+                let output = drumroll()
+                    .env("RAYON_NUM_THREADS", threads)
+                    .args(["scan", "--line", line.to_str().unwrap()])
+                    .args(["--feedback", feedback, "--pixels", "5", "--json", "-q"])
+                    .output()
+                    .expect("runs");
+                assert!(output.status.success());
+                output.stdout
+            })
+            .collect();
+        assert_eq!(
+            line_outputs[0], line_outputs[1],
+            "{feedback}: the line alone"
+        );
+        let alone: serde_json::Value = serde_json::from_slice(&line_outputs[0]).expect("JSON");
         let alone = alone["pixels"].as_array().expect("pixels");
         let mut outputs = Vec::new();
         for threads in ["1", "2", "3"] {

@@ -6,6 +6,8 @@
 //! ends. The first pass engages by a slow approach at its first pixel; a retrace after a
 //! trace goes on from where the trace ended.
 
+use rayon::prelude::*;
+
 use crate::error::AfmError;
 use crate::model::case::Case;
 use crate::orbit::steady_orbit::{SteadyOrbit, SteadyOrbitWorkspace};
@@ -38,8 +40,30 @@ pub fn ideal_scan_until(
     settings.validate()?;
     let models = line_models(case, line)?;
     let search = AmplitudeRatioSearch::new(settings.setpoint)?;
-    let mut branches: Vec<Option<SetpointBranch>> = vec![None; models.len()];
     let centres = line.pixel_centres(settings.pixels);
+    // Each material under a pixel needs its branch (a diagram of its own): they are computed
+    // in parallel, and a material's error is returned where the scan first reaches it, as if
+    // its branch were computed there.
+    let mut branches: Vec<Option<SetpointBranch>> = Vec::with_capacity(models.len());
+    let mut errors: Vec<Option<AfmError>> = Vec::with_capacity(models.len());
+    for result in (0..models.len())
+        .into_par_iter()
+        .map(|material| {
+            centres
+                .iter()
+                .any(|&x| line.material_at(x) == material)
+                .then(|| SetpointBranch::new(&models[material], &search, &settings.orbit))
+        })
+        .collect::<Vec<_>>()
+    {
+        let (branch, error) = match result {
+            Some(Ok(branch)) => (Some(branch), None),
+            Some(Err(error)) => (None, Some(error)),
+            None => (None, None),
+        };
+        branches.push(branch);
+        errors.push(error);
+    }
     let workspace = &mut SteadyOrbitWorkspace::default();
     let a0 = case.free_amplitude_nm;
     let mut pixels = Vec::with_capacity(centres.len() * settings.directions.passes().len());
@@ -54,15 +78,11 @@ pub fn ideal_scan_until(
         for index in order {
             let x = centres[index];
             let material = line.material_at(x);
-            if branches[material].is_none() {
-                branches[material] = Some(SetpointBranch::new(
-                    &models[material],
-                    &search,
-                    &settings.orbit,
-                )?);
+            if let Some(error) = errors[material].take() {
+                return Err(error);
             }
             let Some(branch) = branches[material].as_ref() else {
-                unreachable!("the branch was just computed");
+                unreachable!("every material under a pixel has its branch or its error");
             };
             let (orbit, jump) = match &current {
                 None => branch.engage(workspace)?,
