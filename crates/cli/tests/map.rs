@@ -2,7 +2,7 @@
 //! figure, and its refusal of bad input.
 
 mod common;
-use common::{drumroll, json_of, number};
+use common::{drumroll, json_of, number, stdout_on_threads};
 
 use serde_json::Value;
 
@@ -347,19 +347,7 @@ fn map_is_the_same_on_one_thread_and_on_two() {
         "fold,period-doubling",
         "--json",
     ];
-    let on = |threads: &str| {
-        let output = drumroll()
-            .args(args)
-            .env("RAYON_NUM_THREADS", threads)
-            .output()
-            .expect("runs");
-        assert!(
-            output.status.success(),
-            "{threads} threads: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        output.stdout
-    };
+    let on = |threads: &str| stdout_on_threads(threads, &args);
     let one = on("1");
     assert!(one == on("2"), "the maps on 1 and 2 threads differ");
     let map: Value = serde_json::from_slice(&one).expect("one JSON object");

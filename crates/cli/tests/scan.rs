@@ -2,7 +2,7 @@
 //! input (clear errors naming the option or the file and field; no output file left behind).
 
 mod common;
-use common::{drumroll, json_of, number};
+use common::{drumroll, json_of, number, stdout_on_threads};
 
 #[test]
 fn the_paper_line_reads_the_film_lower_than_it_is_in_csv_json_and_figure() {
@@ -170,20 +170,13 @@ fn raster_rows_run_in_parallel_as_the_lines_run_alone_and_the_first_failing_row_
     )
     .expect("raster file");
     for feedback in ["ideal", "pi"] {
+        let options = ["--feedback", feedback, "--pixels", "5", "--json", "-q"];
         // The line alone, whose materials' branches are computed in parallel: the same bytes
         // on one thread and on two.
+        let line_args = [&["scan", "--line", line.to_str().unwrap()][..], &options].concat();
         let line_outputs: Vec<Vec<u8>> = ["1", "2"]
             .iter()
-            .map(|threads| {
-                let output = drumroll()
-                    .env("RAYON_NUM_THREADS", threads)
-                    .args(["scan", "--line", line.to_str().unwrap()])
-                    .args(["--feedback", feedback, "--pixels", "5", "--json", "-q"])
-                    .output()
-                    .expect("runs");
-                assert!(output.status.success());
-                output.stdout
-            })
+            .map(|threads| stdout_on_threads(threads, &line_args))
             .collect();
         assert_eq!(
             line_outputs[0], line_outputs[1],
@@ -191,21 +184,15 @@ fn raster_rows_run_in_parallel_as_the_lines_run_alone_and_the_first_failing_row_
         );
         let alone: serde_json::Value = serde_json::from_slice(&line_outputs[0]).expect("JSON");
         let alone = alone["pixels"].as_array().expect("pixels");
-        let mut outputs = Vec::new();
-        for threads in ["1", "2", "3"] {
-            let output = drumroll()
-                .env("RAYON_NUM_THREADS", threads)
-                .args(["scan", "--raster", raster.to_str().unwrap()])
-                .args(["--feedback", feedback, "--pixels", "5", "--json", "-q"])
-                .output()
-                .expect("runs");
-            assert!(
-                output.status.success(),
-                "{}",
-                String::from_utf8_lossy(&output.stderr)
-            );
-            outputs.push(output.stdout);
-        }
+        let raster_args = [
+            &["scan", "--raster", raster.to_str().unwrap()][..],
+            &options,
+        ]
+        .concat();
+        let outputs: Vec<Vec<u8>> = ["1", "2", "3"]
+            .iter()
+            .map(|threads| stdout_on_threads(threads, &raster_args))
+            .collect();
         assert_eq!(outputs[0], outputs[1], "{feedback}: 1 and 2 threads");
         assert_eq!(outputs[0], outputs[2], "{feedback}: 1 and 3 threads");
         let value: serde_json::Value = serde_json::from_slice(&outputs[0]).expect("JSON");

@@ -21,6 +21,22 @@ pub fn json_of(args: &[&str]) -> Value {
     serde_json::from_slice(&output.stdout).expect("one JSON object")
 }
 
+/// Run `drumroll ARGS` with rayon's pool of `threads` threads (`RAYON_NUM_THREADS`), require
+/// success, and return its standard output.
+pub fn stdout_on_threads(threads: &str, args: &[&str]) -> Vec<u8> {
+    let output = drumroll()
+        .env("RAYON_NUM_THREADS", threads)
+        .args(args)
+        .output()
+        .expect("runs");
+    assert!(
+        output.status.success(),
+        "{args:?} on {threads} threads: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output.stdout
+}
+
 /// The number at `key` of a JSON object.
 pub fn number(value: &Value, key: &str) -> f64 {
     value[key]
