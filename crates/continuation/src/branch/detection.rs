@@ -25,7 +25,7 @@ type SampleTest = fn(&Sample) -> f64;
 /// near side (`A`, [`extrapolated_zero`]): quadratically where that side crosses the surface (a
 /// minimum of the contact surface below it: the orbit attaches there; a release maximum above
 /// the release surface: the orbit releases there), else linearly (`None`: not an extremum).
-fn near_side_vanishing(test: &StructureTest) -> Option<Vanishing> {
+pub(super) fn near_side_vanishing(test: &StructureTest) -> Option<Vanishing> {
     let StructureTest::Extremum { kind, value_a, .. } = *test else {
         return None;
     };

@@ -152,7 +152,10 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             }));
         }
         *failures += 1;
-        let stuck = *failures >= CORNER_FAILURES || self.step <= self.settings.min_step;
+        // Next to a hysteretic grazing whose zero the branch already resolves, the step is not
+        // cut again: the branch ends here as at the minimum step.
+        let resolved = !wandered && self.grazing_resolved(corrected.smallest_residual);
+        let stuck = *failures >= CORNER_FAILURES || self.step <= self.settings.min_step || resolved;
         let jump = if stuck && !*jump_tried {
             *jump_tried = true;
             self.corner_jump()?
@@ -168,9 +171,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 at_bound: false,
             }));
         }
-        let cut = match self.grazing_fraction(&predicted)? {
-            Some(fraction) => self.cut_by(fraction),
-            None => self.cut(),
+        let cut = !resolved && {
+            match self.grazing_fraction(&predicted)? {
+                Some(fraction) => self.cut_by(fraction),
+                None => self.cut(),
+            }
         };
         if cut {
             return Ok(None);
@@ -328,6 +333,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let accepted = std::mem::replace(&mut self.current, b);
         if jumped || !self.settings.hysteretic_grazing {
             self.recent_structures.clear();
+            self.bracketed_grazing = None;
         } else {
             if self.recent_structures.len() == RECENT_STRUCTURES {
                 self.recent_structures.pop_front();
