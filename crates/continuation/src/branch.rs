@@ -30,7 +30,8 @@
 //! (`branch/hysteretic_break.rs`), so that the minimum step is reached in a few steps. Next to
 //! such a grazing the period map's own error exceeds Newton's tolerance; once the grazing's zero
 //! is extrapolated from the branch to within the location tolerance, a correction that fails
-//! at that noise floor ends the branch as one at the minimum step does.
+//! at that noise floor, or after one such failure the point that resolves the zero, ends the
+//! branch as a failure at the minimum step does.
 
 use std::collections::VecDeque;
 
@@ -146,6 +147,13 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// extrapolated to within the location tolerance. `None` at the start and after a jump over
     /// a corner.
     bracketed_grazing: Option<StructureTest>,
+    /// Whether a correction has failed at the period map's noise floor since the grazing was
+    /// bracketed (`bracketed_grazing`): the branch is as near it as the map resolves.
+    noise_floor_met: bool,
+    /// Where a point accepted after such a failure resolves the grazing's zero, the residual of
+    /// its correction: the branch ends there, with no further correction
+    /// (`branch/hysteretic_break.rs`). `None` otherwise.
+    grazing_reached: Option<f64>,
     start: Option<BranchPoint>,
     step: f64,
     produced: usize,
@@ -219,6 +227,8 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             recent_structures: VecDeque::new(),
             grazing_test: None,
             bracketed_grazing: None,
+            noise_floor_met: false,
+            grazing_reached: None,
             start: Some(first),
             produced: 0,
             special_points: Vec::new(),

@@ -257,14 +257,15 @@ impl PeriodicProblem for NoisyQuadraticGrazing {
 }
 
 /// The branch of [`NoisyQuadraticGrazing`] from `p = 1` downwards (`hysteretic_grazing`): its
-/// steps aimed at the grazing reach the noise band, where (almost) every correction fails at
-/// the noise floor; the zero of `sqrt(|g|)`, exactly linear outside the band, is extrapolated
-/// to within the location tolerance from the points before it, so a failure there ends the
-/// branch. The grazing's bracket holds the exact `p = 0` (its width, 3e-8, from orbits
-/// converged in the band, which the noise shifts by up to `noise / (1 - a)` = 1e-8), and fewer
-/// maps are spent in the band: measured 37 (of 81 in all), against 138 (of 182) when the
-/// branch halved its step down to the smallest through the band instead; asserted as below
-/// half of that.
+/// steps aimed at the grazing reach the noise band, where corrections fail at the noise floor
+/// (or converge by chance onto orbits the noise shifts by up to `noise / (1 - a)` = 1e-8); the
+/// zero of `sqrt(|g|)`, exactly linear outside the band, is extrapolated to within the location
+/// tolerance from the branch's points, so such a failure, or after one the point that resolves
+/// the zero, ends the branch, and the terminal location shoots no trials into the band. The
+/// grazing's bracket holds the exact `p = 0` (measured width 1.8e-9), and fewer maps are spent
+/// in the band: measured 18 (of 62 in all), against 138 (of 182) when the branch halved its
+/// step down to the smallest through the band and the terminal location shot its trials
+/// there; asserted as below a quarter of that.
 #[test]
 fn a_failure_at_the_noise_floor_next_to_a_resolved_grazing_ends_the_branch() {
     let problem = NoisyQuadraticGrazing {
@@ -294,12 +295,12 @@ fn a_failure_at_the_noise_floor_next_to_a_resolved_grazing_ends_the_branch() {
         .collect();
     assert_eq!(grazings.len(), 1, "{:?}", branch.special_points);
     let grazing = grazings[0];
-    // The exact grazing p = 0 inside the claimed bracket, itself within the tolerance 1e-9.
+    // The exact grazing p = 0 inside the claimed bracket.
     assert!(
-        grazing.bracket.0 <= 0.0 && 0.0 <= grazing.bracket.1 && grazing.precision <= 1e-7,
+        grazing.bracket.0 <= 0.0 && 0.0 <= grazing.bracket.1 && grazing.precision <= 1e-8,
         "{grazing:?}"
     );
     let (maps, in_band) = (problem.maps.get(), problem.maps_in_band.get());
     println!("maps {maps}, in the noise band {in_band}; grazing {grazing:?}");
-    assert!(2 * in_band < 138, "maps in the noise band: {in_band}");
+    assert!(4 * in_band < 138, "maps in the noise band: {in_band}");
 }

@@ -41,6 +41,21 @@ pub(super) fn near_side_vanishing(test: &StructureTest) -> Option<Vanishing> {
     })
 }
 
+/// Whether the location of `test` across the jump of a hysteretic grazing, ending at a failed
+/// trial, reports the zero extrapolated from the near side ([`extrapolated_zero`]): where it
+/// vanishes quadratically there, or it is a maximum of the release surface (see
+/// `locate_structure_changes`).
+pub(super) fn extrapolated_from_near_side(test: &StructureTest) -> bool {
+    let release = matches!(
+        test,
+        StructureTest::Extremum {
+            kind: ExtremumKind::ReleaseMaximum,
+            ..
+        }
+    );
+    release || near_side_vanishing(test) == Some(Vanishing::Quadratically)
+}
+
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// Locate every sign change of a test function in the step held by `segment`.
     pub(super) fn locate_all(

@@ -8,13 +8,13 @@
 //! few steps. Next to the grazing the period map's own error exceeds Newton's tolerance (its
 //! `sqrt(|g|)` term), so corrections fail there at random; once the grazing's zero is
 //! extrapolated from the branch to within the location tolerance, such a failure ends the
-//! branch instead of halving the step down to the minimum through more of them.
+//! branch instead of halving the step down to the minimum through more of them, and so does,
+//! after one such failure, the point whose acceptance resolves the zero.
 
 use nalgebra::DVector;
 
 use super::detection::near_side_vanishing;
 use super::Continuation;
-use crate::corrector::NOISE_FLOOR;
 use crate::error::ContinuationError;
 use crate::extrapolated_zero::extrapolated_zero;
 use crate::problem::PeriodicProblem;
@@ -146,21 +146,31 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         }
     }
 
-    /// Whether a failed correction of a step (its smallest residual `smallest_residual`) on a
-    /// branch whose period map jumps at its grazings has met the grazing the branch approaches
-    /// as closely as the period map resolves it, so that the branch ends here (as at the
-    /// minimum step) instead of cutting the step again: the correction came within
-    /// [`NOISE_FLOOR`] times Newton's tolerance of an orbit without reaching the tolerance (next
-    /// to the grazing the map's `sqrt(|g|)` term puts its own error above it), and the zero of
-    /// the test function of the grazing a failed prediction crossed since the last jump
-    /// ([`Continuation::grazing_fraction`]), extrapolated from the current point and the
-    /// branch's recent points as a located grazing's is ([`extrapolated_zero`]: linearly in `g`
-    /// or `sqrt(|g|)`), lies ahead with an error of at most the location tolerance. Halving the
-    /// step further only repeats such corrections: each succeeds or fails as the last bits of
-    /// the flow fall, and the branch's end moves the zero by no more than its error.
-    pub(super) fn grazing_resolved(&self, smallest_residual: f64) -> bool {
-        let at_noise_floor = smallest_residual <= NOISE_FLOOR * self.settings.corrector.tolerance;
-        let Some(test) = self.bracketed_grazing.filter(|_| at_noise_floor) else {
+    /// After a failed correction of a step, whether it ends the branch at the hysteretic
+    /// grazing the branch approaches: where it failed at the period map's noise floor
+    /// (`at_noise_floor`: its smallest residual within [`crate::corrector::NOISE_FLOOR`] times
+    /// Newton's tolerance, it came that near an orbit; next to the grazing the map's `sqrt(|g|)`
+    /// term puts its own error above the tolerance) while a grazing is bracketed, and the
+    /// grazing's zero is resolved ([`Continuation::grazing_resolved`]). Such a failure is
+    /// remembered until the next jump: a point accepted afterwards that resolves the zero ends
+    /// the branch too (`Continuation::accept`).
+    pub(super) fn at_resolved_grazing(&mut self, at_noise_floor: bool) -> bool {
+        if !(at_noise_floor && self.bracketed_grazing.is_some()) {
+            return false;
+        }
+        self.noise_floor_met = true;
+        self.grazing_resolved()
+    }
+
+    /// Whether the zero of the test function of the grazing a failed prediction crossed since
+    /// the last jump ([`Continuation::grazing_fraction`]), extrapolated from the current point
+    /// and the branch's recent points as a located grazing's is ([`extrapolated_zero`]: linearly
+    /// in `g` or `sqrt(|g|)`), lies ahead with an error of at most the location tolerance.
+    /// Where corrections fail at the period map's noise floor next to it, halving the step
+    /// further only repeats them: each succeeds or fails as the last bits of the flow fall, and
+    /// where the branch ends moves the zero by no more than its error.
+    pub(super) fn grazing_resolved(&self) -> bool {
+        let Some(test) = self.bracketed_grazing else {
             return false;
         };
         let Some(vanishing) = near_side_vanishing(&test) else {
