@@ -27,7 +27,11 @@
 //! [`ContinuationSettings::hysteretic_grazing`]) the branch also ends there, and the step that
 //! fails across the grazing is cut to just short of it, extrapolated from the last two points,
 //! rather than halved, and the steps after it are aimed the same way
-//! (`branch/hysteretic_break.rs`), so that the minimum step is reached in a few steps.
+//! (`branch/hysteretic_break.rs`), so that the minimum step is reached in a few steps. Next to
+//! such a grazing the period map's own error exceeds Newton's tolerance; once the grazing's zero
+//! is extrapolated from the branch to within the location tolerance, a correction that fails
+//! at that noise floor, or after one such failure the point that resolves the zero, ends the
+//! branch as a failure at the minimum step does.
 
 use std::collections::VecDeque;
 
@@ -137,6 +141,19 @@ pub struct Continuation<'a, P: PeriodicProblem + ?Sized> {
     /// The test function of the hysteretic grazing the step was last cut towards, at which the
     /// steps after it are aimed (`branch/hysteretic_break.rs`); `None` otherwise.
     grazing_test: Option<StructureTest>,
+    /// The test function of the last hysteretic grazing that a failed step's prediction had
+    /// crossed (`branch/hysteretic_break.rs`), which the branch is approaching: a correction that
+    /// fails at the period map's noise floor ends the branch once that test's zero is
+    /// extrapolated to within the location tolerance. `None` at the start and after a jump over
+    /// a corner.
+    bracketed_grazing: Option<StructureTest>,
+    /// Whether a correction has failed at the period map's noise floor since the grazing was
+    /// bracketed (`bracketed_grazing`): the branch is as near it as the map resolves.
+    noise_floor_met: bool,
+    /// Where a point accepted after such a failure resolves the grazing's zero, the residual of
+    /// its correction: the branch ends there, with no further correction
+    /// (`branch/hysteretic_break.rs`). `None` otherwise.
+    grazing_reached: Option<f64>,
     start: Option<BranchPoint>,
     step: f64,
     produced: usize,
@@ -209,6 +226,9 @@ impl<'a, P: PeriodicProblem + ?Sized> Continuation<'a, P> {
             previous: None,
             recent_structures: VecDeque::new(),
             grazing_test: None,
+            bracketed_grazing: None,
+            noise_floor_met: false,
+            grazing_reached: None,
             start: Some(first),
             produced: 0,
             special_points: Vec::new(),

@@ -25,6 +25,9 @@ pub(crate) struct Corrected {
     pub residual: f64,
     /// Whether the residual reached the tolerance.
     pub converged: bool,
+    /// The smallest residual `|P(x; p) - x|_2` of the iteration's evaluations (infinite if none
+    /// could be evaluated).
+    pub smallest_residual: f64,
 }
 
 /// The bordered matrix `[M - I, dP/dp; row^T]` (`(n + 1) x (n + 1)`).
@@ -141,7 +144,7 @@ fn likely_converges(residual: f64, tolerance: f64) -> bool {
 /// residual is close to the period map's integration error (the tolerance is set a little
 /// above it, [`NewtonSettings::tolerance`]) and Newton's updates need not reduce it before
 /// one lands below the tolerance (as next to a JKR diagram's breaks).
-const NOISE_FLOOR: f64 = 100.0;
+pub(crate) const NOISE_FLOOR: f64 = 100.0;
 
 /// Newton's method on `[P(x; p) - x; tau . (u - anchor)] = 0` from `guess`, for `purpose`.
 ///
@@ -169,13 +172,15 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
     let mut likely_accepted = false;
     let mut checkpoint = f64::INFINITY;
     let mut best_residual = f64::INFINITY;
-    let failed = |u: DVector<f64>, iterations, map: Option<PeriodMap>, residual| Corrected {
-        u,
-        map,
-        iterations,
-        residual,
-        converged: false,
-    };
+    let failed =
+        |u: DVector<f64>, iterations, map: Option<PeriodMap>, residual, smallest| Corrected {
+            u,
+            map,
+            iterations,
+            residual,
+            converged: false,
+            smallest_residual: smallest,
+        };
     loop {
         let p = u[n];
         let evaluated = if likely_accepted {
@@ -185,12 +190,16 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
         };
         let map = match evaluated {
             Ok(map) => map,
-            Err(e) if recoverable(&e) => return Ok(failed(u, iterations, None, f64::INFINITY)),
+            Err(e) if recoverable(&e) => {
+                return Ok(failed(u, iterations, None, f64::INFINITY, best_residual))
+            }
             Err(e) => return Err(e),
         };
         match check_period_map(&map, n, p) {
             Ok(()) => {}
-            Err(e) if recoverable(&e) => return Ok(failed(u, iterations, None, f64::INFINITY)),
+            Err(e) if recoverable(&e) => {
+                return Ok(failed(u, iterations, None, f64::INFINITY, best_residual))
+            }
             Err(e) => return Err(e),
         }
         let mut rhs = DVector::zeros(n + 1);
@@ -206,6 +215,7 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
                 iterations,
                 residual,
                 converged: true,
+                smallest_residual: residual,
             });
         }
         // The stall check's first window starts at the guess (update 0) only above the noise
@@ -218,20 +228,26 @@ pub(crate) fn correct<P: PeriodicProblem + ?Sized>(
                 && best_residual > NOISE_FLOOR * settings.tolerance
                 && residual >= best_residual)
         {
-            return Ok(failed(u, iterations, Some(map), residual));
+            return Ok(failed(
+                u,
+                iterations,
+                Some(map),
+                residual,
+                best_residual.min(residual),
+            ));
         }
         previous_residual = residual;
         best_residual = best_residual.min(residual);
         let a = bordered(&map, tau);
         let Some(update) = a.lu().solve(&rhs) else {
-            return Ok(failed(u, iterations, Some(map), residual));
+            return Ok(failed(u, iterations, Some(map), residual, best_residual));
         };
         u -= update;
         iterations += 1;
         likely_accepted =
             purpose == Purpose::BranchPoint && likely_converges(residual, settings.tolerance);
         if !u.iter().all(|v| v.is_finite()) {
-            return Ok(failed(u, iterations, None, f64::INFINITY));
+            return Ok(failed(u, iterations, None, f64::INFINITY, best_residual));
         }
     }
 }
@@ -352,6 +368,9 @@ mod tests {
         assert!(!corrected.converged);
         assert_eq!(corrected.iterations, 2);
         assert!((corrected.residual - residual(2)).abs() < 1e-9 * residual(2));
+        // The smallest of the three residuals, 1.21 after the 1st update.
+        let smallest = residual(0).min(residual(1));
+        assert!((corrected.smallest_residual - smallest).abs() < 1e-9 * smallest);
         assert_eq!(problem.calls.borrow().len(), 3);
     }
 

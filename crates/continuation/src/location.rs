@@ -120,6 +120,9 @@ pub(crate) struct Segment<'a, P: PeriodicProblem + ?Sized> {
     /// Whether the far end (`sigma = 1`) is an orbit, whose tangent a shot in natural mode can
     /// start from (not where it is the trajectory past the end of a branch).
     far_is_orbit: bool,
+    /// Whether a new trial is taken as failed without a correction
+    /// ([`Segment::with_failing_trials`]).
+    trials_fail: bool,
     samples: RefCell<Vec<Sample>>,
     trials: Cell<usize>,
 }
@@ -239,6 +242,7 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
             location_tolerance,
             natural,
             far_is_orbit: true,
+            trials_fail: false,
             samples: RefCell::new(vec![a, b]),
             trials: Cell::new(0),
         }
@@ -249,6 +253,16 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     /// tangent only.
     pub(crate) fn with_far_trajectory(mut self) -> Self {
         self.far_is_orbit = false;
+        self
+    }
+
+    /// The segment whose new trials all count as failed, with no correction made: at the end of
+    /// a branch next to a hysteretic grazing whose zero the branch's own points resolve, where
+    /// trials between it and the grazing meet the period map's noise floor, and the grazing's
+    /// zero is extrapolated from the branch (`extrapolated_zero.rs`). In natural mode a failed
+    /// trial stands for the far side, so a location ends at the near end.
+    pub(crate) fn with_failing_trials(mut self) -> Self {
+        self.trials_fail = true;
         self
     }
 
@@ -324,6 +338,9 @@ impl<'a, P: PeriodicProblem + ?Sized> Segment<'a, P> {
     pub(crate) fn sample(&self, sigma: f64) -> Result<Option<usize>, ContinuationError> {
         if let Some(i) = self.index_of(sigma) {
             return Ok(Some(i));
+        }
+        if self.trials_fail {
+            return Ok(None);
         }
         self.trials.set(self.trials.get() + 1);
         let found = if self.natural {

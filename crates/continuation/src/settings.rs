@@ -76,9 +76,11 @@ pub struct ContinuationSettings {
     /// prediction lies past such a grazing cuts the step to 0.99 of the way to the grazing
     /// extrapolated from the last two points, instead of by `step_cut`, and the steps after it
     /// are aimed the same way (`branch/hysteretic_break.rs`); the branch reaches the minimum
-    /// step, where it ends, in a few steps instead of about twenty failed corrections; the
-    /// corner jump tried there shoots at its largest offset only (`branch/corner.rs`).
-    /// Default `false`.
+    /// step, where it ends, in a few steps instead of about twenty failed corrections, or ends
+    /// before it where a correction fails at the period map's noise floor (within 100 times
+    /// Newton's tolerance) once the grazing's zero is extrapolated from the branch to within
+    /// `location_tolerance`; the corner jump tried there shoots at its largest offset only
+    /// (`branch/corner.rs`). Default `false`.
     pub hysteretic_grazing: bool,
 }
 

@@ -194,3 +194,113 @@ fn no_fold_at_the_jump_of_a_hysteretic_grazing() {
         "{kinds:?}"
     );
 }
+
+/// A branch `x = p` (`p > 0`) whose gap minimum `g = -x^2` vanishes quadratically at the
+/// grazing `p = 0` (the side of a hysteretic grazing that crosses the surface, one impact:
+/// `sqrt(|g|) = x` is linear in `p`), past which the map jumps (`x <= 0`: minimum `x^2`, no
+/// impact, the map shifted by `J`, no fixed point for `-J < p <= 0`); within `band` of the grazing (`0 < x < band`) the map carries a
+/// deterministic noise of amplitude `noise` (a hash of `x` and `p`), above Newton's tolerance
+/// 1e-10 and below its noise floor 1e-8, as a JKR period map's `sqrt(|g|)` term puts its error
+/// there.
+struct NoisyQuadraticGrazing {
+    contraction: f64,
+    jump: f64,
+    band: f64,
+    noise: f64,
+    /// Period maps evaluated, and those within the noise band.
+    maps: Cell<usize>,
+    maps_in_band: Cell<usize>,
+}
+
+impl NoisyQuadraticGrazing {
+    /// A value in `[-1, 1)` fixed by the bits of `x` and `p`.
+    fn hash(x: f64, p: f64) -> f64 {
+        let bits = (x.to_bits() ^ p.to_bits().rotate_left(17)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        (bits >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
+impl PeriodicProblem for NoisyQuadraticGrazing {
+    fn dim(&self) -> usize {
+        1
+    }
+
+    fn period_map(&self, x: &[f64], p: f64) -> Result<PeriodMap, ContinuationError> {
+        self.maps.set(self.maps.get() + 1);
+        let x = x[0];
+        let a = self.contraction;
+        let past = x <= 0.0;
+        let in_band = !past && x < self.band;
+        if in_band {
+            self.maps_in_band.set(self.maps_in_band.get() + 1);
+        }
+        let shift = if past { self.jump } else { 0.0 };
+        let noise = if in_band {
+            self.noise * Self::hash(x, p)
+        } else {
+            0.0
+        };
+        Ok(PeriodMap {
+            image: DVector::from_element(1, a * x + (1.0 - a) * (p + shift) + noise),
+            monodromy: DMatrix::from_element(1, 1, a),
+            parameter_derivative: DVector::from_element(1, 1.0 - a),
+            structure: OrbitStructure {
+                minima: vec![(0.5, if past { x * x } else { -x * x })],
+                maxima: vec![],
+                impacts: usize::from(!past),
+                duration: 1.0,
+                permanent_contact: false,
+                release_maxima: vec![],
+            },
+        })
+    }
+}
+
+/// The branch of [`NoisyQuadraticGrazing`] from `p = 1` downwards (`hysteretic_grazing`): its
+/// steps aimed at the grazing reach the noise band, where corrections fail at the noise floor
+/// (or converge by chance onto orbits the noise shifts by up to `noise / (1 - a)` = 1e-8); the
+/// zero of `sqrt(|g|)`, exactly linear outside the band, is extrapolated to within the location
+/// tolerance from the branch's points, so such a failure, or after one the point that resolves
+/// the zero, ends the branch, and the terminal location shoots no trials into the band. The
+/// grazing's bracket holds the exact `p = 0` (measured width 1.8e-9), and fewer maps are spent
+/// in the band: measured 18 (of 62 in all), against 138 (of 182) when the branch halved its
+/// step down to the smallest through the band and the terminal location shot its trials
+/// there; asserted as below a quarter of that.
+#[test]
+fn a_failure_at_the_noise_floor_next_to_a_resolved_grazing_ends_the_branch() {
+    let problem = NoisyQuadraticGrazing {
+        contraction: 0.5,
+        jump: 2.0,
+        band: 1e-5,
+        noise: 5e-9,
+        maps: Cell::new(0),
+        maps_in_band: Cell::new(0),
+    };
+    let settings = ContinuationSettings {
+        initial_step: 0.05,
+        max_step: 0.1,
+        direction: ParameterDirection::Decreasing,
+        parameter_min: -1.0,
+        hysteretic_grazing: true,
+        ..ContinuationSettings::default()
+    };
+    let branch = Continuation::new(&problem, &[1.0], 1.0, settings)
+        .expect("start converges")
+        .run();
+    assert_eq!(branch.stop, StopReason::StepTooSmall);
+    let grazings: Vec<_> = branch
+        .special_points
+        .iter()
+        .filter(|s| s.kind == SpecialPointKind::Grazing)
+        .collect();
+    assert_eq!(grazings.len(), 1, "{:?}", branch.special_points);
+    let grazing = grazings[0];
+    // The exact grazing p = 0 inside the claimed bracket.
+    assert!(
+        grazing.bracket.0 <= 0.0 && 0.0 <= grazing.bracket.1 && grazing.precision <= 1e-8,
+        "{grazing:?}"
+    );
+    let (maps, in_band) = (problem.maps.get(), problem.maps_in_band.get());
+    println!("maps {maps}, in the noise band {in_band}; grazing {grazing:?}");
+    assert!(4 * in_band < 138, "maps in the noise band: {in_band}");
+}

@@ -5,6 +5,7 @@
 
 use nalgebra::DVector;
 
+use super::detection::extrapolated_from_near_side;
 use super::Continuation;
 use crate::error::ContinuationError;
 use crate::location::{Sample, Segment};
@@ -141,8 +142,16 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// side; the change is then located in the natural parameter between the last orbit and
     /// that parameter, trials (shot from the state extrapolated along the last orbit's tangent)
     /// with no orbit counting as the far side. `impacts_after` is the
-    /// impact count of that extrapolated trajectory (no orbit exists there).
-    pub(super) fn terminal_location(&self) -> Result<Vec<SpecialPoint>, ContinuationError> {
+    /// impact count of that extrapolated trajectory (no orbit exists there). Where the branch
+    /// ends at a hysteretic grazing whose zero its points resolve (`resolved`,
+    /// [`Continuation::grazing_resolved`]) and every change found is one whose zero is
+    /// extrapolated from the near side ([`extrapolated_from_near_side`]), no trial is shot:
+    /// trials between the last orbit and the grazing meet the period map's noise floor, and the
+    /// zero is extrapolated from the branch's points as it would be past their failures.
+    pub(super) fn terminal_location(
+        &self,
+        resolved: bool,
+    ) -> Result<Vec<SpecialPoint>, ContinuationError> {
         let a = &self.current;
         let n = self.problem.dim();
         let tp = a.tangent[n];
@@ -182,6 +191,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 true,
             )
             .with_far_trajectory();
+            let segment = if resolved && structure.iter().all(extrapolated_from_near_side) {
+                segment.with_failing_trials()
+            } else {
+                segment
+            };
             let index = self.produced.saturating_sub(1);
             return self.locate_all(&segment, &structure, index, true, false);
         }

@@ -25,7 +25,7 @@ type SampleTest = fn(&Sample) -> f64;
 /// near side (`A`, [`extrapolated_zero`]): quadratically where that side crosses the surface (a
 /// minimum of the contact surface below it: the orbit attaches there; a release maximum above
 /// the release surface: the orbit releases there), else linearly (`None`: not an extremum).
-fn near_side_vanishing(test: &StructureTest) -> Option<Vanishing> {
+pub(super) fn near_side_vanishing(test: &StructureTest) -> Option<Vanishing> {
     let StructureTest::Extremum { kind, value_a, .. } = *test else {
         return None;
     };
@@ -39,6 +39,21 @@ fn near_side_vanishing(test: &StructureTest) -> Option<Vanishing> {
     } else {
         Vanishing::Linearly
     })
+}
+
+/// Whether the location of `test` across the jump of a hysteretic grazing, ending at a failed
+/// trial, reports the zero extrapolated from the near side ([`extrapolated_zero`]): where it
+/// vanishes quadratically there, or it is a maximum of the release surface (see
+/// `locate_structure_changes`).
+pub(super) fn extrapolated_from_near_side(test: &StructureTest) -> bool {
+    let release = matches!(
+        test,
+        StructureTest::Extremum {
+            kind: ExtremumKind::ReleaseMaximum,
+            ..
+        }
+    );
+    release || near_side_vanishing(test) == Some(Vanishing::Quadratically)
 }
 
 impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {

@@ -5,12 +5,18 @@
 //! [`super::Continuation::terminal_location`]). Halving the step takes about twenty failed
 //! corrections from the largest step down; cutting it instead to just short of the grazing
 //! extrapolated from the accepted side, and aiming the steps after it the same way, takes a
-//! few steps.
+//! few steps. Next to the grazing the period map's own error exceeds Newton's tolerance (its
+//! `sqrt(|g|)` term), so corrections fail there at random; once the grazing's zero is
+//! extrapolated from the branch to within the location tolerance, such a failure ends the
+//! branch instead of halving the step down to the minimum through more of them, and so does,
+//! after one such failure, the point whose acceptance resolves the zero.
 
 use nalgebra::DVector;
 
+use super::detection::near_side_vanishing;
 use super::Continuation;
 use crate::error::ContinuationError;
+use crate::extrapolated_zero::extrapolated_zero;
 use crate::problem::PeriodicProblem;
 use crate::test_function::{structure_changes, ExtremumKind, StructureTest};
 
@@ -69,6 +75,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let Some((share, test)) = nearest else {
             return Ok(None);
         };
+        self.bracketed_grazing = Some(test);
         let fraction = SHORT_OF_GRAZING * share;
         let cuts = fraction > 0.0 && fraction < self.settings.step_cut;
         if cuts {
@@ -137,5 +144,52 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
             Some(share) if share.is_finite() && share > 0.0 => share,
             _ => test.linear_root(),
         }
+    }
+
+    /// After a failed correction of a step, whether it ends the branch at the hysteretic
+    /// grazing the branch approaches: where it failed at the period map's noise floor
+    /// (`at_noise_floor`: its smallest residual within [`crate::corrector::NOISE_FLOOR`] times
+    /// Newton's tolerance, it came that near an orbit; next to the grazing the map's `sqrt(|g|)`
+    /// term puts its own error above the tolerance) while a grazing is bracketed, and the
+    /// grazing's zero is resolved ([`Continuation::grazing_resolved`]). Such a failure is
+    /// remembered until the next jump: a point accepted afterwards that resolves the zero ends
+    /// the branch too (`Continuation::accept`).
+    pub(super) fn at_resolved_grazing(&mut self, at_noise_floor: bool) -> bool {
+        if !(at_noise_floor && self.bracketed_grazing.is_some()) {
+            return false;
+        }
+        self.noise_floor_met = true;
+        self.grazing_resolved()
+    }
+
+    /// Whether the zero of the test function of the grazing a failed prediction crossed since
+    /// the last jump ([`Continuation::grazing_fraction`]), extrapolated from the current point
+    /// and the branch's recent points as a located grazing's is ([`extrapolated_zero`]: linearly
+    /// in `g` or `sqrt(|g|)`), lies ahead with an error of at most the location tolerance.
+    /// Where corrections fail at the period map's noise floor next to it, halving the step
+    /// further only repeats them: each succeeds or fails as the last bits of the flow fall, and
+    /// where the branch ends moves the zero by no more than its error.
+    pub(super) fn grazing_resolved(&self) -> bool {
+        let Some(test) = self.bracketed_grazing else {
+            return false;
+        };
+        let Some(vanishing) = near_side_vanishing(&test) else {
+            return false;
+        };
+        let n = self.problem.dim();
+        let (p_a, t_p) = (self.current.parameter(), self.current.tangent[n]);
+        let g_a = test.value(0.0, &self.current.map.structure);
+        let near_side = |g: f64| g.is_finite() && g != 0.0 && (g < 0.0) == (g_a < 0.0);
+        let points: Vec<(f64, f64)> = std::iter::once((p_a, g_a))
+            .chain(
+                self.recent_structures
+                    .iter()
+                    .map(|(p, structure)| (*p, test.value(0.0, structure))),
+            )
+            .filter(|&(_, g)| near_side(g))
+            .collect();
+        t_p != 0.0
+            && extrapolated_zero(&points, t_p.signum(), vanishing)
+                .is_some_and(|zero| zero.error <= self.settings.location_tolerance)
     }
 }

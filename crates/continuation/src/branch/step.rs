@@ -7,7 +7,7 @@ use nalgebra::DVector;
 
 use super::corner::CORNER_FAILURES;
 use super::{BranchPoint, Continuation, StopReason, RECENT_STRUCTURES};
-use crate::corrector::{correct, Purpose};
+use crate::corrector::{correct, Purpose, NOISE_FLOOR};
 use crate::error::ContinuationError;
 use crate::floquet::is_stable;
 use crate::hermite::hermite_basis;
@@ -119,7 +119,11 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
     /// the corrector fails (or wanders further than `ds`), after [`CORNER_FAILURES`] failures
     /// or at the minimum step, once, the orbit past a corner ([`Continuation::corner_jump`]).
     /// `None` when the step was cut and is to be tried again; an error when it cannot be cut
-    /// (the branch ends, after locating the structure change it ran into).
+    /// (the branch ends, after locating the structure change it ran into). Next to a hysteretic
+    /// grazing whose zero the branch resolves, a correction that fails at the period map's noise
+    /// floor is not cut again, and after such a failure, the point that resolves the zero is
+    /// the branch's last: no correction is tried from it
+    /// ([`Continuation::at_resolved_grazing`]).
     fn corrected_trial(
         &mut self,
         ds: f64,
@@ -128,31 +132,40 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         jump_tried: &mut bool,
     ) -> Result<Option<Trial>, ContinuationError> {
         let predicted = &self.current.u + ds * t_a;
-        let guess = self
-            .cubic_predictor(ds)
-            .unwrap_or_else(|| predicted.clone());
-        let corrected = correct(
-            self.problem,
-            guess,
-            &predicted,
-            t_a,
-            &self.settings.corrector,
-            Purpose::BranchPoint,
-        )?;
-        // A corrector that wandered further than the step itself has probably left the
-        // branch: treat it as a failure.
-        let wandered = (&corrected.u - &predicted).norm() > ds;
-        if let (true, Some(map)) = (corrected.converged && !wandered, corrected.map) {
-            return Ok(Some(Trial {
-                sample: Sample::new(1.0, corrected.u, map, t_a),
-                iterations: corrected.iterations,
-                residual: corrected.residual,
-                reference: t_a.clone(),
-                at_bound: false,
-            }));
-        }
-        *failures += 1;
-        let stuck = *failures >= CORNER_FAILURES || self.step <= self.settings.min_step;
+        let (resolved, residual) = match self.grazing_reached {
+            Some(residual) => (true, residual),
+            None => {
+                let guess = self
+                    .cubic_predictor(ds)
+                    .unwrap_or_else(|| predicted.clone());
+                let corrected = correct(
+                    self.problem,
+                    guess,
+                    &predicted,
+                    t_a,
+                    &self.settings.corrector,
+                    Purpose::BranchPoint,
+                )?;
+                // A corrector that wandered further than the step itself has probably left the
+                // branch: treat it as a failure.
+                let wandered = (&corrected.u - &predicted).norm() > ds;
+                if let (true, Some(map)) = (corrected.converged && !wandered, corrected.map) {
+                    return Ok(Some(Trial {
+                        sample: Sample::new(1.0, corrected.u, map, t_a),
+                        iterations: corrected.iterations,
+                        residual: corrected.residual,
+                        reference: t_a.clone(),
+                        at_bound: false,
+                    }));
+                }
+                *failures += 1;
+                let at_noise_floor = !wandered
+                    && corrected.smallest_residual
+                        <= NOISE_FLOOR * self.settings.corrector.tolerance;
+                (self.at_resolved_grazing(at_noise_floor), corrected.residual)
+            }
+        };
+        let stuck = *failures >= CORNER_FAILURES || self.step <= self.settings.min_step || resolved;
         let jump = if stuck && !*jump_tried {
             *jump_tried = true;
             self.corner_jump()?
@@ -168,20 +181,22 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
                 at_bound: false,
             }));
         }
-        let cut = match self.grazing_fraction(&predicted)? {
-            Some(fraction) => self.cut_by(fraction),
-            None => self.cut(),
+        let cut = !resolved && {
+            match self.grazing_fraction(&predicted)? {
+                Some(fraction) => self.cut_by(fraction),
+                None => self.cut(),
+            }
         };
         if cut {
             return Ok(None);
         }
-        let terminal = self.terminal_location()?;
+        let terminal = self.terminal_location(resolved)?;
         self.special_points.extend(terminal);
         self.stop = Some(StopReason::StepTooSmall);
         Err(ContinuationError::StepTooSmall {
             parameter: self.current.parameter(),
             step: ds,
-            residual: corrected.residual,
+            residual,
         })
     }
 
@@ -328,6 +343,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         let accepted = std::mem::replace(&mut self.current, b);
         if jumped || !self.settings.hysteretic_grazing {
             self.recent_structures.clear();
+            self.bracketed_grazing = None;
+            self.noise_floor_met = false;
         } else {
             if self.recent_structures.len() == RECENT_STRUCTURES {
                 self.recent_structures.pop_front();
@@ -340,6 +357,8 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         } else {
             Some((accepted.u, accepted.tangent))
         };
+        self.grazing_reached =
+            (self.noise_floor_met && self.grazing_resolved()).then_some(residual);
         self.aim_at_grazing();
         Ok(self.emit(point, at_bound))
     }
