@@ -239,3 +239,43 @@ fn raster_rows_run_in_parallel_as_the_lines_run_alone_and_the_first_failing_row_
         assert!(output.stdout.is_empty(), "{threads} threads printed output");
     }
 }
+
+#[test]
+fn a_failing_material_is_named_where_the_scan_first_reaches_it() {
+    // Mica, then the strong van der Waals polymer (an air sample: under the liquid MAClever of
+    // the default case its branch does not start), then humid mica (A/A0 = 0.8 lies in a jump
+    // of its approach). Both failing branches are computed in parallel before the first pixel;
+    // the error is the one a serial scan meets first: the polymer on a trace, the humid mica
+    // on a retrace, on any number of threads, with the sample named.
+    let directory = tempfile::tempdir().expect("temporary directory");
+    let line = directory.path().join("two-failing.json");
+    std::fs::write(
+        &line,
+        r#"{"segments": [{"from_nm": 0, "to_nm": 30, "height_nm": 0, "sample": "mica"},
+            {"from_nm": 30, "to_nm": 60, "height_nm": 0, "sample": "polymer-strong-vdw"},
+            {"from_nm": 60, "to_nm": 90, "height_nm": 0, "sample": "mica-humid"}]}"#,
+    )
+    .expect("line file");
+    for (direction, failing) in [("trace", "polymer-strong-vdw"), ("retrace", "mica-humid")] {
+        for threads in ["1", "2"] {
+            let output = drumroll()
+                .env("RAYON_NUM_THREADS", threads)
+                .args(["scan", "--line", line.to_str().unwrap(), "--pixels", "6"])
+                .args(["--direction", direction])
+                .output()
+                .expect("runs");
+            assert_eq!(
+                output.status.code(),
+                Some(1),
+                "{direction}, {threads} threads"
+            );
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert!(
+                stderr.contains(&format!("A/A0 = 0.8 on sample `{failing}` not reached")),
+                "{direction}, {threads} threads: {stderr}"
+            );
+            assert!(!stderr.contains("panicked"), "{stderr}");
+            assert!(output.stdout.is_empty());
+        }
+    }
+}

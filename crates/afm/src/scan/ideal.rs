@@ -14,7 +14,7 @@ use crate::orbit::steady_orbit::{SteadyOrbit, SteadyOrbitWorkspace};
 use crate::scan::line::ScanLine;
 use crate::scan::materials::line_models;
 use crate::scan::pixel::{set_measured_heights, ScanDirection, ScanPixel};
-use crate::scan::setpoint_branch::SetpointBranch;
+use crate::scan::setpoint_branch::{on_sample, SetpointBranch};
 use crate::scan::settings::ScanSettings;
 use crate::sweep::amplitude_ratio::AmplitudeRatioSearch;
 
@@ -52,7 +52,11 @@ pub fn ideal_scan_until(
             centres
                 .iter()
                 .any(|&x| line.material_at(x) == material)
-                .then(|| SetpointBranch::new(&models[material], &search, &settings.orbit))
+                .then(|| {
+                    SetpointBranch::new(&models[material], &search, &settings.orbit).map_err(
+                        |error| on_sample(error, settings.setpoint, &line.materials[material].name),
+                    )
+                })
         })
         .collect::<Vec<_>>()
     {
@@ -85,9 +89,13 @@ pub fn ideal_scan_until(
                 unreachable!("every material under a pixel has its branch or its error");
             };
             let (orbit, jump) = match &current {
-                None => branch.engage(workspace)?,
+                None => branch
+                    .engage(workspace)
+                    .map_err(|error| branch.named(error))?,
                 Some((on, orbit)) if *on == material => (orbit.clone(), None),
-                Some((_, orbit)) => branch.follow(orbit.z_nm, &orbit.state, workspace)?,
+                Some((_, orbit)) => branch
+                    .follow(orbit.z_nm, &orbit.state, workspace)
+                    .map_err(|error| branch.named(error))?,
             };
             pixels.push(ScanPixel::of_orbit(
                 index,

@@ -316,6 +316,12 @@ impl SetpointBranch {
         )))
     }
 
+    /// `error` of a search for this branch's setpoint, with the sample named (see
+    /// [`on_sample`]).
+    pub fn named(&self, error: AfmError) -> AfmError {
+        on_sample(error, self.search.ratio, &self.model.sample().name)
+    }
+
     fn not_reached(&self, reason: &str) -> AfmError {
         AfmError::NotReached {
             what: format!(
@@ -325,5 +331,25 @@ impl SetpointBranch {
             ),
             reason: reason.to_string(),
         }
+    }
+}
+
+/// `error` of the search for the setpoint `A/A0 = ratio` on sample `sample` (its branch, the
+/// feedback's engaging or its walk), naming the sample, so that a scan over several materials
+/// says which one failed: a setpoint not reached gets the sample in what was searched for, a
+/// failed orbit or continuation becomes the setpoint not reached on that sample for that
+/// reason; other errors (an interruption, bad input) are returned as they are.
+pub fn on_sample(error: AfmError, ratio: f64, sample: &str) -> AfmError {
+    let what = format!("A/A0 = {ratio} on sample `{sample}`");
+    match error {
+        AfmError::NotReached {
+            what: searched,
+            reason,
+        } if !searched.contains("on sample") => AfmError::NotReached { what, reason },
+        AfmError::Continuation(_) | AfmError::Solver(_) => AfmError::NotReached {
+            what,
+            reason: error.to_string(),
+        },
+        other => other,
     }
 }
