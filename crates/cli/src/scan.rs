@@ -16,7 +16,7 @@ use clap::{Args, ValueEnum};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use crate::inputs::orbit_inputs_json;
@@ -421,11 +421,14 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
     let case = args.case(&raster.rows[0])?;
     let settings = args.settings()?;
     let total = (settings.pixels * settings.directions.passes().len() * raster.rows.len()) as u64;
-    let progress = Mutex::new(Progress::new(
-        total,
-        "{wide_bar} {human_pos}/{human_len} pixels, {eta} left",
+    // The bar and the pixels done in all rows, moved together.
+    let progress = Mutex::new((
+        Progress::new(
+            total,
+            "{wide_bar} {human_pos}/{human_len} pixels, {eta} left",
+        ),
+        0u64,
     ));
-    let pixels_done = AtomicU64::new(0);
     let first_failed = AtomicUsize::new(usize::MAX);
     let scanned: Vec<Option<Result<ScannedLine>>> = raster
         .rows
@@ -439,9 +442,10 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
             let result = scan_pixels(args, &case, line, &settings, &mut |done| {
                 let added = done.saturating_sub(row_done) as u64;
                 row_done = row_done.max(done);
-                let position = pixels_done.fetch_add(added, Ordering::Relaxed) + added;
-                if let Ok(mut progress) = progress.lock() {
-                    progress.update(position, String::new);
+                if let Ok(mut guard) = progress.lock() {
+                    let (bar, pixels_done) = &mut *guard;
+                    *pixels_done += added;
+                    bar.update(*pixels_done, String::new);
                 }
                 false
             })
@@ -459,8 +463,8 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
         rows.push(pixels);
         inputs = row_inputs;
     }
-    if let Ok(progress) = progress.into_inner() {
-        progress.finish();
+    if let Ok((bar, _)) = progress.into_inner() {
+        bar.finish();
     }
     inputs["options"]["raster"] = json!(path.display().to_string());
     let tagged = |row: usize, pixel: &ScanPixel| {
