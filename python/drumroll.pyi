@@ -113,6 +113,41 @@ class Case:
         harmonic_<n>_phase_deg (deg) for n = 1..`harmonics`; a DataFrame's attrs["inputs"]
         holds the inputs. Releases the GIL; Ctrl-C
         stops it."""
+    def fit(
+        self,
+        measurement: "Measurement",
+        *,
+        fit: Sequence[str] = ("z-offset", "phase-offset", "sample-modulus"),
+        max_evaluations: int = 40,
+    ) -> "FitResult":
+        """Fit this case's approach branch to `measurement` over the parameters in `fit`
+        ("z-offset", "amplitude-calibration", "phase-offset", "sample-modulus", "tip-radius",
+        ...), as `drumroll fit` (MODEL.md section 13.3): Levenberg-Marquardt on the followed
+        branch, at most `max_evaluations` evaluations. Releases the GIL."""
+    def scan(
+        self,
+        line: Union[str, Dict[str, Any], None] = None,
+        *,
+        setpoint: float = 0.8,
+        pixels: int = 64,
+        feedback: str = "ideal",
+        direction: str = "trace",
+        gain_p: float = 0.2,
+        gain_i_per_ms: float = 0.5,
+        scan_rate_nm_per_s: float = 100.0,
+        lockin_time_constant_ms: float = 0.0,
+        harmonics: int = 4,
+    ) -> Table:
+        """An image line with amplitude feedback, as `drumroll scan` (MODEL.md section 12):
+        this case's cantilever, drive and A0 over `line` (a built-in line name, default
+        "membrane-patch", a line file path, or a dict in the line files' format), `pixels`
+        pixels at the setpoint A/A0 `setpoint`, `feedback` "ideal" (steady orbits followed
+        along their branches, jumps marked) or "pi" (the time-domain loop: `gain_p` nm/nm,
+        `gain_i_per_ms` 1/ms, `scan_rate_nm_per_s` nm/s, `lockin_time_constant_ms` ms),
+        `direction` "trace", "retrace" or "both". One row per pixel in scan order with the
+        columns of `drumroll scan`'s CSV (height_nm, z_nm, phase_deg, impacts_per_period,
+        ...); a DataFrame's attrs["inputs"] and attrs["line"] as in `--json`. Releases the
+        GIL; Ctrl-C stops it."""
     def map(
         self,
         vary: str,
@@ -284,6 +319,52 @@ class RegimeMap:
     @classmethod
     def from_dict(cls, data: Dict[str, Any]) -> "RegimeMap":
         """A map from its dict (or a saved `map --json` file's content)."""
+
+class Measurement:
+    """A measured approach curve read from a CSV or TSV file with a header, as `drumroll
+    detect --data` reads it (MODEL.md section 13.1)."""
+
+    @staticmethod
+    def from_csv(
+        path: str,
+        *,
+        columns: Optional[str] = None,
+        z_unit: str = "nm",
+        amplitude_unit: str = "nm",
+        invols: Optional[float] = None,
+        phase_radians: bool = False,
+        a0: Optional[float] = None,
+    ) -> "Measurement":
+        """Read `path`: the columns z_nm, amplitude_nm, phase_deg unless `columns`
+        ("z=NAME,amplitude=NAME,phase=NAME", any of the three) names others; `z_unit` "nm",
+        "um" or "m"; `amplitude_unit` "nm", "um", "m" or "V" (with `invols`, nm/V);
+        `phase_radians`; `a0` the free amplitude (nm; default the mean of the free rows).
+        ValueError names the file, line and column of a bad file."""
+    @property
+    def a0(self) -> float:
+        """The free amplitude, nm."""
+    @property
+    def approach(self) -> Table:
+        """The approach rows (Z decreasing): line, z_nm, amplitude_nm, phase_deg."""
+    @property
+    def bad_rows(self) -> List[Dict[str, Any]]:
+        """The rows left out: dicts line, column, reason."""
+    def detect(self, *, significance: float = 0.01, window: int = 0) -> Dict[str, Any]:
+        """The transitions (kinks and jumps) with their Z, 1-sigma uncertainty, A/A0, phase
+        and significance: the dict of `drumroll detect --json` (MODEL.md section 13.2)."""
+
+class FitResult:
+    """The result of `Case.fit`."""
+
+    @property
+    def parameters(self) -> Dict[str, Dict[str, Any]]:
+        """The fitted parameters: name -> {"value", "stderr" (None: undetermined),
+        "initial"}."""
+    @property
+    def points(self) -> Table:
+        """The measured points with the fitted model, one row each (docs/output-schema.md)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The whole `drumroll fit --json` object."""
 
 def cases() -> Dict[str, Dict[str, Dict[str, Any]]]:
     """The built-in fixtures: {"cases": {...}, "cantilevers": {...}, "samples": {...}}, each
