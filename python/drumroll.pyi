@@ -128,6 +128,7 @@ class Case:
         self,
         line: Union[str, Dict[str, Any], None] = None,
         *,
+        raster: Union[str, Dict[str, Any], None] = None,
         setpoint: float = 0.8,
         pixels: int = 64,
         feedback: str = "ideal",
@@ -146,7 +147,10 @@ class Case:
         `gain_i_per_ms` 1/ms, `scan_rate_nm_per_s` nm/s, `lockin_time_constant_ms` ms),
         `direction` "trace", "retrace" or "both". One row per pixel in scan order with the
         columns of `drumroll scan`'s CSV (height_nm, z_nm, phase_deg, impacts_per_period,
-        ...); a DataFrame's attrs["inputs"] and attrs["line"] as in `--json`. Releases the
+        ...); a DataFrame's attrs["inputs"] and attrs["line"] as in `--json`. `raster` (a
+        raster file path or a dict in the raster files' format) instead of `line` scans every
+        row as a line, as `drumroll scan --raster` (rows in parallel): the columns row and
+        y_nm (nm) follow direction, and attrs["raster"] replaces attrs["line"]. Releases the
         GIL; Ctrl-C stops it."""
     def map(
         self,

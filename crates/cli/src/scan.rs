@@ -408,27 +408,24 @@ pub fn run(args: &ScanArgs) -> Result<()> {
 /// One line's pixels and the `inputs` object of its output ([`scan_pixels`]).
 pub type ScannedLine = (Vec<ScanPixel>, Value);
 
-/// `drumroll scan --raster FILE`: every row scanned as a line (the case and settings of the
-/// first row), the pixels tagged with `row` and `y_nm`; `--plot` draws the trace's images.
+/// The rows of `raster` (named `source` in errors) each scanned as a line with the case `case`
+/// and `settings` (as [`scan_pixels`]), their pixels in row order, with the `inputs` object of
+/// the last row. `pixels_done(n)` is told of every `n` pixels finished, from any row's thread;
+/// answering `true` stops the scan (the rows end with `Interrupted`).
 ///
 /// The rows are independent (each is scanned from the case's own start, MODEL.md section 12),
 /// so they are scanned in parallel on rayon's pool (`RAYON_NUM_THREADS`, else one thread per
-/// core); their pixels are kept in row order, so the output is the same on any number of
-/// threads. The first failing row in row order is reported (rows after a failed one are not
-/// started).
-fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Result<()> {
-    let raster = ScanRaster::load(path).with_context(|| format!("--raster {}", path.display()))?;
-    let case = args.case(&raster.rows[0])?;
-    let settings = args.settings()?;
-    let total = (settings.pixels * settings.directions.passes().len() * raster.rows.len()) as u64;
-    // The bar and the pixels done in all rows, moved together.
-    let progress = Mutex::new((
-        Progress::new(
-            total,
-            "{wide_bar} {human_pos}/{human_len} pixels, {eta} left",
-        ),
-        0u64,
-    ));
+/// core); their pixels are kept in row order, so the result is the same on any number of
+/// threads. The first failing row in row order is the error, named (`row J of SOURCE`; rows
+/// after a failed one are not started). Shared with the Python module's `Case.scan`.
+pub fn scan_raster(
+    args: &ScanArgs,
+    case: &Case,
+    raster: &ScanRaster,
+    source: &str,
+    settings: &ScanSettings,
+    pixels_done: &(dyn Fn(u64) -> bool + Sync),
+) -> Result<(Vec<Vec<ScanPixel>>, Value)> {
     let first_failed = AtomicUsize::new(usize::MAX);
     let scanned: Vec<Option<Result<ScannedLine>>> = raster
         .rows
@@ -439,17 +436,12 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
                 return None;
             }
             let mut row_done = 0;
-            let result = scan_pixels(args, &case, line, &settings, &mut |done| {
+            let result = scan_pixels(args, case, line, settings, &mut |done| {
                 let added = done.saturating_sub(row_done) as u64;
                 row_done = row_done.max(done);
-                if let Ok(mut guard) = progress.lock() {
-                    let (bar, pixels_done) = &mut *guard;
-                    *pixels_done += added;
-                    bar.update(*pixels_done, String::new);
-                }
-                false
+                pixels_done(added)
             })
-            .with_context(|| format!("row {row} of --raster {}", path.display()));
+            .with_context(|| format!("row {row} of {source}"));
             if result.is_err() {
                 first_failed.fetch_min(row, Ordering::Relaxed);
             }
@@ -463,25 +455,61 @@ fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Re
         rows.push(pixels);
         inputs = row_inputs;
     }
+    Ok((rows, inputs))
+}
+
+/// The `raster` object of `drumroll scan --raster --json` (docs/output-schema.md).
+pub fn raster_json(raster: &ScanRaster) -> Value {
+    json!({
+        "name": raster.name,
+        "description": raster.description,
+        "row_spacing_nm": raster.row_spacing_nm,
+        "rows": raster.rows.iter().map(line_json).collect::<Vec<_>>(),
+    })
+}
+
+/// A raster pixel's JSON object: [`pixel_json`] with its `row` and `y_nm` (nm).
+pub fn raster_pixel_json(raster: &ScanRaster, row: usize, pixel: &ScanPixel) -> Value {
+    let mut value = pixel_json(pixel);
+    value["row"] = json!(row);
+    value["y_nm"] = json!(row as f64 * raster.row_spacing_nm);
+    value
+}
+
+/// `drumroll scan --raster FILE`: every row scanned as a line (the case and settings of the
+/// first row; [`scan_raster`]), the pixels tagged with `row` and `y_nm`; `--plot` draws the
+/// trace's images.
+fn run_raster(args: &ScanArgs, path: &Path, plot_path: Option<FigureFile>) -> Result<()> {
+    let raster = ScanRaster::load(path).with_context(|| format!("--raster {}", path.display()))?;
+    let case = args.case(&raster.rows[0])?;
+    let settings = args.settings()?;
+    let total = (settings.pixels * settings.directions.passes().len() * raster.rows.len()) as u64;
+    // The bar and the pixels done in all rows, moved together.
+    let progress = Mutex::new((
+        Progress::new(
+            total,
+            "{wide_bar} {human_pos}/{human_len} pixels, {eta} left",
+        ),
+        0u64,
+    ));
+    let source = format!("--raster {}", path.display());
+    let (rows, mut inputs) = scan_raster(args, &case, &raster, &source, &settings, &|added| {
+        if let Ok(mut guard) = progress.lock() {
+            let (bar, pixels_done) = &mut *guard;
+            *pixels_done += added;
+            bar.update(*pixels_done, String::new);
+        }
+        false
+    })?;
     if let Ok((bar, _)) = progress.into_inner() {
         bar.finish();
     }
     inputs["options"]["raster"] = json!(path.display().to_string());
-    let tagged = |row: usize, pixel: &ScanPixel| {
-        let mut value = pixel_json(pixel);
-        value["row"] = json!(row);
-        value["y_nm"] = json!(row as f64 * raster.row_spacing_nm);
-        value
-    };
+    let tagged = |row: usize, pixel: &ScanPixel| raster_pixel_json(&raster, row, pixel);
     let text = if args.json {
         let value = json!({
             "inputs": inputs,
-            "raster": {
-                "name": raster.name,
-                "description": raster.description,
-                "row_spacing_nm": raster.row_spacing_nm,
-                "rows": raster.rows.iter().map(line_json).collect::<Vec<_>>(),
-            },
+            "raster": raster_json(&raster),
             "pixels": rows.iter().enumerate().flat_map(|(j, row)| row.iter().map(move |p| (j, p)))
                 .map(|(j, p)| tagged(j, p)).collect::<Vec<_>>(),
         });

@@ -338,13 +338,17 @@ impl Case {
     /// or `"both"`. Returns a pandas DataFrame (dict of numpy arrays without pandas), one row
     /// per pixel with the CLI's CSV columns (`height_nm`, `z_nm`, `phase_deg`,
     /// `impacts_per_period`, ...); `attrs["inputs"]` and `attrs["line"]` as in `--json`.
-    /// Runs without the GIL; Ctrl-C stops it and raises KeyboardInterrupt.
-    #[pyo3(signature = (line=None, *, setpoint=0.8, pixels=64, feedback="ideal", direction="trace", gain_p=0.2, gain_i_per_ms=0.5, scan_rate_nm_per_s=100.0, lockin_time_constant_ms=0.0, harmonics=4))]
+    /// `raster` (a raster file path or a dict in the raster files' format) instead of `line`
+    /// scans every row as a line, as `drumroll scan --raster` (the rows in parallel): the
+    /// columns `row` and `y_nm` (nm) follow `direction`, and `attrs["raster"]` replaces
+    /// `attrs["line"]`. Runs without the GIL; Ctrl-C stops it and raises KeyboardInterrupt.
+    #[pyo3(signature = (line=None, *, raster=None, setpoint=0.8, pixels=64, feedback="ideal", direction="trace", gain_p=0.2, gain_i_per_ms=0.5, scan_rate_nm_per_s=100.0, lockin_time_constant_ms=0.0, harmonics=4))]
     #[allow(clippy::too_many_arguments)]
     fn scan<'py>(
         &self,
         py: Python<'py>,
         line: Option<&Bound<'py, PyAny>>,
+        raster: Option<&Bound<'py, PyAny>>,
         setpoint: f64,
         pixels: i64,
         feedback: &str,
@@ -366,6 +370,14 @@ impl Case {
             lockin_time_constant_ms,
             harmonics,
         };
+        if let Some(raster) = raster {
+            if line.is_some() {
+                return Err(pyo3::exceptions::PyValueError::new_err(
+                    "scan: give a line or a raster, not both",
+                ));
+            }
+            return crate::scan::compute_raster_scan(py, &self.resolved, raster, &options);
+        }
         let default = pyo3::types::PyString::new(py, "membrane-patch");
         let line = line.cloned().unwrap_or_else(|| default.into_any());
         crate::scan::compute_scan(py, &self.resolved, &line, &options)

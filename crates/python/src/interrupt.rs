@@ -12,9 +12,10 @@ const CHECK_INTERVAL: Duration = Duration::from_millis(50);
 /// Run `work` with the GIL released. `work` gets a callback to call between steps; it
 /// answers `true` once Python has a pending exception from a signal handler (Ctrl-C), which
 /// is then returned as `Err` in place of the result (the computation must stop when told).
+/// The callback may be moved to another thread (behind a lock, for work on several).
 pub fn without_gil<T: Send>(
     py: Python<'_>,
-    work: impl FnOnce(&mut dyn FnMut() -> bool) -> T + Send,
+    work: impl FnOnce(&mut (dyn FnMut() -> bool + Send)) -> T + Send,
 ) -> Result<T, PyErr> {
     let mut pending: Option<PyErr> = None;
     let result = py.allow_threads(|| {

@@ -2,12 +2,15 @@
 //! 12), as a table of pixels whose columns are the CLI's CSV columns.
 
 use afm::scan::line::ScanLine;
+use afm::scan::raster::ScanRaster;
 use drumroll::scan::{
-    line_json, pixel_json, scan_pixels, Direction, Feedback, ScanArgs, CSV_COLUMNS,
+    line_json, pixel_json, raster_json, raster_pixel_json, scan_pixels, scan_raster, Direction,
+    Feedback, ScanArgs, CSV_COLUMNS,
 };
 use pyo3::prelude::*;
 use serde_json::Value;
-use std::sync::Arc;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
 
 use crate::convert::{json_to_py, py_to_json, records_to_table};
 use crate::errors::to_py_err;
@@ -46,20 +49,21 @@ pub fn line_of(line: &Bound<'_, PyAny>) -> PyResult<ScanLine> {
     ScanLine::parse("the line dict", &value.to_string(), None).map_err(crate::errors::afm_to_py_err)
 }
 
-/// The scan of `line` with the case `resolved`'s cantilever, drive and A0: a table
-/// (DataFrame, or dict of numpy arrays) with one row per pixel in scan order, the columns
-/// `direction` and those of `drumroll scan`'s CSV; a DataFrame's `attrs["inputs"]` and
-/// `attrs["line"]` hold the JSON output's `inputs` and `line`.
-pub fn compute_scan<'py>(
-    py: Python<'py>,
-    resolved: &Arc<Resolved>,
-    line: &Bound<'py, PyAny>,
-    options: &ScanOptions,
-) -> PyResult<Bound<'py, PyAny>> {
-    let line_name = line
-        .extract::<String>()
-        .unwrap_or_else(|_| String::from("(dict)"));
-    let line = line_of(line)?;
+/// The raster of a Python argument: a raster file path (`str`; its rows' relative paths
+/// resolved beside it), or a dict in the raster files' format (rows as line dicts or built-in
+/// line names).
+pub fn raster_of(raster: &Bound<'_, PyAny>) -> PyResult<ScanRaster> {
+    if let Ok(path) = raster.extract::<String>() {
+        return ScanRaster::load(Path::new(&path)).map_err(crate::errors::afm_to_py_err);
+    }
+    let value = py_to_json(raster)?;
+    ScanRaster::parse("the raster dict", &value.to_string(), None)
+        .map_err(crate::errors::afm_to_py_err)
+}
+
+/// `drumroll scan`'s arguments for `options` over the line or raster named `name` (a path or
+/// built-in name, or `(dict)`).
+fn scan_args(name: String, options: &ScanOptions) -> PyResult<ScanArgs> {
     let feedback = match options.feedback.as_str() {
         "ideal" => Feedback::Ideal,
         "pi" => Feedback::Pi,
@@ -79,8 +83,8 @@ pub fn compute_scan<'py>(
             )))
         }
     };
-    let args = ScanArgs {
-        line: line_name,
+    Ok(ScanArgs {
+        line: name,
         raster: None,
         case: None,
         cantilever: None,
@@ -98,7 +102,29 @@ pub fn compute_scan<'py>(
         json: true,
         out: None,
         plot: None,
-    };
+    })
+}
+
+/// The name of a line or raster argument in the outputs: its path or built-in name, or
+/// `(dict)`.
+fn argument_name(argument: &Bound<'_, PyAny>) -> String {
+    argument
+        .extract::<String>()
+        .unwrap_or_else(|_| String::from("(dict)"))
+}
+
+/// The scan of `line` with the case `resolved`'s cantilever, drive and A0: a table
+/// (DataFrame, or dict of numpy arrays) with one row per pixel in scan order, the columns
+/// `direction` and those of `drumroll scan`'s CSV; a DataFrame's `attrs["inputs"]` and
+/// `attrs["line"]` hold the JSON output's `inputs` and `line`.
+pub fn compute_scan<'py>(
+    py: Python<'py>,
+    resolved: &Arc<Resolved>,
+    line: &Bound<'py, PyAny>,
+    options: &ScanOptions,
+) -> PyResult<Bound<'py, PyAny>> {
+    let args = scan_args(argument_name(line), options)?;
+    let line = line_of(line)?;
     let mut case = resolved.case.clone();
     case.sample = line.materials[0].clone();
     let (pixels, inputs) = without_gil(py, |interrupted| -> anyhow::Result<(Vec<Value>, Value)> {
@@ -113,6 +139,48 @@ pub fn compute_scan<'py>(
     if let Ok(attrs) = table.getattr("attrs") {
         attrs.set_item("inputs", json_to_py(py, &inputs)?)?;
         attrs.set_item("line", json_to_py(py, &line_json(&line))?)?;
+    }
+    Ok(table)
+}
+
+/// The scan of every row of `raster` (a raster file path or dict) as a line, as `drumroll scan
+/// --raster` (the rows in parallel): a table with one row per pixel, rows in order, the
+/// columns `direction`, `row`, `y_nm` (nm) and those of `drumroll scan`'s CSV; a DataFrame's
+/// `attrs["inputs"]` and `attrs["raster"]` hold the JSON output's `inputs` and `raster`.
+pub fn compute_raster_scan<'py>(
+    py: Python<'py>,
+    resolved: &Arc<Resolved>,
+    raster: &Bound<'py, PyAny>,
+    options: &ScanOptions,
+) -> PyResult<Bound<'py, PyAny>> {
+    let name = argument_name(raster);
+    let args = scan_args(name.clone(), options)?;
+    let raster = raster_of(raster)?;
+    let mut case = resolved.case.clone();
+    case.sample = raster.rows[0].materials[0].clone();
+    let (pixels, inputs) = without_gil(py, |interrupted| -> anyhow::Result<(Vec<Value>, Value)> {
+        let settings = args.settings()?;
+        // The rows run on rayon's threads; each asks for a Ctrl-C through the one callback.
+        let interrupted = Mutex::new(interrupted);
+        let asked = |_| interrupted.lock().map_or(true, |mut asked| asked());
+        let source = format!("raster {name}");
+        let (rows, mut inputs) = scan_raster(&args, &case, &raster, &source, &settings, &asked)?;
+        inputs["options"]["raster"] = Value::String(name.clone());
+        let pixels = rows
+            .iter()
+            .enumerate()
+            .flat_map(|(j, row)| row.iter().map(move |pixel| (j, pixel)))
+            .map(|(j, pixel)| raster_pixel_json(&raster, j, pixel))
+            .collect();
+        Ok((pixels, inputs))
+    })?
+    .map_err(to_py_err)?;
+    let mut columns = vec!["direction", "row", "y_nm"];
+    columns.extend(CSV_COLUMNS);
+    let table = records_to_table(py, &pixels, &columns)?;
+    if let Ok(attrs) = table.getattr("attrs") {
+        attrs.set_item("inputs", json_to_py(py, &inputs)?)?;
+        attrs.set_item("raster", json_to_py(py, &raster_json(&raster))?)?;
     }
     Ok(table)
 }
