@@ -133,14 +133,7 @@ pub fn compute_scan<'py>(
         Ok((pixels.iter().map(pixel_json).collect(), inputs))
     })?
     .map_err(to_py_err)?;
-    let mut columns = vec!["direction"];
-    columns.extend(CSV_COLUMNS);
-    let table = records_to_table(py, &pixels, &columns)?;
-    if let Ok(attrs) = table.getattr("attrs") {
-        attrs.set_item("inputs", json_to_py(py, &inputs)?)?;
-        attrs.set_item("line", json_to_py(py, &line_json(&line))?)?;
-    }
-    Ok(table)
+    pixel_table(py, &pixels, &[], &inputs, ("line", &line_json(&line)))
 }
 
 /// The scan of every row of `raster` (a raster file path or dict) as a line, as `drumroll scan
@@ -175,12 +168,27 @@ pub fn compute_raster_scan<'py>(
         Ok((pixels, inputs))
     })?
     .map_err(to_py_err)?;
-    let mut columns = vec!["direction", "row", "y_nm"];
+    let sample = raster_json(&raster);
+    pixel_table(py, &pixels, &["row", "y_nm"], &inputs, ("raster", &sample))
+}
+
+/// The table of a scan's JSON `pixels`: the columns `direction`, then `leading`, then those of
+/// `drumroll scan`'s CSV; a DataFrame's `attrs["inputs"]` holds `inputs` and
+/// `attrs[sample.0]` the JSON output's line or raster object `sample.1`.
+fn pixel_table<'py>(
+    py: Python<'py>,
+    pixels: &[Value],
+    leading: &[&'static str],
+    inputs: &Value,
+    sample: (&str, &Value),
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut columns = vec!["direction"];
+    columns.extend(leading);
     columns.extend(CSV_COLUMNS);
-    let table = records_to_table(py, &pixels, &columns)?;
+    let table = records_to_table(py, pixels, &columns)?;
     if let Ok(attrs) = table.getattr("attrs") {
-        attrs.set_item("inputs", json_to_py(py, &inputs)?)?;
-        attrs.set_item("raster", json_to_py(py, &raster_json(&raster))?)?;
+        attrs.set_item("inputs", json_to_py(py, inputs)?)?;
+        attrs.set_item(sample.0, json_to_py(py, sample.1)?)?;
     }
     Ok(table)
 }
