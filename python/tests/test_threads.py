@@ -2,6 +2,7 @@
 time of one, and Ctrl-C interrupts a long computation."""
 
 import os
+import pathlib
 import signal
 import subprocess
 import sys
@@ -117,5 +118,32 @@ def test_ctrl_c_interrupts_a_diagram():
     sent = time.perf_counter()
     process.send_signal(signal.SIGINT)
     out, err = process.communicate(timeout=30)
+    assert out.strip() == "interrupted", (out, err)
+    assert time.perf_counter() - sent < 2.0
+
+
+def test_ctrl_c_interrupts_a_raster_scan_on_several_threads():
+    # The rows run on rayon's threads, which do not see signals: the calling thread looks for
+    # the Ctrl-C while they run, and they stop (the scan takes about 10 s on two cores).
+    raster = str(pathlib.Path(__file__).resolve().parents[2] / "fixtures" / "rasters"
+                 / "membrane-disc.json")
+    code = (
+        "import drumroll, time\n"
+        "case = drumroll.Case('maclever-membrane-experiment')\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        f"    case.scan(raster={raster!r}, pixels=64, feedback='pi', scan_rate_nm_per_s=10.0)\n"
+        "    print('finished')\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    process = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    assert process.stdout.readline().strip() == "started"
+    time.sleep(1.0)
+    sent = time.perf_counter()
+    process.send_signal(signal.SIGINT)
+    out, err = process.communicate(timeout=60)
     assert out.strip() == "interrupted", (out, err)
     assert time.perf_counter() - sent < 2.0

@@ -10,11 +10,11 @@ use drumroll::scan::{
 use pyo3::prelude::*;
 use serde_json::Value;
 use std::path::Path;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use crate::convert::{json_to_py, py_to_json, records_to_table};
 use crate::errors::to_py_err;
-use crate::interrupt::without_gil;
+use crate::interrupt::{without_gil, without_gil_on_workers};
 use crate::resolved::Resolved;
 
 /// The options of `Case.scan`, named as in Python (units in the names).
@@ -151,11 +151,11 @@ pub fn compute_raster_scan<'py>(
     let raster = raster_of(raster)?;
     let mut case = resolved.case.clone();
     case.sample = raster.rows[0].materials[0].clone();
-    let (pixels, inputs) = without_gil(py, |interrupted| -> anyhow::Result<(Vec<Value>, Value)> {
+    // The rows run on rayon's threads, which cannot see a Ctrl-C themselves: this thread
+    // looks for one while they run.
+    let work = |interrupted: &(dyn Fn() -> bool + Sync)| -> anyhow::Result<(Vec<Value>, Value)> {
         let settings = args.settings()?;
-        // The rows run on rayon's threads; each asks for a Ctrl-C through the one callback.
-        let interrupted = Mutex::new(interrupted);
-        let asked = |_| interrupted.lock().map_or(true, |mut asked| asked());
+        let asked = |_| interrupted();
         let source = format!("raster {name}");
         let (rows, mut inputs) = scan_raster(&args, &case, &raster, &source, &settings, &asked)?;
         inputs["options"]["raster"] = Value::String(name.clone());
@@ -166,8 +166,8 @@ pub fn compute_raster_scan<'py>(
             .map(|(j, pixel)| raster_pixel_json(&raster, j, pixel))
             .collect();
         Ok((pixels, inputs))
-    })?
-    .map_err(to_py_err)?;
+    };
+    let (pixels, inputs) = without_gil_on_workers(py, work)?.map_err(to_py_err)?;
     let sample = raster_json(&raster);
     pixel_table(py, &pixels, &["row", "y_nm"], &inputs, ("raster", &sample))
 }
