@@ -6,7 +6,7 @@
 #   scripts/measure-targets.sh OUT [DRUMROLL [APPROACH_BENCH]]
 #
 # DRUMROLL defaults to target/release/drumroll (built first), APPROACH_BENCH to the binary of
-# `cargo bench -p afm --bench approach --no-run` (built first), run over its window 9 -> 8 nm.
+# `cargo bench -p afm --bench approach --no-run` (built first), run over its window 9 -> 8 nm on one thread.
 # Counts are repeatable for one binary; the same source built at another path can count up to
 # 1% apart (docs/guide/performance.md), so compare builds made in one checkout.
 set -euo pipefail
@@ -46,6 +46,6 @@ for z in 9.279985 8.518336 2.733157; do
     count "simulate-$z" "$drumroll" simulate --case biolever-mica --z "$z" --json &
     two_at_a_time
 done
-count bench-window "$bench" --from 9 --to 8 &
+count bench-window "$bench" --from 9 --to 8 --one-thread &
 wait
 sort "$out/totals.txt"

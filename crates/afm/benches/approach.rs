@@ -9,8 +9,14 @@
 //! step (default `afm::sweep::SAMPLES_PER_STEP`), `--tolerance X` for the contact integration's tolerance (default
 //! `afm::sweep::DEFAULT_TOLERANCE`), `--all-extrema` to search every free-flight step for extrema
 //! (`extremum_height` infinite, as before the sweep skipped steps proven clear of the sample).
+//!
+//! The sweep runs twice: first in a pool of one thread (the cycles one after the other; the
+//! per-regime table and the "one core" figures), then on rayon's global pool
+//! (`RAYON_NUM_THREADS`, default one thread per core), where the cycles ahead run in
+//! speculative segments; the second run's wall time is reported, and its records must be the
+//! first run's, bit for bit. `--one-thread` stops after the first run (for instruction counts).
 
-use afm::{builtin_case, Sweep, SweepSettings, TappingModel};
+use afm::{builtin_case, Sweep, SweepRecord, SweepSettings, TappingModel};
 use std::time::Instant;
 
 mod cpu_time;
@@ -59,7 +65,36 @@ fn main() {
         settings.integration.extremum_height = f64::INFINITY;
         println!("every free-flight step searched for extrema");
     }
-    let mut sweep = Sweep::new(&model, settings).expect("sweep");
+    let one_thread = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a pool of one thread");
+    let records = one_thread.install(|| one_core(&model, settings.clone()));
+    if arguments.iter().any(|a| a == "--one-thread") {
+        return;
+    }
+    let threads = rayon::current_num_threads();
+    let start = Instant::now();
+    let segmented: Vec<SweepRecord> = Sweep::new(&model, settings)
+        .expect("sweep")
+        .map(|record| record.expect("sweep runs"))
+        .collect();
+    let wall = start.elapsed().as_secs_f64();
+    assert!(
+        segmented == records,
+        "the records on {threads} threads differ from one thread's"
+    );
+    println!(
+        "on {threads} threads (speculative segments): wall time {wall:.3} s, the same {} records \
+         bit for bit",
+        records.len()
+    );
+}
+
+/// The sweep on the calling thread's pool (of one thread): prints its per-regime and total
+/// times, and returns its records.
+fn one_core(model: &TappingModel, settings: SweepSettings) -> Vec<SweepRecord> {
+    let mut sweep = Sweep::new(model, settings).expect("sweep");
     let cycles = sweep.total_cycles();
     println!(
         "approach sweep, Biolever on mica, A0 = 10 nm, Z_G1 = {:.4} nm, {} -> {} nm at 1 nm/s: \
@@ -74,6 +109,7 @@ fn main() {
     let cpu_start = thread_cpu_seconds();
     let mut last = Instant::now();
     let mut last_z_print = f64::INFINITY;
+    let mut records = Vec::new();
     while let Some(record) = sweep.next_record().expect("sweep runs") {
         let now = Instant::now();
         let seconds = (now - last).as_secs_f64();
@@ -93,6 +129,7 @@ fn main() {
                 record.z_nm, record.amplitude_ratio, record.phase_deg, record.impacts_per_period
             );
         }
+        records.push(record);
     }
     let total = start.elapsed().as_secs_f64();
     let cpu = cpu_start.and_then(|s| thread_cpu_seconds().map(|e| e - s));
@@ -109,7 +146,7 @@ fn main() {
             seconds / *count as f64 * 1e6
         );
     }
-    for (what, seconds) in [("wall", Some(total)), ("cpu", cpu)] {
+    for (what, seconds) in [("one thread: wall", Some(total)), ("one thread: cpu", cpu)] {
         let Some(seconds) = seconds else { continue };
         let per_cycle = seconds / cycles as f64;
         println!(
@@ -121,4 +158,5 @@ fn main() {
             SCIPY_SECONDS_PER_CYCLE / per_cycle
         );
     }
+    records
 }

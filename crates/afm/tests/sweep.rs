@@ -502,3 +502,44 @@ fn cycle_lockin_reads_harmonics_and_dissipation() {
         observables.dissipated_ev
     );
 }
+
+/// A sweep whose solver fails in a cycle ends there on any number of threads: the same records
+/// before it, the same error, cycle count and separation (the segments integrated ahead fail
+/// too, or are never reached). The solver's step budget is cut so that free-flight cycles fit
+/// in it and a cycle with deep enough contact does not.
+#[test]
+fn a_failing_cycle_ends_the_sweep_at_the_same_record_on_any_number_of_threads() {
+    let model = biolever_on_mica();
+    let mut settings = window(&model, 9.6, 7.0, 1.0);
+    settings.integration.max_steps = 22;
+    let outcome = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            let mut sweep = Sweep::new(&model, settings.clone()).expect("sweep");
+            let mut records = Vec::new();
+            loop {
+                match sweep.next_record() {
+                    Ok(Some(record)) => records.push(record),
+                    Ok(None) => panic!("the sweep did not fail"),
+                    Err(error) => {
+                        return (
+                            records,
+                            error.to_string(),
+                            sweep.cycles_done(),
+                            sweep.z_nm(),
+                            sweep.state().to_vec(),
+                        )
+                    }
+                }
+            }
+        })
+    };
+    let one = outcome(1);
+    assert!(one.0.len() > 4096, "{} records", one.0.len());
+    for threads in [2, 3] {
+        assert!(outcome(threads) == one, "{threads} threads");
+    }
+}

@@ -7,7 +7,7 @@
 //! # Time keeping
 //!
 //! The clock restarts at every drive cycle: cycle `k` is integrated over local time
-//! `t in [0, T]` with [`Separation::Ramp`] whose `z0` is `Z` at the cycle's start, computed from
+//! `t in [0, T]` with [`Separation::Ramp`](crate::model::separation::Separation::Ramp) whose `z0` is `Z` at the cycle's start, computed from
 //! the cycle index (`Z_start -/+ k rate T`, no accumulated sum). The drive `cos(w t)` is
 //! `T`-periodic, so the restart changes nothing physically, while every time, drive phase and
 //! event tolerance stays that of a single period (absolute times would reach 1e7 us over a
@@ -23,20 +23,30 @@
 //! unfinished block at the floor is discarded. The cycles of the blocks not returned, and the
 //! settling cycles, are integrated without the lock-in ([`advance_cycle`]: the same steps,
 //! no reading).
+//!
+//! # Threads
+//!
+//! One trajectory ([`run`]) is integrated cycle after cycle. On rayon's pool of more than one
+//! thread the cycles ahead are integrated in speculative segments ([`segments`]), whose records
+//! are used only from where the true trajectory meets them bit for bit: the records are the
+//! same on any number of threads.
 
 pub mod amplitude_ratio;
+mod run;
+mod segments;
+
+use std::collections::VecDeque;
 
 use hybrid::{HybridSystem, Sensitivity, Settings, Solver, SolverWorkspace, StepOutcome};
 use serde::Serialize;
 
 use crate::error::AfmError;
-use crate::model::separation::Separation;
 use crate::model::TappingModel;
-use crate::orbit::lockin::{
-    BlockAverage, BlockReading, CycleLockIn, CycleReading, MAX_LOCKIN_HARMONICS,
-};
+use crate::orbit::lockin::{BlockReading, CycleLockIn, CycleReading, MAX_LOCKIN_HARMONICS};
 use crate::orbit::observables::Harmonic;
 use crate::validation::{check, invalid, Interval};
+use run::{SweepPlan, SweepRun};
+use segments::{Segmentation, Served};
 
 /// Microseconds per second: rates are given in nm/s, the model's time is in us.
 const US_PER_S: f64 = 1e6;
@@ -247,32 +257,25 @@ impl SweepSettings {
 
 /// A time-domain approach (and retract) sweep of a [`TappingModel`], run cycle by cycle.
 ///
-/// An iterator of [`SweepRecord`]s: each call of [`Sweep::next_record`] integrates drive
-/// cycles until the next record is due, so a caller can stream the records as they come and
-/// stop at any time. The first call also integrates the settling cycles.
-#[derive(Debug, Clone)]
+/// An iterator of [`SweepRecord`]s: each call of [`Sweep::next_record`] returns the next
+/// record, so a caller can stream the records as they come and stop at any time. The first
+/// call also integrates the settling cycles. On rayon's pool of more than one thread the
+/// cycles ahead are integrated in speculative segments ([`segments`]) whose records are the
+/// same bits as one thread's; with one thread each call integrates cycles until the next
+/// record is due.
+#[derive(Debug)]
 pub struct Sweep {
-    model: TappingModel,
     settings: SweepSettings,
-    /// `|dZ/dt|`, nm/us.
-    rate_nm_per_us: f64,
-    /// `|dZ|` per drive cycle, nm.
-    z_step_nm: f64,
-    /// Cycles in each direction.
-    cycles_per_leg: u64,
-    /// `Z` at the end of the approach (the retract's start), nm.
-    floor_nm: f64,
-    state: Vec<f64>,
-    /// The solver's buffers between cycles (each cycle's solver takes them and gives them
-    /// back, so that cycles allocate nothing).
-    workspace: SolverWorkspace,
-    lockin: CycleLockIn,
-    average: BlockAverage,
-    /// Cycles done since the start of the approach.
-    cycles_done: u64,
-    /// Blocks completed in the current direction.
-    blocks_in_leg: u64,
-    settled: bool,
+    plan: SweepPlan,
+    /// The trajectory's frontier: the run after the last cycle integrated.
+    frontier: SweepRun,
+    /// Records integrated ahead of the caller (by segments), in order.
+    ahead: VecDeque<Served>,
+    /// How the cycles ahead are cut into segments on several threads.
+    segmentation: Segmentation,
+    /// Cycles done at the last record returned and the state then, when it came from
+    /// `ahead` (else the frontier's).
+    served: Option<(u64, Vec<f64>)>,
     finished: bool,
 }
 
@@ -313,22 +316,22 @@ impl Sweep {
                 format!("at most the {cycles_per_leg} drive cycles of one sweep direction"),
             ));
         }
-        let mut model = model.clone();
-        model.set_separation(Separation::Constant(settings.from_nm))?;
-        Ok(Self {
-            state: model.free_state(),
-            workspace: SolverWorkspace::default(),
-            lockin: CycleLockIn::with_harmonics(&model, settings.harmonics),
-            average: BlockAverage::new(settings.lockin_cycles, model.free_amplitude_nm()),
-            floor_nm: settings.from_nm - cycles_per_leg as f64 * z_step_nm,
-            model,
+        let plan = SweepPlan {
+            from_nm: settings.from_nm,
             rate_nm_per_us,
             z_step_nm,
             cycles_per_leg,
+            floor_nm: settings.from_nm - cycles_per_leg as f64 * z_step_nm,
+            lockin_cycles: settings.lockin_cycles as u64,
+            retract: settings.retract,
+        };
+        Ok(Self {
+            frontier: SweepRun::new(model.clone(), settings.clone(), plan)?,
             settings,
-            cycles_done: 0,
-            blocks_in_leg: 0,
-            settled: false,
+            plan,
+            ahead: VecDeque::new(),
+            segmentation: Segmentation::for_model(model),
+            served: None,
             finished: false,
         })
     }
@@ -340,62 +343,55 @@ impl Sweep {
 
     /// Drive cycles in each direction (the approach, and the retract if asked).
     pub fn cycles_per_leg(&self) -> u64 {
-        self.cycles_per_leg
+        self.plan.cycles_per_leg
     }
 
     /// Drive cycles of the whole sweep (settling excluded).
     pub fn total_cycles(&self) -> u64 {
-        if self.settings.retract {
-            2 * self.cycles_per_leg
-        } else {
-            self.cycles_per_leg
-        }
+        self.plan.total_cycles()
     }
 
-    /// Drive cycles integrated so far (settling excluded).
+    /// Drive cycles integrated up to the last record returned (settling excluded); after an
+    /// error, the cycles before the failing one.
     pub fn cycles_done(&self) -> u64 {
-        self.cycles_done
+        match &self.served {
+            Some((cycles, _)) => *cycles,
+            None => self.frontier.cycles_done(),
+        }
     }
 
     /// `Z` at the end of the approach (where the retract starts), nm: `from_nm` minus a whole
     /// number of cycles, within one cycle's travel above `to_nm`.
     pub fn floor_nm(&self) -> f64 {
-        self.floor_nm
+        self.plan.floor_nm
     }
 
     /// The direction of the next cycle (of the last one once the sweep has finished).
     pub fn direction(&self) -> SweepDirection {
-        if self.cycles_done < self.cycles_per_leg {
+        let k = self.cycles_done();
+        if k < self.plan.cycles_per_leg || !self.settings.retract {
             SweepDirection::Approach
-        } else if self.settings.retract {
+        } else {
             SweepDirection::Retract
-        } else {
-            SweepDirection::Approach
         }
     }
 
-    /// The separation now (at the end of the last cycle integrated), nm.
+    /// The separation at the end of the cycles counted by [`Sweep::cycles_done`], nm.
     pub fn z_nm(&self) -> f64 {
-        let k = self.cycles_done;
-        if k <= self.cycles_per_leg {
-            self.settings.from_nm - k as f64 * self.z_step_nm
-        } else {
-            self.floor_nm + (k - self.cycles_per_leg) as f64 * self.z_step_nm
+        self.plan.z_nm(self.cycles_done())
+    }
+
+    /// The cantilever state `[q_1, q_1', ..., q_N, q_N']` (nm, nm/us; and the sample's state
+    /// for a standard linear solid) at the end of the cycles counted by
+    /// [`Sweep::cycles_done`].
+    pub fn state(&self) -> &[f64] {
+        match &self.served {
+            Some((_, state)) => state,
+            None => self.frontier.state(),
         }
     }
 
-    /// The cantilever state `[q_1, q_1', ..., q_N, q_N']` now (nm, nm/us).
-    pub fn state(&self) -> &[f64] {
-        &self.state
-    }
-
-    /// The model (its separation law is that of the last cycle integrated).
-    pub fn model(&self) -> &TappingModel {
-        &self.model
-    }
-
-    /// Integrate drive cycles until the next record is due and return it; `None` when the
-    /// sweep is over. After an error the sweep is over.
+    /// The next record; `None` when the sweep is over. After an error the sweep is over.
     ///
     /// # Errors
     /// [`AfmError::Solver`] if the hybrid solver fails in a cycle.
@@ -403,97 +399,44 @@ impl Sweep {
         if self.finished {
             return Ok(None);
         }
-        let result = self.advance();
-        if !matches!(result, Ok(Some(_))) {
-            self.finished = true;
-        }
-        result
-    }
-
-    /// One drive period at the separation already set, integrated without the lock-in (a
-    /// settling cycle, or a cycle of a block whose record is not returned).
-    fn advance_unread_cycle(&mut self) -> Result<(), AfmError> {
-        advance_cycle(
-            &self.model,
-            &self.settings.integration,
-            &mut self.state,
-            &mut self.workspace,
-        )
-    }
-
-    fn advance(&mut self) -> Result<Option<SweepRecord>, AfmError> {
-        if !self.settled {
-            // The settling cycles are not read.
-            self.model
-                .set_separation(Separation::Constant(self.settings.from_nm))?;
-            for _ in 0..self.settings.settle_cycles {
-                self.advance_unread_cycle()?;
-            }
-            self.settled = true;
-        }
-        while self.cycles_done < self.total_cycles() {
-            let k = self.cycles_done;
-            let (direction, separation, z_mid) = if k < self.cycles_per_leg {
-                let z0 = self.settings.from_nm - k as f64 * self.z_step_nm;
-                (
-                    SweepDirection::Approach,
-                    Separation::Ramp {
-                        z0_nm: z0,
-                        rate_nm_per_us: self.rate_nm_per_us,
-                    },
-                    z0 - 0.5 * self.z_step_nm,
-                )
-            } else {
-                if k == self.cycles_per_leg {
-                    self.average.clear();
-                    self.blocks_in_leg = 0;
+        if self.ahead.is_empty() {
+            let result = self.frontier.settle().and_then(|()| {
+                let threads = rayon::current_num_threads();
+                if self.segmentation.worth_it(&self.frontier, threads) {
+                    segments::integrate_ahead(
+                        &mut self.segmentation,
+                        &mut self.frontier,
+                        &mut self.ahead,
+                    );
+                    Ok(None)
+                } else {
+                    self.served = None;
+                    self.frontier.next_record()
                 }
-                let z0 = self.floor_nm + (k - self.cycles_per_leg) as f64 * self.z_step_nm;
-                (
-                    SweepDirection::Retract,
-                    Separation::Ramp {
-                        z0_nm: z0,
-                        rate_nm_per_us: -self.rate_nm_per_us,
-                    },
-                    z0 + 0.5 * self.z_step_nm,
-                )
-            };
-            // Only the blocks whose records are returned (every `every`-th) are read: the
-            // cycles of the others are integrated without the lock-in.
-            let due = self
-                .blocks_in_leg
-                .is_multiple_of(self.settings.every as u64);
-            let (completed, block) = if due {
-                let reading = self.run_cycle(separation)?;
-                let block = self.average.push(k, z_mid, &reading);
-                (block.is_some(), block)
-            } else {
-                self.model.set_separation(separation)?;
-                self.advance_unread_cycle()?;
-                (self.average.skip(k), None)
-            };
-            self.cycles_done += 1;
-            if completed {
-                self.blocks_in_leg += 1;
-            }
-            if let Some(block) = block {
-                return Ok(Some(SweepRecord::new(direction, block)));
+            });
+            match result {
+                Ok(Some(record)) => return Ok(Some(record)),
+                Ok(None) if self.ahead.is_empty() => {
+                    self.finished = true;
+                    return Ok(None);
+                }
+                Ok(None) => {}
+                Err(error) => {
+                    self.finished = true;
+                    return Err(error);
+                }
             }
         }
-        Ok(None)
-    }
-
-    /// Integrate one drive cycle (local time `[0, T]`) under `separation` from the current
-    /// state, and return the lock-in's reading of it.
-    fn run_cycle(&mut self, separation: Separation) -> Result<CycleReading, AfmError> {
-        self.model.set_separation(separation)?;
-        integrate_cycle(
-            &self.model,
-            &self.settings.integration,
-            &mut self.state,
-            &mut self.workspace,
-            &mut self.lockin,
-        )
+        let served = self.ahead.pop_front().expect("records ahead");
+        self.served = Some((served.cycles_done, served.state));
+        match served.outcome {
+            Ok(record) => Ok(Some(record)),
+            Err(error) => {
+                self.finished = true;
+                self.ahead.clear();
+                Err(error)
+            }
+        }
     }
 }
 
