@@ -31,7 +31,7 @@ use crate::error::AfmError;
 use crate::model::TappingModel;
 
 use super::run::SweepRun;
-use super::{SweepRecord, MAX_CYCLE_COUNT};
+use super::SweepRecord;
 
 /// Drive cycles per segment, at least (about 50 ms of one core for the paper's cantilevers):
 /// a segment's extension until it meets the next one is work done twice, for the Biolever's
@@ -56,10 +56,15 @@ const E_FOLDINGS_TO_THE_LAST_BIT: f64 = 39.1;
 /// decay sets the pace).
 const SEGMENTS_PER_MEMORY: f64 = 8.0;
 
+/// Drive cycles per segment, at most: the records of the segments integrated at once are
+/// held in memory (about 300 bytes a cycle read, so 65,536 cycles on each of 4 segments take
+/// about 80 MB).
+const MAX_SEGMENT_CYCLES: u64 = 65_536;
+
 /// How the cycles ahead are cut into segments: their length, which doubles after a wave in
 /// which the true trajectory ran through a whole segment without meeting it (a sweep that
-/// forgets more slowly than its free decay, or not at all, then falls back towards one
-/// trajectory on one thread).
+/// forgets more slowly than its free decay, or not at all); past [`MAX_SEGMENT_CYCLES`] the
+/// sweep runs on one thread.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Segmentation {
     /// Drive cycles per segment.
@@ -83,21 +88,24 @@ impl Segmentation {
             * E_FOLDINGS_TO_THE_LAST_BIT;
         let length = (SEGMENTS_PER_MEMORY * memory).ceil();
         Self {
-            length: if length.is_finite() {
-                (length as u64).clamp(SEGMENT_CYCLES, MAX_CYCLE_COUNT as u64)
+            length: if length <= MAX_SEGMENT_CYCLES as f64 {
+                (length as u64).max(SEGMENT_CYCLES)
             } else {
-                MAX_CYCLE_COUNT as u64
+                // Also NaN: longer than segments may be (one thread).
+                MAX_SEGMENT_CYCLES + 1
             },
         }
     }
 
     /// Whether the cycles ahead of `frontier` (settled) are worth integrating in segments on
-    /// `threads` threads: more than one thread, room for two segments, blocks short enough to
-    /// leave block starts to meet at, and the frontier at a block start.
+    /// `threads` threads: more than one thread, segments no longer than
+    /// [`MAX_SEGMENT_CYCLES`] and room for two, blocks short enough to leave block starts to
+    /// meet at, and the frontier at a block start.
     pub fn worth_it(&self, frontier: &SweepRun, threads: usize) -> bool {
         let plan = frontier.plan();
         let k = frontier.cycles_done();
         threads > 1
+            && self.length <= MAX_SEGMENT_CYCLES
             && plan.total_cycles().saturating_sub(k) >= 2 * self.shortest()
             && plan.lockin_cycles * 64 <= MIN_SEGMENT_CYCLES
             && plan.is_block_start(k)
@@ -365,10 +373,7 @@ fn integrate_ahead_from(
             if extension.passed {
                 // The true trajectory ran through a whole segment without meeting it:
                 // segments twice as long from now on.
-                segmentation.length = segmentation
-                    .length
-                    .saturating_mul(2)
-                    .min(MAX_CYCLE_COUNT as u64);
+                segmentation.length = segmentation.length.saturating_mul(2);
             }
             if let Some((m, k)) = extension.met {
                 j = m;
