@@ -543,3 +543,26 @@ fn a_failing_cycle_ends_the_sweep_at_the_same_record_on_any_number_of_threads() 
         assert!(outcome(threads) == one, "{threads} threads");
     }
 }
+
+/// A sweep whose records are far apart (every 35,000th of 37,200 cycles) returns each of them
+/// on several threads, where a group of segments may hold no record at all (on 2 threads the
+/// second group, cycles 16,384 to 32,768): the same two records as on one thread.
+#[test]
+fn records_far_apart_are_all_returned_on_several_threads() {
+    let model = biolever_on_mica();
+    let mut settings = window(&model, 9.0, 5.0, 1.0);
+    settings.every = 35_000;
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+            .install(|| run(&model, settings.clone()))
+    };
+    let one = on(1);
+    assert_eq!(
+        one.iter().map(|record| record.cycle).collect::<Vec<_>>(),
+        [0, 35_000]
+    );
+    assert!(on(2) == one);
+}

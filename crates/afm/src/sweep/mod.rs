@@ -399,33 +399,25 @@ impl Sweep {
         if self.finished {
             return Ok(None);
         }
-        if self.ahead.is_empty() {
-            let result = self.frontier.settle().and_then(|()| {
-                let threads = rayon::current_num_threads();
-                if self.segmentation.worth_it(&self.frontier, threads) {
-                    segments::integrate_ahead(
-                        &mut self.segmentation,
-                        &mut self.frontier,
-                        &mut self.ahead,
-                    );
-                    Ok(None)
-                } else {
-                    self.served = None;
-                    self.frontier.next_record()
-                }
-            });
-            match result {
-                Ok(Some(record)) => return Ok(Some(record)),
-                Ok(None) if self.ahead.is_empty() => {
-                    self.finished = true;
-                    return Ok(None);
-                }
-                Ok(None) => {}
-                Err(error) => {
-                    self.finished = true;
-                    return Err(error);
-                }
+        // Segments until one holds a record (a group of them may hold none), or the cycles
+        // left one after the other.
+        while self.ahead.is_empty() {
+            let threads = rayon::current_num_threads();
+            let settled = self.frontier.settle();
+            if settled.is_ok() && self.segmentation.worth_it(&self.frontier, threads) {
+                segments::integrate_ahead(
+                    &mut self.segmentation,
+                    &mut self.frontier,
+                    &mut self.ahead,
+                );
+                continue;
             }
+            self.served = None;
+            let result = settled.and_then(|()| self.frontier.next_record());
+            if !matches!(result, Ok(Some(_))) {
+                self.finished = true;
+            }
+            return result;
         }
         let served = self.ahead.pop_front().expect("records ahead");
         self.served = Some((served.cycles_done, served.state));

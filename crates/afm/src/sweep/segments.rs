@@ -240,7 +240,8 @@ struct Extension {
     records: Vec<Served>,
     /// The later segment met (its index) and the block start where.
     met: Option<(usize, u64)>,
-    /// Whether it ran through the whole of a later segment without meeting it.
+    /// Whether it ran through the whole of a later segment that was not overtaken without
+    /// meeting it.
     passed: bool,
     /// The run where it stopped (at the meeting, the given cycle, or the failing cycle).
     run: SweepRun,
@@ -267,7 +268,11 @@ impl Extension {
                 .position(|later| later.start <= k && k < later.end)
                 .map(|i| i + j + 1);
             if let Some(m) = later {
-                passed |= m > j + 1 && k == segments[m].start;
+                // Through the whole of segment `m - 1` without meeting it, though it ran (a
+                // segment overtaken was only late to start).
+                passed |= m > j + 1
+                    && k == segments[m].start
+                    && !segments[m - 1].overtaken.load(Ordering::Relaxed);
                 if segments[m].meets(k, run.state()) {
                     break (Some((m, k)), None);
                 }
