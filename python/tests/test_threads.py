@@ -94,14 +94,33 @@ def test_ctrl_c_interrupts_an_approach():
         "print('started', flush=True)\n"
         "start = time.perf_counter()\n"
         "try:\n"
-        "    case.approach(from_nm=10.2, to_nm=0.0, rate_nm_per_s=1.0)\n"
+        "    case.approach(from_nm=10.2, to_nm=0.0, rate_nm_per_s=0.2)\n"
         "    print('finished')\n"
         "except KeyboardInterrupt:\n"
         "    print(f'interrupted after {time.perf_counter() - start:.2f} s')\n"
     )
     out, err, answered = _ctrl_c_after_a_second(code, timeout=30)
     assert out.startswith("interrupted after"), (out, err)
-    # The sweep (about a minute) stops within the check interval (50 ms) and a cycle.
+    # The sweep (about 475,000 cycles: 7 s on two cores, 12 s on one) stops within the check
+    # interval (50 ms) and a cycle, also while its cycles ahead run on rayon's threads.
+    assert answered < 2.0, answered
+
+
+def test_ctrl_c_interrupts_an_approach_between_its_records():
+    # One record kept of about 475,000 cycles (every millionth): Ctrl-C is looked for between
+    # cycles, on every thread the sweep runs on, not only when a record comes.
+    code = (
+        "import drumroll\n"
+        "case = drumroll.Case('biolever-mica')\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        "    case.approach(from_nm=10.2, to_nm=0.0, rate_nm_per_s=0.2, every=1000000)\n"
+        "    print('finished')\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
+    assert out.strip() == "interrupted", (out, err)
     assert answered < 2.0, answered
 
 

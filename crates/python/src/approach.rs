@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use crate::convert::{json_to_py, records_to_table};
 use crate::errors::to_py_err;
-use crate::interrupt::without_gil;
+use crate::interrupt::without_gil_on_workers;
 use crate::resolved::{resolved_model_args, Resolved};
 use std::sync::Arc;
 
@@ -56,14 +56,17 @@ pub fn compute_approach<'py>(
         out: None,
         plot: None,
     };
+    // The sweep may integrate its cycles ahead on rayon's threads: the work runs on a thread
+    // of its own while this one looks for Ctrl-C, and every thread of the sweep asks between
+    // cycles whether one came.
     let (records, inputs) =
-        without_gil(py, |interrupted| -> anyhow::Result<(Vec<Value>, Value)> {
+        without_gil_on_workers(py, |interrupted| -> anyhow::Result<(Vec<Value>, Value)> {
             let model = &resolved.model;
             let settings = args.settings(model)?;
             let inputs = approach_inputs_json(&resolved.case, model, &settings);
             let mut sweep = afm::Sweep::new(model, settings).map_err(anyhow::Error::new)?;
             let mut records = Vec::new();
-            while let Some(record) = sweep.next_record().map_err(|error| {
+            while let Some(record) = sweep.next_record_until(interrupted).map_err(|error| {
                 anyhow::Error::new(error).context(format!(
                     "the sweep of case `{}` failed at Z = {} nm after {} cycles",
                     resolved.case.name,
@@ -72,9 +75,6 @@ pub fn compute_approach<'py>(
                 ))
             })? {
                 records.push(serde_json::to_value(record)?);
-                if interrupted() {
-                    break;
-                }
             }
             Ok((records, inputs))
         })?

@@ -46,6 +46,7 @@ use crate::orbit::lockin::{BlockReading, CycleLockIn, CycleReading, MAX_LOCKIN_H
 use crate::orbit::observables::Harmonic;
 use crate::validation::{check, invalid, Interval};
 use run::{SweepPlan, SweepRun};
+pub use segments::Stop;
 use segments::{Segmentation, Served};
 
 /// Microseconds per second: rates are given in nm/s, the model's time is in us.
@@ -396,12 +397,25 @@ impl Sweep {
     /// # Errors
     /// [`AfmError::Solver`] if the hybrid solver fails in a cycle.
     pub fn next_record(&mut self) -> Result<Option<SweepRecord>, AfmError> {
+        self.next_record_until(&|| false)
+    }
+
+    /// [`Sweep::next_record`], asking `stop` between cycles (on every thread the sweep uses):
+    /// once it answers `true` (and from then on), the sweep ends and `None` is returned.
+    ///
+    /// # Errors
+    /// [`AfmError::Solver`] if the hybrid solver fails in a cycle.
+    pub fn next_record_until(&mut self, stop: &Stop<'_>) -> Result<Option<SweepRecord>, AfmError> {
         if self.finished {
             return Ok(None);
         }
         // Segments until one holds a record (a group of them may hold none), or the cycles
         // left one after the other.
         while self.ahead.is_empty() {
+            if stop() {
+                self.finished = true;
+                return Ok(None);
+            }
             let threads = rayon::current_num_threads();
             let settled = self.frontier.settle();
             if settled.is_ok() && self.segmentation.worth_it(&self.frontier, threads) {
@@ -409,11 +423,12 @@ impl Sweep {
                     &mut self.segmentation,
                     &mut self.frontier,
                     &mut self.ahead,
+                    stop,
                 );
                 continue;
             }
             self.served = None;
-            let result = settled.and_then(|()| self.frontier.next_record());
+            let result = settled.and_then(|()| self.frontier.next_record_until(stop));
             if !matches!(result, Ok(Some(_))) {
                 self.finished = true;
             }

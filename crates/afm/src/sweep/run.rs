@@ -15,6 +15,7 @@ use crate::model::separation::Separation;
 use crate::model::TappingModel;
 use crate::orbit::lockin::{BlockAverage, CycleLockIn, CycleReading};
 
+use super::segments::Stop;
 use super::{advance_cycle, integrate_cycle, SweepDirection, SweepRecord, SweepSettings};
 
 /// The sweep's schedule: which separation law, direction and lock-in block each drive cycle
@@ -251,10 +252,11 @@ impl SweepRun {
         Ok(block.map(|block| SweepRecord::new(direction, block)))
     }
 
-    /// Integrate cycles until the next record is due and return it; `None` at the sweep's end.
-    pub fn next_record(&mut self) -> Result<Option<SweepRecord>, AfmError> {
+    /// Integrate cycles until the next record is due and return it; `None` at the sweep's end,
+    /// or once `stop` (asked before each cycle) answers `true`.
+    pub fn next_record_until(&mut self, stop: &Stop<'_>) -> Result<Option<SweepRecord>, AfmError> {
         self.settle()?;
-        while self.cycles_done < self.plan.total_cycles() {
+        while self.cycles_done < self.plan.total_cycles() && !stop() {
             if let Some(record) = self.cycle()? {
                 return Ok(Some(record));
             }

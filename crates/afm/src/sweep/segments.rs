@@ -118,6 +118,9 @@ impl Segmentation {
     }
 }
 
+/// A caller's request to stop (answered between cycles; callable from any thread).
+pub type Stop<'a> = dyn Fn() -> bool + Sync + 'a;
+
 /// One record of the true trajectory, as handed to the caller: the record (or the failure
 /// that ends the sweep), with the cycles done and the cantilever state after it (before the
 /// failing cycle, for a failure).
@@ -196,13 +199,23 @@ struct Stretch {
 
 impl Stretch {
     /// Integrate `segments[j]` of `template`'s sweep from `state` at its start, then continue
-    /// it until it meets a later segment or reaches the last one's end.
-    fn integrate(template: &SweepRun, segments: &[Segment], j: usize, state: &[f64]) -> Self {
+    /// it until it meets a later segment or reaches the last one's end (or until `stop`
+    /// answers `true`).
+    fn integrate(
+        template: &SweepRun,
+        segments: &[Segment],
+        j: usize,
+        state: &[f64],
+        stop: &Stop<'_>,
+    ) -> Self {
         let segment = &segments[j];
         let mut run = template.at(segment.start, state);
         let mut records = Vec::new();
         let mut failure = None;
-        while run.cycles_done() < segment.end && !segment.overtaken.load(Ordering::Relaxed) {
+        while run.cycles_done() < segment.end
+            && !segment.overtaken.load(Ordering::Relaxed)
+            && !stop()
+        {
             let k = run.cycles_done();
             if run.plan().is_block_start(k) {
                 let mut landmarks = segment.landmarks.lock().unwrap_or_else(|e| e.into_inner());
@@ -223,7 +236,7 @@ impl Stretch {
         let end = segments.last().map_or(segment.end, |last| last.end);
         let extension =
             (failure.is_none() && run.cycles_done() == segment.end && segment.end < end)
-                .then(|| Extension::integrate(segments, j, run.clone(), end));
+                .then(|| Extension::integrate(segments, j, run.clone(), end, stop));
         Self {
             records,
             run,
@@ -251,14 +264,20 @@ struct Extension {
 
 impl Extension {
     /// Continue `run`, in or after `segments[j]`, cycle by cycle until it meets a
-    /// later segment or reaches cycle `until`. A later segment that has not reached the cycle
-    /// it is at is overtaken (told to stop).
-    fn integrate(segments: &[Segment], j: usize, mut run: SweepRun, until: u64) -> Self {
+    /// later segment or reaches cycle `until` (or until `stop` answers `true`). A later
+    /// segment that has not reached the cycle it is at is overtaken (told to stop).
+    fn integrate(
+        segments: &[Segment],
+        j: usize,
+        mut run: SweepRun,
+        until: u64,
+        stop: &Stop<'_>,
+    ) -> Self {
         let mut records = Vec::new();
         let mut passed = false;
         let (met, failure) = loop {
             let k = run.cycles_done();
-            if k >= until {
+            if k >= until || stop() {
                 break (None, None);
             }
             // The later segment whose cycles these are (none while still in segment `j`'s
@@ -309,9 +328,10 @@ pub(super) fn integrate_ahead(
     segmentation: &mut Segmentation,
     frontier: &mut SweepRun,
     ahead: &mut VecDeque<Served>,
+    stop: &Stop<'_>,
 ) {
     let guess = frontier.state().to_vec();
-    integrate_ahead_from(segmentation, frontier, &guess, ahead);
+    integrate_ahead_from(segmentation, frontier, &guess, ahead, stop);
 }
 
 /// [`integrate_ahead`] with `guess` as the later segments' start state.
@@ -320,6 +340,7 @@ fn integrate_ahead_from(
     frontier: &mut SweepRun,
     guess: &[f64],
     ahead: &mut VecDeque<Served>,
+    stop: &Stop<'_>,
 ) {
     let plan = *frontier.plan();
     let first = frontier.cycles_done();
@@ -343,13 +364,17 @@ fn integrate_ahead_from(
         .into_par_iter()
         .map(|j| {
             let start = if j == 0 { frontier.state() } else { guess };
-            Some(Stretch::integrate(frontier, &segments, j, start))
+            Some(Stretch::integrate(frontier, &segments, j, start, stop))
         })
         .collect();
     // The true trajectory: segment `j`'s records from cycle `from` on, then its extension's.
     let mut j = 0;
     let mut from = first;
     loop {
+        if stop() {
+            // Told to stop: the records may be incomplete, and the sweep ends.
+            return;
+        }
         let stretch = stretches[j].take().expect("each segment is walked once");
         ahead.extend(
             stretch
@@ -367,7 +392,7 @@ fn integrate_ahead_from(
                 *frontier = stretch.run;
                 return;
             }
-            None => Extension::integrate(&segments, j, stretch.run, end),
+            None => Extension::integrate(&segments, j, stretch.run, end, stop),
         };
         loop {
             ahead.extend(extension.records);
@@ -385,11 +410,11 @@ fn integrate_ahead_from(
                 from = k;
                 break;
             }
-            if extension.run.cycles_done() >= end {
+            if extension.run.cycles_done() >= end || stop() {
                 *frontier = extension.run;
                 return;
             }
-            extension = Extension::integrate(&segments, j, extension.run, end);
+            extension = Extension::integrate(&segments, j, extension.run, end, stop);
         }
     }
 }
@@ -430,7 +455,7 @@ mod tests {
     /// The records (and final state) of one trajectory, cycle after cycle on this thread.
     fn one_trajectory(mut run: SweepRun) -> (Vec<SweepRecord>, Vec<f64>) {
         let mut records = Vec::new();
-        while let Some(record) = run.next_record().expect("cycle") {
+        while let Some(record) = run.next_record_until(&|| false).expect("cycle") {
             records.push(record);
         }
         (records, run.state().to_vec())
@@ -452,7 +477,7 @@ mod tests {
                 if !segmentation.worth_it(&run, threads) {
                     break;
                 }
-                integrate_ahead_from(&mut segmentation, &mut run, guess, &mut ahead);
+                integrate_ahead_from(&mut segmentation, &mut run, guess, &mut ahead, &|| false);
             }
         });
         let mut records: Vec<SweepRecord> = ahead
