@@ -566,3 +566,61 @@ fn records_far_apart_are_all_returned_on_several_threads() {
     );
     assert!(on(2) == one);
 }
+
+/// Cases of the random sweeps: `DRUMROLL_SWEEP_CASES`, default 10 (about 6 s; 150 took
+/// 110 s).
+fn random_sweep_cases() -> u32 {
+    std::env::var("DRUMROLL_SWEEP_CASES")
+        .ok()
+        .and_then(|cases| cases.parse().ok())
+        .unwrap_or(10)
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig {
+        cases: random_sweep_cases(),
+        ..Default::default()
+    })]
+
+    /// Random sweeps long enough for the segments (4,200 to 12,000 cycles a leg) of three
+    /// cases (Hertz in water, the MAClever, JKR's pull-off hysteresis), with or without the
+    /// retract, any block length, decimation and settling: the same records on 1, 2 and 3
+    /// threads, and no panic.
+    #[test]
+    fn random_sweeps_give_the_same_records_on_any_number_of_threads(
+        case in proptest::sample::select(vec!["biolever-mica", "maclever-mica", "biolever-sticky"]),
+        from in 7.0..9.6f64,
+        cycles in 4200.0..12000.0f64,
+        lockin_cycles in 1usize..=4,
+        every in 1usize..=50,
+        retract in proptest::bool::ANY,
+        settle_cycles in 0usize..=30,
+    ) {
+        let model = TappingModel::from_case(&builtin_case(case).expect("case")).expect("model");
+        let mut settings = SweepSettings::for_model(&model);
+        settings.from_nm = from;
+        settings.to_nm = from - cycles * 1e-6 * model.period_us();
+        settings.rate_nm_per_s = 1.0;
+        settings.retract = retract;
+        settings.lockin_cycles = lockin_cycles;
+        settings.every = every;
+        settings.settle_cycles = settle_cycles;
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool")
+                .install(|| {
+                    Sweep::new(&model, settings.clone())
+                        .expect("sweep")
+                        .map(|record| record.map_err(|error| error.to_string()))
+                        .collect::<Vec<_>>()
+                })
+        };
+        let one = on(1);
+        proptest::prop_assert!(!one.is_empty());
+        for threads in [2, 3] {
+            proptest::prop_assert!(on(threads) == one, "{} threads", threads);
+        }
+    }
+}
