@@ -7,11 +7,12 @@
 //! # Time keeping
 //!
 //! The clock restarts at every drive cycle: cycle `k` is integrated over local time
-//! `t in [0, T]` with [`Separation::Ramp`](crate::model::separation::Separation::Ramp) whose `z0` is `Z` at the cycle's start, computed from
-//! the cycle index (`Z_start -/+ k rate T`, no accumulated sum). The drive `cos(w t)` is
-//! `T`-periodic, so the restart changes nothing physically, while every time, drive phase and
-//! event tolerance stays that of a single period (absolute times would reach 1e7 us over a
-//! paper-rate sweep). The free flight is propagated by the model's exact flow (the gap moves
+//! `t in [0, T]` with
+//! [`Separation::Ramp`](crate::model::separation::Separation::Ramp) whose `z0` is `Z` at the
+//! cycle's start, computed from the cycle index (`Z_start -/+ k rate T`, no accumulated
+//! sum). The drive `cos(w t)` is `T`-periodic, so the restart changes nothing physically,
+//! while every time, drive phase and event tolerance stays that of a single period
+//! (absolute times would reach 1e7 us over a paper-rate sweep). The free flight is propagated by the model's exact flow (the gap moves
 //! with `Z(t)`, the free dynamics do not); contacts are integrated with event location, and a
 //! gap that dips below zero between samples is still found (see `hybrid::solver`).
 //!
@@ -26,10 +27,10 @@
 //!
 //! # Threads
 //!
-//! One trajectory ([`run`]) is integrated cycle after cycle. On rayon's pool of more than one
-//! thread the cycles ahead are integrated in speculative segments ([`segments`]), whose records
-//! are used only from where the true trajectory meets them bit for bit: the records are the
-//! same on any number of threads.
+//! One trajectory (`sweep/run.rs`) is integrated cycle after cycle. On rayon's pool of more
+//! than one thread the cycles ahead are integrated in speculative segments
+//! (`sweep/segments.rs`), whose records are used only from where the true trajectory meets
+//! them bit for bit: the records are the same on any number of threads.
 
 pub mod amplitude_ratio;
 mod run;
@@ -261,7 +262,7 @@ impl SweepSettings {
 /// An iterator of [`SweepRecord`]s: each call of [`Sweep::next_record`] returns the next
 /// record, so a caller can stream the records as they come and stop at any time. The first
 /// call also integrates the settling cycles. On rayon's pool of more than one thread the
-/// cycles ahead are integrated in speculative segments ([`segments`]) whose records are the
+/// cycles ahead are integrated in speculative segments (`sweep/segments.rs`) whose records are the
 /// same bits as one thread's; with one thread each call integrates cycles until the next
 /// record is due.
 #[derive(Debug)]
@@ -425,6 +426,11 @@ impl Sweep {
                     &mut self.ahead,
                     stop,
                 );
+                if stop() {
+                    self.finished = true;
+                    self.ahead.clear();
+                    return Ok(None);
+                }
                 continue;
             }
             self.served = None;

@@ -10,22 +10,21 @@
 //!
 //! So the cycles ahead of the sweep's frontier are cut into segments at block starts, and the
 //! segments are integrated at once on rayon's pool: the first from the frontier's state (the
-//! true one), each later one from the same state as a guess, recording its state at every
-//! block start. Then, in order, the true trajectory takes the first segment's records and,
-//! from its end, continues cycle by cycle until its state at a block start equals the next
-//! segment's state there; from that block on the next segment's records are the true ones.
-//! A segment the true trajectory never meets (a guess that fell on another attractor, a
-//! bistable window, a sweep that does not contract) is only wasted work: the true trajectory
-//! runs through it. Nothing is approximated, and the records do not depend on the number of
-//! threads.
+//! true one), each later one from the same state as a guess, publishing its state at every
+//! block start as it goes. Each segment, at its end, continues cycle by cycle until its state
+//! at a block start equals a later segment's there. Then, in order, the true trajectory takes
+//! the first segment's records, its continuation's, and from the block where it met the next
+//! segment that one's, and so on. A segment the true trajectory never meets (a guess that fell
+//! on another attractor, a bistable window, a sweep that does not contract) is only wasted
+//! work: the true trajectory runs through it. Nothing is approximated, and the records do not
+//! depend on the number of threads or on their timing.
 
 use std::collections::VecDeque;
+use std::f64::consts::PI;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
 
 use rayon::prelude::*;
-
-use std::f64::consts::PI;
 
 use crate::error::AfmError;
 use crate::model::TappingModel;
@@ -54,7 +53,7 @@ const E_FOLDINGS_TO_THE_LAST_BIT: f64 = 39.1;
 /// Segment lengths at least this many times the cycles a free transient takes to fall below
 /// the last bit (so that an extension is at most about an eighth of a segment when the free
 /// decay sets the pace).
-const SEGMENTS_PER_MEMORY: f64 = 8.0;
+const MEMORIES_PER_SEGMENT: f64 = 8.0;
 
 /// Drive cycles per segment, at most: the records of the segments integrated at once are
 /// held in memory (about 300 bytes a cycle read, so 65,536 cycles on each of 4 segments take
@@ -86,7 +85,7 @@ impl Segmentation {
             .map(|mode| mode.quality_factor * drive_khz / (PI * mode.frequency_khz))
             .fold(0.0, f64::max)
             * E_FOLDINGS_TO_THE_LAST_BIT;
-        let length = (SEGMENTS_PER_MEMORY * memory).ceil();
+        let length = (MEMORIES_PER_SEGMENT * memory).ceil();
         Self {
             length: if length <= MAX_SEGMENT_CYCLES as f64 {
                 (length as u64).max(SEGMENT_CYCLES)
@@ -320,10 +319,11 @@ impl Extension {
 /// failure, if one), and leave `frontier` after the last cycle integrated.
 ///
 /// [`SEGMENTS_PER_THREAD`] segments per thread, at once: the first from the frontier's state,
-/// the others from a guess; each, at its end, continues until it meets a later one (reading the later one's
-/// states as they come), so that the true trajectory never waits for a guess. Then the true
-/// trajectory's walk through them, from the first segment; where it finds no continuation
-/// (a segment stopped when overtaken), it continues on this thread.
+/// the others from a guess; each, at its end, continues until it meets a later one (reading
+/// the later one's states as they come), so that the true trajectory never waits for a guess.
+/// Then the true trajectory's walk through them, from the first segment; where it finds no
+/// continuation (a segment stopped when overtaken), it continues on this thread. If `stop`
+/// answers `true`, the records pushed may end anywhere and `frontier` is not to be used.
 pub(super) fn integrate_ahead(
     segmentation: &mut Segmentation,
     frontier: &mut SweepRun,
