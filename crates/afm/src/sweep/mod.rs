@@ -12,9 +12,10 @@
 //! cycle's start, computed from the cycle index (`Z_start -/+ k rate T`, no accumulated
 //! sum). The drive `cos(w t)` is `T`-periodic, so the restart changes nothing physically,
 //! while every time, drive phase and event tolerance stays that of a single period
-//! (absolute times would reach 1e7 us over a paper-rate sweep). The free flight is propagated by the model's exact flow (the gap moves
-//! with `Z(t)`, the free dynamics do not); contacts are integrated with event location, and a
-//! gap that dips below zero between samples is still found (see `hybrid::solver`).
+//! (absolute times would reach 1e7 us over a paper-rate sweep). The free flight is propagated
+//! by the model's exact flow (the gap moves with `Z(t)`, the free dynamics do not); contacts
+//! are integrated with event location, and a gap that dips below zero between samples is still
+//! found (see `hybrid::solver`).
 //!
 //! # Records
 //!
