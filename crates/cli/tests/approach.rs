@@ -288,37 +288,14 @@ fn a_killed_run_leaves_only_complete_records() {
 /// the same bytes on 1, 2 and 3 threads.
 #[test]
 fn records_are_the_same_bytes_on_any_number_of_threads() {
-    let runs: [&[&str]; 2] = [
-        &[
-            "approach",
-            "--case",
-            "biolever-mica",
-            "--from",
-            "9",
-            "--to",
-            "8.5",
-            "--rate",
-            "1",
-            "--retract",
-            "--lockin-cycles",
-            "2",
-            "--every",
-            "3",
-        ],
-        &[
-            "approach",
-            "--case",
-            "biolever-mica",
-            "--from",
-            "9",
-            "--to",
-            "8",
-            "--rate",
-            "1",
-            "--jsonl",
-        ],
+    let runs = [
+        "approach --case biolever-mica --from 9 --to 8.5 --rate 1 --retract --lockin-cycles 2 \
+         --every 3",
+        "approach --case biolever-mica --from 9 --to 8 --rate 1 --jsonl",
     ];
-    for args in runs {
+    for command in runs {
+        let args: Vec<&str> = command.split_whitespace().collect();
+        let args = args.as_slice();
         let one = stdout_on_threads("1", args);
         assert!(one.split(|&b| b == b'\n').count() > 1000, "{args:?}");
         for threads in ["2", "3"] {

@@ -203,12 +203,7 @@ impl SweepRun {
             self.model
                 .set_separation(Separation::Constant(self.settings.from_nm))?;
             for _ in 0..self.settings.settle_cycles {
-                advance_cycle(
-                    &self.model,
-                    &self.settings.integration,
-                    &mut self.state,
-                    &mut self.workspace,
-                )?;
+                self.advance_unread_cycle()?;
             }
             self.settled = true;
         }
@@ -237,12 +232,7 @@ impl SweepRun {
             let block = self.average.push(k, z_mid, &reading);
             (block.is_some(), block)
         } else {
-            advance_cycle(
-                &self.model,
-                &self.settings.integration,
-                &mut self.state,
-                &mut self.workspace,
-            )?;
+            self.advance_unread_cycle()?;
             (self.average.skip(k), None)
         };
         self.cycles_done += 1;
@@ -262,6 +252,17 @@ impl SweepRun {
             }
         }
         Ok(None)
+    }
+
+    /// Integrate one drive period at the separation already set without the lock-in (a
+    /// settling cycle, or a cycle of a block whose record is not returned).
+    fn advance_unread_cycle(&mut self) -> Result<(), AfmError> {
+        advance_cycle(
+            &self.model,
+            &self.settings.integration,
+            &mut self.state,
+            &mut self.workspace,
+        )
     }
 
     /// Integrate the current cycle (its separation already set) and return the lock-in's
