@@ -55,10 +55,14 @@ const E_FOLDINGS_TO_THE_LAST_BIT: f64 = 39.1;
 /// decay sets the pace).
 const MEMORIES_PER_SEGMENT: f64 = 8.0;
 
-/// Drive cycles per segment, at most: the records of the segments integrated at once are
-/// held in memory (about 300 bytes a cycle read, so 65,536 cycles on each of 4 segments take
-/// about 80 MB).
+/// Drive cycles per segment, at most (a longer one's share of the work done twice is not
+/// worth it).
 const MAX_SEGMENT_CYCLES: u64 = 65_536;
+
+/// Drive cycles of the segments integrated at once, at most (unless two segments are
+/// longer): their records are held in memory, about 300 bytes a cycle read, so about 80 MB
+/// (135 MB resident for the humid air lever's four segments of 63,400 cycles).
+const MAX_CYCLES_IN_FLIGHT: u64 = 262_144;
 
 /// How the cycles ahead are cut into segments: their length, which doubles after a wave in
 /// which the true trajectory ran through a whole segment without meeting it (a sweep that
@@ -344,7 +348,10 @@ fn integrate_ahead_from(
 ) {
     let plan = *frontier.plan();
     let first = frontier.cycles_done();
-    let count = SEGMENTS_PER_THREAD * rayon::current_num_threads() as u64;
+    // Two segments per thread, as long as the cycles in flight fit in memory (at least two).
+    let count = (SEGMENTS_PER_THREAD * rayon::current_num_threads() as u64)
+        .min(MAX_CYCLES_IN_FLIGHT / segmentation.length)
+        .max(2);
     // Segments of the segmentation's length, shorter (down to its shortest) to share the last
     // cycles of the sweep among the threads.
     let left = plan.total_cycles() - first;
