@@ -263,13 +263,11 @@ impl SweepSettings {
 /// An iterator of [`SweepRecord`]s: each call of [`Sweep::next_record`] returns the next
 /// record, so a caller can stream the records as they come and stop at any time. The first
 /// call also integrates the settling cycles. On rayon's pool of more than one thread the
-/// cycles ahead are integrated in speculative segments (`sweep/segments.rs`) whose records are the
-/// same bits as one thread's; with one thread each call integrates cycles until the next
-/// record is due.
+/// cycles ahead are integrated in speculative segments (`sweep/segments.rs`) whose records
+/// are the same bits as one thread's; with one thread each call integrates cycles until the
+/// next record is due.
 #[derive(Debug)]
 pub struct Sweep {
-    settings: SweepSettings,
-    plan: SweepPlan,
     /// The trajectory's frontier: the run after the last cycle integrated.
     frontier: SweepRun,
     /// Records integrated ahead of the caller (by segments), in order.
@@ -329,9 +327,7 @@ impl Sweep {
             retract: settings.retract,
         };
         Ok(Self {
-            frontier: SweepRun::new(model.clone(), settings.clone(), plan)?,
-            settings,
-            plan,
+            frontier: SweepRun::new(model.clone(), settings, plan)?,
             ahead: VecDeque::new(),
             segmentation: Segmentation::for_model(model),
             served: None,
@@ -341,17 +337,17 @@ impl Sweep {
 
     /// The settings in use.
     pub fn settings(&self) -> &SweepSettings {
-        &self.settings
+        self.frontier.settings()
     }
 
     /// Drive cycles in each direction (the approach, and the retract if asked).
     pub fn cycles_per_leg(&self) -> u64 {
-        self.plan.cycles_per_leg
+        self.frontier.plan().cycles_per_leg
     }
 
     /// Drive cycles of the whole sweep (settling excluded).
     pub fn total_cycles(&self) -> u64 {
-        self.plan.total_cycles()
+        self.frontier.plan().total_cycles()
     }
 
     /// Drive cycles integrated up to the last record returned (settling excluded); after an
@@ -366,13 +362,13 @@ impl Sweep {
     /// `Z` at the end of the approach (where the retract starts), nm: `from_nm` minus a whole
     /// number of cycles, within one cycle's travel above `to_nm`.
     pub fn floor_nm(&self) -> f64 {
-        self.plan.floor_nm
+        self.frontier.plan().floor_nm
     }
 
     /// The direction of the next cycle (of the last one once the sweep has finished).
     pub fn direction(&self) -> SweepDirection {
-        let k = self.cycles_done();
-        if k < self.plan.cycles_per_leg || !self.settings.retract {
+        let plan = self.frontier.plan();
+        if self.cycles_done() < plan.cycles_per_leg || !plan.retract {
             SweepDirection::Approach
         } else {
             SweepDirection::Retract
@@ -381,7 +377,7 @@ impl Sweep {
 
     /// The separation at the end of the cycles counted by [`Sweep::cycles_done`], nm.
     pub fn z_nm(&self) -> f64 {
-        self.plan.z_nm(self.cycles_done())
+        self.frontier.plan().z_nm(self.cycles_done())
     }
 
     /// The cantilever state `[q_1, q_1', ..., q_N, q_N']` (nm, nm/us; and the sample's state

@@ -150,36 +150,51 @@ impl SweepRun {
     ) -> Result<Self, AfmError> {
         let mut model = model;
         model.set_separation(Separation::Constant(settings.from_nm))?;
-        Ok(Self {
-            state: model.free_state(),
-            workspace: SolverWorkspace::default(),
-            lockin: CycleLockIn::with_harmonics(&model, settings.harmonics),
-            average: BlockAverage::new(settings.lockin_cycles, model.free_amplitude_nm()),
-            model,
-            settings,
-            plan,
-            cycles_done: 0,
-            blocks_in_leg: 0,
-            settled: false,
-        })
+        let state = model.free_state();
+        Ok(Self::standing(model, settings, plan, 0, state, false))
     }
 
     /// A run of the same sweep standing at block start `cycle` with `state` (settled): what
     /// this run would do from there if its state at `cycle` were `state`.
     pub fn at(&self, cycle: u64, state: &[f64]) -> Self {
         debug_assert!(self.plan.is_block_start(cycle));
+        Self::standing(
+            self.model.clone(),
+            self.settings.clone(),
+            self.plan,
+            cycle,
+            state.to_vec(),
+            true,
+        )
+    }
+
+    /// The run at block start `cycle` with `state`, fresh buffers, an empty block and the
+    /// blocks before `cycle` in its leg counted.
+    fn standing(
+        model: TappingModel,
+        settings: SweepSettings,
+        plan: SweepPlan,
+        cycle: u64,
+        state: Vec<f64>,
+        settled: bool,
+    ) -> Self {
         Self {
-            state: state.to_vec(),
+            state,
             workspace: SolverWorkspace::default(),
-            lockin: CycleLockIn::with_harmonics(&self.model, self.settings.harmonics),
-            average: BlockAverage::new(self.settings.lockin_cycles, self.model.free_amplitude_nm()),
-            model: self.model.clone(),
-            settings: self.settings.clone(),
-            plan: self.plan,
+            lockin: CycleLockIn::with_harmonics(&model, settings.harmonics),
+            average: BlockAverage::new(settings.lockin_cycles, model.free_amplitude_nm()),
+            blocks_in_leg: plan.blocks_before(cycle.min(plan.total_cycles())),
+            model,
+            settings,
+            plan,
             cycles_done: cycle,
-            blocks_in_leg: self.plan.blocks_before(cycle.min(self.plan.total_cycles())),
-            settled: true,
+            settled,
         }
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &SweepSettings {
+        &self.settings
     }
 
     /// The schedule.

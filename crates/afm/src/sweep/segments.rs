@@ -225,15 +225,11 @@ impl Stretch {
                 landmarks.0.push(k);
                 landmarks.1.extend_from_slice(run.state());
             }
-            let outcome = run.cycle();
+            let outcome = advance(&mut run, &mut records);
             segment.reached.store(run.cycles_done(), Ordering::Relaxed);
-            match outcome {
-                Ok(Some(record)) => records.push(Served::of(&run, Ok(record))),
-                Ok(None) => {}
-                Err(error) => {
-                    failure = Some(error);
-                    break;
-                }
+            if let Err(error) = outcome {
+                failure = Some(error);
+                break;
             }
         }
         let end = segments.last().map_or(segment.end, |last| last.end);
@@ -302,10 +298,8 @@ impl Extension {
                     segments[m].overtaken.store(true, Ordering::Relaxed);
                 }
             }
-            match run.cycle() {
-                Ok(Some(record)) => records.push(Served::of(&run, Ok(record))),
-                Ok(None) => {}
-                Err(error) => break (None, Some(error)),
+            if let Err(error) = advance(&mut run, &mut records) {
+                break (None, Some(error));
             }
         };
         Self {
@@ -424,6 +418,15 @@ fn integrate_ahead_from(
             extension = Extension::integrate(&segments, j, extension.run, end, stop);
         }
     }
+}
+
+/// Integrate `run`'s next cycle, pushing its block's record onto `records` if it completes
+/// one that is returned.
+fn advance(run: &mut SweepRun, records: &mut Vec<Served>) -> Result<(), AfmError> {
+    if let Some(record) = run.cycle()? {
+        records.push(Served::of(run, Ok(record)));
+    }
+    Ok(())
 }
 
 /// The first cycle of a served record's block.
