@@ -198,3 +198,60 @@ fn quiet_curve_returns_the_truth() {
         );
     }
 }
+
+/// Seven parameters on the MAClever's synthetic curve (`fixtures/measurements`), fitted with the
+/// built-in `maclever-mica` case: the data cannot separate the sample modulus, tip radius and
+/// first mode, and Levenberg-Marquardt's early steps push the modulus past its range (to an
+/// overflow of its logarithm). Such trial steps are rejected and the fit goes on: it returns a
+/// result whose values all lie in their ranges and which says how many steps were rejected. Before the
+/// rejection this fit failed with "field `sample-modulus` = inf is invalid".
+#[test]
+fn trial_steps_out_of_the_models_range_are_rejected_and_the_fit_goes_on() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/measurements/maclever-mica-synthetic.csv"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let measurement = Measurement::parse(&text, path, &MeasurementOptions::default()).unwrap();
+    let case = builtin_case("maclever-mica").unwrap();
+    let mut parameters = vec![
+        FitParameter::ZOffset,
+        FitParameter::AmplitudeCalibration,
+        FitParameter::PhaseOffset,
+    ];
+    parameters.extend(
+        [
+            ParameterAxis::SampleModulus,
+            ParameterAxis::TipRadius,
+            ParameterAxis::QualityFactor(1),
+            ParameterAxis::Stiffness(1),
+        ]
+        .map(FitParameter::Case),
+    );
+    let axes: Vec<Option<ParameterAxis>> = parameters
+        .iter()
+        .map(|p| match p {
+            FitParameter::Case(axis) => Some(*axis),
+            _ => None,
+        })
+        .collect();
+    let mut settings = FitSettings::new(parameters);
+    settings.max_evaluations = 8;
+    let result = fit_measurement(&case, &measurement, &settings).unwrap();
+    assert!(
+        result
+            .warnings
+            .iter()
+            .any(|w| w.contains("trial steps left the model's valid range and were rejected")),
+        "{:?}",
+        result.warnings
+    );
+    for (value, axis) in result.parameters.iter().zip(&axes) {
+        assert!(value.value.is_finite(), "{value:?}");
+        if let Some(axis) = axis {
+            assert!(axis.allows(&case, value.value), "{value:?}");
+        }
+    }
+    // Levenberg-Marquardt's count includes the rejected steps.
+    assert!(result.evaluations <= 9, "{}", result.evaluations);
+}

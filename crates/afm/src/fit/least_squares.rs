@@ -4,7 +4,7 @@
 //! Levenberg-Marquardt (the `levenberg-marquardt` crate), with standard errors and correlations
 //! from the Jacobian at the optimum (MODEL.md section 13.4).
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 
@@ -263,11 +263,28 @@ struct Residuals<'a> {
 
 /// The least-squares problem Levenberg-Marquardt sees: the residuals at its current `theta`,
 /// the first error met kept (the trait's residuals and Jacobian can only say `None`).
+///
+/// A trial step whose model cannot be built or followed (a parameter pushed out of its range,
+/// a continuation that fails there) is rejected, not fatal: its residuals are
+/// [`REJECTED_RESIDUAL`] each, far above any accepted norm, so that Levenberg-Marquardt counts
+/// the step as a failed reduction, shrinks its trust region and tries a shorter one. Only the
+/// starting point and the Jacobian's differences fail the fit.
 struct Problem<'a> {
     residuals: Residuals<'a>,
     theta: DVector<f64>,
     failure: RefCell<Option<AfmError>>,
+    /// Whether the starting point's residuals have been evaluated (later evaluations are
+    /// trial steps).
+    started: Cell<bool>,
+    /// The trial steps rejected, and the first one's error.
+    rejected: RefCell<(usize, Option<AfmError>)>,
 }
+
+/// Each residual of a rejected trial step (weighted, dimensionless): with `m` residuals its norm
+/// `1e100 sqrt(m)` exceeds ten times any accepted norm, which Levenberg-Marquardt (MINPACK's
+/// `lmder`) takes as an increase: the step is not taken and the trust region shrinks tenfold.
+/// Its square stays finite.
+const REJECTED_RESIDUAL: f64 = 1e100;
 
 /// Values of the parameters that are not fitted.
 #[derive(Debug, Clone, Copy)]
@@ -380,7 +397,8 @@ impl Residuals<'_> {
     /// Column `k` of the Jacobian at `theta` (whose values and followed branch are `values`
     /// and `branch`): exact for the offsets and the reported amplitude, central differences
     /// in the logarithm for the model's parameters (`(r(up) - r(down)) / (2 step)`, both
-    /// branches at once; the `up` one's error first).
+    /// branches at once), one-sided where one of them fails (`(r(up) - r) / step` or `(r -
+    /// r(down)) / step`: next to a parameter's bound); the `up` one's error where both fail.
     fn jacobian_column(
         &self,
         k: usize,
@@ -414,15 +432,21 @@ impl Residuals<'_> {
                 }
             }
             Internal::ModelAmplitude | Internal::Case(_) => {
-                // Central differences in the logarithm.
+                // Central differences in the logarithm; one-sided (against the residuals at
+                // `theta`) where one side leaves the model's valid range or fails, as at a
+                // parameter's bound.
                 let mut up = theta.clone();
                 up[k] += self.step;
                 let mut down = theta.clone();
                 down[k] -= self.step;
                 let (up, down) =
                     rayon::join(|| self.residuals_at(&up), || self.residuals_at(&down));
-                let r = up? - down?;
-                column = r / (2.0 * self.step);
+                column = match (up, down) {
+                    (Ok(up), Ok(down)) => (up - down) / (2.0 * self.step),
+                    (Ok(up), Err(_)) => (up - self.residuals_at(theta)?) / self.step,
+                    (Err(_), Ok(down)) => (self.residuals_at(theta)? - down) / self.step,
+                    (Err(error), Err(_)) => return Err(error),
+                };
             }
         }
         Ok(column)
@@ -452,10 +476,25 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        self.residuals
-            .residuals_at(&self.theta)
-            .map_err(|e| self.note(e))
-            .ok()
+        match self.residuals.residuals_at(&self.theta) {
+            Ok(r) => {
+                self.started.set(true);
+                Some(r)
+            }
+            Err(error) if self.started.get() => {
+                let mut rejected = self.rejected.borrow_mut();
+                rejected.0 += 1;
+                rejected.1.get_or_insert(error);
+                Some(DVector::from_element(
+                    2 * self.residuals.points.len(),
+                    REJECTED_RESIDUAL,
+                ))
+            }
+            Err(error) => {
+                self.note(error);
+                None
+            }
+        }
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
@@ -586,6 +625,8 @@ pub fn fit_measurement(
         },
         theta: theta.clone(),
         failure: RefCell::new(None),
+        started: Cell::new(false),
+        rejected: RefCell::new((0, None)),
     };
     let patience = settings
         .max_evaluations
@@ -602,6 +643,7 @@ pub fn fit_measurement(
         }
     }
     let theta = problem.theta.clone();
+    let (rejected, rejection) = problem.rejected.take();
     let problem = problem.residuals;
     let residuals = problem.residuals_at(&theta)?;
     let jacobian = problem.jacobian_at(&theta)?;
@@ -649,6 +691,18 @@ pub fn fit_measurement(
         } else {
             raw
         };
+        if let FitParameter::Case(axis) = parameter {
+            // Within one difference step of a bound, the fit stopped against the range.
+            let range = axis.physical_range(case);
+            let margin = settings.difference_step.exp();
+            if value * margin > range.max || value / margin < range.min {
+                warnings.push(format!(
+                    "{}: stopped at the bound of its range {} (the data pull it out of the model's range)",
+                    parameter.key(),
+                    range.describe()
+                ));
+            }
+        }
         let relative = stderr / value.abs().max(1e-300);
         let stderr = if undetermined[k] {
             warnings.push(format!(
@@ -684,6 +738,13 @@ pub fn fit_measurement(
                 .collect()
         })
         .collect();
+    if let Some(rejection) = rejection {
+        warnings.push(format!(
+            "{rejected} trial step{} left the model's valid range and {} rejected (the first: {rejection})",
+            if rejected == 1 { "" } else { "s" },
+            if rejected == 1 { "was" } else { "were" },
+        ));
+    }
     if reduced_chi2 > 4.0 {
         warnings.push(format!(
             "reduced chi^2 = {reduced_chi2:.2}: the model does not describe the data within its noise; the standard errors are scaled by sqrt of it"
