@@ -158,3 +158,28 @@ def test_ctrl_c_interrupts_a_raster_scan_on_several_threads():
     out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
     assert out.strip() == "interrupted", (out, err)
     assert answered < 2.0
+
+
+def test_ctrl_c_interrupts_a_fit():
+    # Seven parameters on the MAClever's curve: about 8 s on two cores, each Levenberg-Marquardt
+    # evaluation a followed branch (its Jacobian's columns on rayon's threads). Ctrl-C is looked
+    # for between the branches' points, on every thread, not only when the fit returns.
+    data = str(REPO / "fixtures" / "measurements" / "maclever-mica-synthetic.csv")
+    fit = [
+        "z-offset", "amplitude-calibration", "phase-offset", "sample-modulus", "tip-radius",
+        "quality-factor-1", "stiffness-1",
+    ]
+    code = (
+        "import drumroll, time\n"
+        f"measurement = drumroll.Measurement.from_csv({data!r})\n"
+        "case = drumroll.Case('maclever-mica')\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        f"    case.fit(measurement, fit={fit!r})\n"
+        "    print('finished')\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
+    assert out.strip() == "interrupted", (out, err)
+    assert answered < 2.0, answered

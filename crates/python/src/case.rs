@@ -277,7 +277,8 @@ impl Case {
     /// Fit this case's approach branch to `measurement` (a `drumroll.Measurement`) over the
     /// parameters in `fit` (`z-offset`, `amplitude-calibration`, `phase-offset`,
     /// `sample-modulus`, `tip-radius`, ...), as `drumroll fit` (MODEL.md section 13.3):
-    /// a `drumroll.FitResult`. Runs without the GIL.
+    /// a `drumroll.FitResult`. Runs without the GIL; Ctrl-C stops it (between the branch points
+    /// of its followed branches) and raises KeyboardInterrupt.
     #[pyo3(signature = (measurement, *, fit=vec![String::from("z-offset"), String::from("phase-offset"), String::from("sample-modulus")], max_evaluations=40))]
     fn fit(
         &self,

@@ -2,7 +2,7 @@
 //! (`drumroll detect`) and a fit of the model to it (`drumroll fit`), whose dicts are the CLI's
 //! JSON built by the cli crate's own functions (MODEL.md section 13).
 
-use afm::fit::least_squares::{fit_measurement, FitParameter, FitSettings};
+use afm::fit::least_squares::{fit_measurement_until, FitParameter, FitSettings};
 use afm::fit::measurement::Measurement as AfmMeasurement;
 use afm::fit::transitions::{detect_transitions, DetectionSettings};
 use drumroll::detect::detect_json;
@@ -13,6 +13,7 @@ use serde_json::Value;
 
 use crate::convert::{json_to_py, records_to_table};
 use crate::errors::{afm_to_py_err, to_py_err};
+use crate::interrupt::without_gil_on_workers;
 use crate::resolved::Resolved;
 
 /// A measured approach curve read from a CSV or TSV file with a header, as `drumroll detect
@@ -168,23 +169,24 @@ pub fn fit_case(
     let mut settings = FitSettings::new(parameters);
     settings.max_evaluations = max_evaluations.clamp(1, 10_000);
     let measured = &measurement.measurement;
-    let json = py
-        .allow_threads(|| {
-            // The fit and the detection are independent: both at once, the fit's error first
-            // (as `drumroll fit`).
-            let (result, detection) = rayon::join(
-                || fit_measurement(&resolved.case, measured, &settings),
-                || {
-                    detect_transitions(
-                        &measured.approach,
-                        measured.a0_nm,
-                        &DetectionSettings::default(),
-                    )
-                },
-            );
-            let (result, detection) = (result?, detection?);
-            Ok::<Value, afm::AfmError>(fit_json(&resolved.case.name, measured, &result, &detection))
-        })
-        .map_err(afm_to_py_err)?;
+    // The fit runs on rayon's threads (its Jacobian's columns), each asking between branch
+    // points whether Ctrl-C came.
+    let json = without_gil_on_workers(py, |interrupted| {
+        // The fit and the detection are independent: both at once, the fit's error first
+        // (as `drumroll fit`).
+        let (result, detection) = rayon::join(
+            || fit_measurement_until(&resolved.case, measured, &settings, interrupted),
+            || {
+                detect_transitions(
+                    &measured.approach,
+                    measured.a0_nm,
+                    &DetectionSettings::default(),
+                )
+            },
+        );
+        let (result, detection) = (result?, detection?);
+        Ok::<Value, afm::AfmError>(fit_json(&resolved.case.name, measured, &result, &detection))
+    })?
+    .map_err(afm_to_py_err)?;
     Ok(FitResult { json })
 }

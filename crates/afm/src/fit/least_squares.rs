@@ -14,7 +14,7 @@ use nalgebra::{DMatrix, DVector, Dyn};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::diagram::bifurcation_diagram::{approach_diagram, DiagramPoint, DiagramSettings};
+use crate::diagram::bifurcation_diagram::{approach_diagram_until, DiagramPoint, DiagramSettings};
 use crate::error::AfmError;
 use crate::fit::followed_branch::{FollowedBranch, Reading};
 use crate::fit::measurement::{noise_sigma, MeasuredPoint, Measurement};
@@ -259,6 +259,9 @@ struct Residuals<'a> {
     step: f64,
     z_floor: f64,
     cache: Mutex<BranchCache>,
+    /// Asked after every branch point of every followed branch, from any thread: `true` ends
+    /// the fit with [`AfmError::Interrupted`].
+    stop: &'a (dyn Fn() -> bool + Sync),
 }
 
 /// The least-squares problem Levenberg-Marquardt sees: the residuals at its current `theta`,
@@ -353,7 +356,11 @@ impl Residuals<'_> {
         settings.z_limit_nm = self
             .z_floor
             .clamp(-0.95 * a0, 0.9 * model.grazing_separation_nm());
-        let branch = Arc::new(FollowedBranch::new(approach_diagram(&model, &settings)?));
+        let branch = Arc::new(FollowedBranch::new(approach_diagram_until(
+            &model,
+            &settings,
+            &mut || (self.stop)(),
+        )?));
         let mut cache = self.cache.lock().unwrap_or_else(PoisonError::into_inner);
         if cache.len() > 64 {
             cache.clear();
@@ -442,6 +449,9 @@ impl Residuals<'_> {
                 let (up, down) =
                     rayon::join(|| self.residuals_at(&up), || self.residuals_at(&down));
                 column = match (up, down) {
+                    (Err(AfmError::Interrupted), _) | (_, Err(AfmError::Interrupted)) => {
+                        return Err(AfmError::Interrupted)
+                    }
                     (Ok(up), Ok(down)) => (up - down) / (2.0 * self.step),
                     (Ok(up), Err(_)) => (up - self.residuals_at(theta)?) / self.step,
                     (Err(_), Ok(down)) => (self.residuals_at(theta)? - down) / self.step,
@@ -481,7 +491,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
                 self.started.set(true);
                 Some(r)
             }
-            Err(error) if self.started.get() => {
+            Err(error) if self.started.get() && !matches!(error, AfmError::Interrupted) => {
                 let mut rejected = self.rejected.borrow_mut();
                 rejected.0 += 1;
                 rejected.1.get_or_insert(error);
@@ -528,6 +538,21 @@ pub fn fit_measurement(
     measurement: &Measurement,
     settings: &FitSettings,
 ) -> Result<FitResult, AfmError> {
+    fit_measurement_until(case, measurement, settings, &|| false)
+}
+
+/// As [`fit_measurement`], asking `stop` (from any thread) after every branch point of every
+/// followed branch whether to give up: when it answers `true` the fit ends with
+/// [`AfmError::Interrupted`] (a caller's Ctrl-C or cancel button).
+///
+/// # Errors
+/// As [`fit_measurement`], and [`AfmError::Interrupted`].
+pub fn fit_measurement_until(
+    case: &Case,
+    measurement: &Measurement,
+    settings: &FitSettings,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<FitResult, AfmError> {
     let parameters = &settings.parameters;
     if parameters.is_empty()
         || (0..parameters.len()).any(|i| parameters[..i].contains(&parameters[i]))
@@ -562,6 +587,7 @@ pub fn fit_measurement(
         step: settings.difference_step,
         z_floor: 0.0,
         cache: Mutex::new(HashMap::new()),
+        stop,
     };
     let start_values = Values {
         z_offset: 0.0,
@@ -622,6 +648,7 @@ pub fn fit_measurement(
             step: settings.difference_step,
             z_floor,
             cache: Mutex::new(HashMap::new()),
+            stop,
         },
         theta: theta.clone(),
         failure: RefCell::new(None),
