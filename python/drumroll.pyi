@@ -172,7 +172,7 @@ class Case:
         "quality-factor-N", "stiffness-N" N/m) from the case's value over [start, stop],
         exactly at each value of `at`, at least `points` points per curve; every point
         carries the contrast observables and harmonics n = 1..`harmonics` of u. Releases the
-        GIL."""
+        GIL; Ctrl-C stops it."""
     def to_dict(self) -> Dict[str, Any]:
         """The case in the case files' format, cantilever and sample inline."""
     @classmethod

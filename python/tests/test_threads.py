@@ -183,3 +183,21 @@ def test_ctrl_c_interrupts_a_fit():
     out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
     assert out.strip() == "interrupted", (out, err)
     assert answered < 2.0, answered
+
+
+def test_ctrl_c_interrupts_a_map():
+    # Three grazing curves of 1500 points each over A0 on the hydration case: about 6 s on two
+    # cores, the curves on rayon's threads. Ctrl-C is looked for before every curve step.
+    code = (
+        "import drumroll, time\n"
+        "case = drumroll.Case('biolever-mica-hydration')\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        "    case.map('a0', 5.0, 20.0, points=1500)\n"
+        "    print('finished')\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
+    assert out.strip() == "interrupted", (out, err)
+    assert answered < 2.0, answered

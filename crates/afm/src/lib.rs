@@ -43,7 +43,8 @@ pub use fixtures::{
 };
 pub use map::parameter_axis::{CaseFamily, ParameterAxis, PARAMETER_NAMES};
 pub use map::regime_map::{
-    regime_map, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap, RegimeMapSettings,
+    regime_map, regime_map_until, MapCodim2Point, MapCurve, MapEnd, MapPoint, RegimeMap,
+    RegimeMapSettings,
 };
 pub use model::cantilever::{Cantilever, MAX_MODES};
 pub use model::case::{Case, CaseFile};

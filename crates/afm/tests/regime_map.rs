@@ -3,8 +3,8 @@
 //! points as the map's curves hold there.
 
 use afm::{
-    approach_diagram, builtin_case, regime_map, DiagramSettings, ParameterAxis, RegimeMapSettings,
-    TappingModel,
+    approach_diagram, builtin_case, regime_map, regime_map_until, DiagramSettings, ParameterAxis,
+    RegimeMapSettings, TappingModel,
 };
 
 /// Biolever on mica over `A0 = 8 .. 12 nm`: at six `at` values and at the case's own
@@ -234,5 +234,44 @@ fn period_doubling_curves_match_independent_diagrams() {
                 "A0 = {a0}: map Z = {z} vs diagram {zd}"
             );
         }
+    }
+}
+
+/// A stop that answers `true` after some questions ends the map with `Interrupted`, whether
+/// it comes during the seed diagram (after 5 questions) or during the curves (after the seed
+/// diagram's, counted on an uninterrupted map); a stop that never answers `true` gives the
+/// map of `regime_map`.
+#[test]
+fn a_stop_ends_the_map_with_interrupted() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let case = builtin_case("biolever-mica").unwrap();
+    let model = TappingModel::from_case(&case).unwrap();
+    let settings = RegimeMapSettings {
+        points_per_range: 10,
+        ..RegimeMapSettings::new(&model, 8.0, 12.0)
+    };
+    let asked = AtomicUsize::new(0);
+    let counting = || {
+        asked.fetch_add(1, Ordering::Relaxed);
+        false
+    };
+    let whole =
+        regime_map_until(&case, ParameterAxis::FreeAmplitude, &settings, &counting).expect("map");
+    let questions = asked.load(Ordering::Relaxed);
+    let seed_questions = whole.seed.points.len();
+    assert!(questions > seed_questions + 10, "{questions} questions");
+    let plain = regime_map(&case, ParameterAxis::FreeAmplitude, &settings).unwrap();
+    assert_eq!(
+        serde_json::to_string(&whole).unwrap(),
+        serde_json::to_string(&plain).unwrap()
+    );
+    for after in [5, seed_questions + 10] {
+        let asked = AtomicUsize::new(0);
+        let stop = || asked.fetch_add(1, Ordering::Relaxed) >= after;
+        let result = regime_map_until(&case, ParameterAxis::FreeAmplitude, &settings, &stop);
+        assert!(
+            matches!(result, Err(afm::AfmError::Interrupted)),
+            "stopped after {after}: {result:?}"
+        );
     }
 }

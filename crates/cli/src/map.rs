@@ -3,7 +3,7 @@
 //! over a range (`afm::map::regime_map`), as curves in the `(p, Z)` and `(p, A/A0)` planes.
 
 use afm::{
-    regime_map, Case, MapCodim2Point, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings,
+    regime_map_until, Case, MapCodim2Point, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings,
     TappingModel,
 };
 use anyhow::{bail, Context, Result};
@@ -166,7 +166,18 @@ pub fn compute_map(
     axis: ParameterAxis,
     settings: &RegimeMapSettings,
 ) -> Result<RegimeMap> {
-    let map = regime_map(case, axis, settings)
+    compute_map_until(case, axis, settings, &|| false)
+}
+
+/// As [`compute_map`], asking `stop` (from any thread) between the map's steps whether to give
+/// up ([`afm::regime_map_until`]).
+pub fn compute_map_until(
+    case: &Case,
+    axis: ParameterAxis,
+    settings: &RegimeMapSettings,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<RegimeMap> {
+    let map = regime_map_until(case, axis, settings, stop)
         .with_context(|| format!("regime map of case `{}` failed", case.name))?;
     for label in settings.labels.iter().flatten() {
         if !map.curves.iter().any(|c| c.label == *label) {

@@ -77,6 +77,8 @@ pub enum CurveStop {
     StepTooSmall,
     /// Another error.
     Error,
+    /// The caller's stop predicate answered `true` ([`continue_curve_until`]).
+    Interrupted,
 }
 
 /// One end of a curve.
@@ -123,6 +125,22 @@ pub fn continue_curve<F: SystemFamily>(
     kind: CodimOneKind,
     start: &CurveStart,
     settings: &CurveSettings,
+) -> Result<Curve, ContinuationError> {
+    continue_curve_until(problem, kind, start, settings, &|| false)
+}
+
+/// As [`continue_curve`], asking `stop` before every step of each half whether to give up:
+/// when it answers `true` that half ends there with [`CurveStop::Interrupted`] (a caller's
+/// Ctrl-C or cancel button), keeping the points found.
+///
+/// # Errors
+/// As [`continue_curve`].
+pub fn continue_curve_until<F: SystemFamily>(
+    problem: &TwoParameterProblem<F>,
+    kind: CodimOneKind,
+    start: &CurveStart,
+    settings: &CurveSettings,
+    stop: &dyn Fn() -> bool,
 ) -> Result<Curve, ContinuationError> {
     settings.validate()?;
     let q0 = start.second_parameter;
@@ -175,7 +193,7 @@ pub fn continue_curve<F: SystemFamily>(
             section: defining.section.get(),
             at_fixed_second: true,
         };
-        halves.push(half_curve(&defining, current, settings));
+        halves.push(half_curve(&defining, current, settings, stop));
     }
     let (mut low_points, mut low_codim, low_end) = halves.remove(0);
     let (high_points, high_codim, high_end) = halves.remove(0);
@@ -281,12 +299,13 @@ fn crossed(values: &[f64], from: f64, to: f64) -> Option<f64> {
         .min_by(|a, b| (a - from).abs().total_cmp(&(b - from).abs()))
 }
 
-/// Trace one half of a curve from `current`; returns its points (without the start), its
-/// codimension-two points and its end.
+/// Trace one half of a curve from `current`, asking `stop` before every step; returns its
+/// points (without the start), its codimension-two points and its end.
 fn half_curve<F: SystemFamily>(
     defining: &Defining<'_, F>,
     mut current: Current,
     settings: &CurveSettings,
+    stop: &dyn Fn() -> bool,
 ) -> (Vec<CurvePoint>, Vec<Codim2Point>, CurveEnd) {
     defining.section.set(current.section);
     let m = defining.unknowns();
@@ -313,6 +332,9 @@ fn half_curve<F: SystemFamily>(
     loop {
         if points.len() >= settings.max_points {
             return (points, codim2, end(CurveStop::MaxPoints, &current, None));
+        }
+        if stop() {
+            return (points, codim2, end(CurveStop::Interrupted, &current, None));
         }
         let tq = current.tangent[iq].abs();
         if tq * step > settings.max_second_step {

@@ -76,7 +76,9 @@ pub mod two_parameter;
 pub use branch::{Branch, BranchPoint, Continuation, StopReason};
 pub use codim_one::CodimOneKind;
 pub use codim_two::{Codim2Kind, Codim2Point};
-pub use curve::{continue_curve, Curve, CurveEnd, CurvePoint, CurveStart, CurveStop};
+pub use curve::{
+    continue_curve, continue_curve_until, Curve, CurveEnd, CurvePoint, CurveStart, CurveStop,
+};
 pub use curve_settings::CurveSettings;
 pub use error::ContinuationError;
 pub use floquet::{floquet_multipliers, is_stable, spectral_radius};

@@ -392,7 +392,8 @@ impl Case {
     /// and at least `points` points per curve over the range. `floor`,
     /// `min_amplitude_ratio` and `max_step` set the seed approach as in `diagram`;
     /// `harmonics`: the harmonics n = 1..N of u at every curve point (N in [1, 1000]). Runs
-    /// without the GIL.
+    /// without the GIL; Ctrl-C stops it (between the steps of its curves) and raises
+    /// KeyboardInterrupt.
     #[pyo3(signature = (vary, start, stop, *, at=None, labels=None, points=100, floor=None, min_amplitude_ratio=0.3, max_step=None, harmonics=drumroll::approach::DEFAULT_HARMONICS))]
     #[allow(clippy::too_many_arguments)]
     fn map(

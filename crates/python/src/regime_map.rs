@@ -3,7 +3,7 @@
 //! parameter (MODEL.md section 5), each curve a table.
 
 use afm::ParameterAxis;
-use drumroll::map::{compute_map, map_json, map_settings, MapArgs, CSV_COLUMNS};
+use drumroll::map::{compute_map_until, map_json, map_settings, MapArgs, CSV_COLUMNS};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -12,6 +12,7 @@ use std::sync::Arc;
 
 use crate::convert::{json_to_py, py_to_json, records_to_table, reduce_by_from_dict};
 use crate::errors::to_py_err;
+use crate::interrupt::without_gil_on_workers;
 use crate::resolved::{resolved_model_args, Resolved};
 
 /// The options of `Case.map`, as `drumroll map`'s.
@@ -160,14 +161,14 @@ pub fn compute_regime_map(
         plot: None,
         grid_file: None,
     };
-    let json = py
-        .allow_threads(|| -> anyhow::Result<Value> {
-            let (case, model) = (&resolved.case, &resolved.model);
-            let axis = ParameterAxis::parse(&args.vary, case.cantilever.modes.len())?;
-            let settings = map_settings(&args, model)?;
-            let map = compute_map(case, axis, &settings)?;
-            Ok(map_json(&args, case, model, axis, &settings, &map))
-        })
-        .map_err(to_py_err)?;
+    // The curves run on rayon's threads, each asking between its steps whether Ctrl-C came.
+    let json = without_gil_on_workers(py, |interrupted| -> anyhow::Result<Value> {
+        let (case, model) = (&resolved.case, &resolved.model);
+        let axis = ParameterAxis::parse(&args.vary, case.cantilever.modes.len())?;
+        let settings = map_settings(&args, model)?;
+        let map = compute_map_until(case, axis, &settings, interrupted)?;
+        Ok(map_json(&args, case, model, axis, &settings, &map))
+    })?
+    .map_err(to_py_err)?;
     Ok(RegimeMap { json })
 }

@@ -30,14 +30,16 @@
 //! ```
 
 use continuation::{
-    continue_curve, spectral_radius, CodimOneKind, Curve, CurveEnd, CurveSettings, CurveStart,
-    CurveStop, NewtonSettings, TwoParameterProblem,
+    continue_curve_until, spectral_radius, CodimOneKind, Curve, CurveEnd, CurveSettings,
+    CurveStart, CurveStop, NewtonSettings, TwoParameterProblem,
 };
 use hybrid::{flow_map, Sensitivity};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::diagram::bifurcation_diagram::{approach_diagram, BifurcationDiagram, DiagramSettings};
+use crate::diagram::bifurcation_diagram::{
+    approach_diagram_until, BifurcationDiagram, DiagramSettings,
+};
 use crate::error::AfmError;
 use crate::map::parameter_axis::{CaseFamily, ParameterAxis};
 use crate::map::seed_order::continue_in_seed_order;
@@ -285,6 +287,22 @@ pub fn regime_map(
     axis: ParameterAxis,
     settings: &RegimeMapSettings,
 ) -> Result<RegimeMap, AfmError> {
+    regime_map_until(case, axis, settings, &|| false)
+}
+
+/// As [`regime_map`], asking `stop` (from any thread) after every point of the seed diagram,
+/// before every step of every curve and before the curve points' observables whether to give up:
+/// when it answers `true` the map ends with [`AfmError::Interrupted`] (a caller's Ctrl-C or
+/// cancel button).
+///
+/// # Errors
+/// As [`regime_map`], and [`AfmError::Interrupted`].
+pub fn regime_map_until(
+    case: &Case,
+    axis: ParameterAxis,
+    settings: &RegimeMapSettings,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<RegimeMap, AfmError> {
     check_range(case, axis, settings)?;
     settings.diagram.validate()?;
     let q0 = axis.value(case)?;
@@ -293,7 +311,7 @@ pub fn regime_map(
         axis,
     };
     let model = family.model_at(q0)?;
-    let seed = approach_diagram(&model, &settings.diagram)?;
+    let seed = approach_diagram_until(&model, &settings.diagram, &mut || stop())?;
     let integration = settings.diagram.orbit.integration.clone();
     // The problem's inputs checked once, before any curve, as the serial loop did; each curve
     // builds its own problem from them.
@@ -342,7 +360,9 @@ pub fn regime_map(
             let (kind, _, start) = &seeds[i];
             // Each curve has a problem of its own (the members it keeps built are its own).
             let curve = TwoParameterProblem::new(family.clone(), q0, 1, integration.clone())
-                .and_then(|problem| continue_curve(&problem, *kind, start, &curve_settings));
+                .and_then(|problem| {
+                    continue_curve_until(&problem, *kind, start, &curve_settings, stop)
+                });
             // A curve that cannot start is kept, empty, with the reason at both ends.
             curve.unwrap_or_else(|error| {
                 let end = CurveEnd {
@@ -366,6 +386,9 @@ pub fn regime_map(
             })
         },
     );
+    if stop() {
+        return Err(AfmError::Interrupted);
+    }
     // The observables of every point, in parallel; the first error in curve order (a curve's
     // points, then its codimension-two points) stops the map, as serially.
     let harmonics = settings.diagram.orbit.harmonics;
@@ -467,6 +490,7 @@ fn end_words(end: &CurveEnd) -> &'static str {
         CurveStop::Closed => "closed",
         CurveStop::StepTooSmall => "corrector-failed",
         CurveStop::Error => "error",
+        CurveStop::Interrupted => "interrupted",
     }
 }
 
