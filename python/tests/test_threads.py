@@ -87,6 +87,25 @@ def _ctrl_c_after_a_second(code, timeout):
     return out, err, time.perf_counter() - sent
 
 
+def _interrupted_within_two_seconds(setup, call, timeout=60):
+    """Run `setup` (lines of Python making `case` and the call's arguments), then `call` (one
+    expression, the long computation), in a fresh Python; Ctrl-C a second after it starts must
+    raise KeyboardInterrupt within 2 s of the signal."""
+    code = (
+        "import drumroll\n"
+        f"{setup}"
+        "print('started', flush=True)\n"
+        "try:\n"
+        f"    {call}\n"
+        "    print('finished')\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    out, err, answered = _ctrl_c_after_a_second(code, timeout)
+    assert out.strip() == "interrupted", (out, err)
+    assert answered < 2.0, answered
+
+
 def test_ctrl_c_interrupts_an_approach():
     code = (
         "import drumroll, time\n"
@@ -109,55 +128,28 @@ def test_ctrl_c_interrupts_an_approach():
 def test_ctrl_c_interrupts_an_approach_between_its_records():
     # One record kept of about 475,000 cycles (every millionth): Ctrl-C is looked for between
     # cycles, on every thread the sweep runs on, not only when a record comes.
-    code = (
-        "import drumroll\n"
-        "case = drumroll.Case('biolever-mica')\n"
-        "print('started', flush=True)\n"
-        "try:\n"
-        "    case.approach(from_nm=10.2, to_nm=0.0, rate_nm_per_s=0.2, every=1000000)\n"
-        "    print('finished')\n"
-        "except KeyboardInterrupt:\n"
-        "    print('interrupted')\n"
+    _interrupted_within_two_seconds(
+        "case = drumroll.Case('biolever-mica')\n",
+        "case.approach(from_nm=10.2, to_nm=0.0, rate_nm_per_s=0.2, every=1000000)",
     )
-    out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
-    assert out.strip() == "interrupted", (out, err)
-    assert answered < 2.0, answered
 
 
 def test_ctrl_c_interrupts_a_diagram():
-    code = (
-        "import drumroll, time\n"
-        "case = drumroll.Case('maclever-soft')\n"
-        "print('started', flush=True)\n"
-        "try:\n"
-        "    for _ in range(100):\n"
-        "        case.diagram(min_amplitude_ratio=0.0, max_step=0.01)\n"
-        "    print('finished')\n"
-        "except KeyboardInterrupt:\n"
-        "    print('interrupted')\n"
+    _interrupted_within_two_seconds(
+        "case = drumroll.Case('maclever-soft')\n",
+        "[case.diagram(min_amplitude_ratio=0.0, max_step=0.01) for _ in range(100)]",
+        timeout=30,
     )
-    out, err, answered = _ctrl_c_after_a_second(code, timeout=30)
-    assert out.strip() == "interrupted", (out, err)
-    assert answered < 2.0
 
 
 def test_ctrl_c_interrupts_a_raster_scan_on_several_threads():
     # The rows run on rayon's threads, which do not see signals: the calling thread looks for
     # the Ctrl-C while they run, and they stop (the scan takes about 10 s on two cores).
     raster = str(REPO / "fixtures" / "rasters" / "membrane-disc.json")
-    code = (
-        "import drumroll, time\n"
-        "case = drumroll.Case('maclever-membrane-experiment')\n"
-        "print('started', flush=True)\n"
-        "try:\n"
-        f"    case.scan(raster={raster!r}, pixels=64, feedback='pi', scan_rate_nm_per_s=10.0)\n"
-        "    print('finished')\n"
-        "except KeyboardInterrupt:\n"
-        "    print('interrupted')\n"
+    _interrupted_within_two_seconds(
+        "case = drumroll.Case('maclever-membrane-experiment')\n",
+        f"case.scan(raster={raster!r}, pixels=64, feedback='pi', scan_rate_nm_per_s=10.0)",
     )
-    out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
-    assert out.strip() == "interrupted", (out, err)
-    assert answered < 2.0
 
 
 def test_ctrl_c_interrupts_a_fit():
@@ -169,35 +161,17 @@ def test_ctrl_c_interrupts_a_fit():
         "z-offset", "amplitude-calibration", "phase-offset", "sample-modulus", "tip-radius",
         "quality-factor-1", "stiffness-1",
     ]
-    code = (
-        "import drumroll, time\n"
+    _interrupted_within_two_seconds(
         f"measurement = drumroll.Measurement.from_csv({data!r})\n"
-        "case = drumroll.Case('maclever-mica')\n"
-        "print('started', flush=True)\n"
-        "try:\n"
-        f"    case.fit(measurement, fit={fit!r})\n"
-        "    print('finished')\n"
-        "except KeyboardInterrupt:\n"
-        "    print('interrupted')\n"
+        "case = drumroll.Case('maclever-mica')\n",
+        f"case.fit(measurement, fit={fit!r})",
     )
-    out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
-    assert out.strip() == "interrupted", (out, err)
-    assert answered < 2.0, answered
 
 
 def test_ctrl_c_interrupts_a_map():
     # Three grazing curves of 1500 points each over A0 on the hydration case: about 6 s on two
     # cores, the curves on rayon's threads. Ctrl-C is looked for before every curve step.
-    code = (
-        "import drumroll, time\n"
-        "case = drumroll.Case('biolever-mica-hydration')\n"
-        "print('started', flush=True)\n"
-        "try:\n"
-        "    case.map('a0', 5.0, 20.0, points=1500)\n"
-        "    print('finished')\n"
-        "except KeyboardInterrupt:\n"
-        "    print('interrupted')\n"
+    _interrupted_within_two_seconds(
+        "case = drumroll.Case('biolever-mica-hydration')\n",
+        "case.map('a0', 5.0, 20.0, points=1500)",
     )
-    out, err, answered = _ctrl_c_after_a_second(code, timeout=60)
-    assert out.strip() == "interrupted", (out, err)
-    assert answered < 2.0, answered
