@@ -6,8 +6,8 @@
 mod oscillator;
 
 use continuation::{
-    continue_curve, CodimOneKind, CurveSettings, CurveStart, CurveStop, NewtonSettings,
-    SpecialPointKind, TwoParameterProblem,
+    continue_curve, continue_curve_until, CodimOneKind, CurveSettings, CurveStart, CurveStop,
+    NewtonSettings, SpecialPointKind, TwoParameterProblem,
 };
 use hybrid::Settings;
 use oscillator::{continue_in_amplitude, ImpactOscillator};
@@ -210,4 +210,61 @@ fn fold_curve_of_the_cusp_normal_form_is_exact_and_turns_at_the_cusp() {
         .collect();
     assert_eq!(cusps.len(), 1, "{:?}", curve.codim2_points);
     assert!(cusps[0].parameter.abs() < 1e-6 && cusps[0].second_parameter.abs() < 1e-6);
+}
+
+/// A stop that answers `true` from its 6th question on ends each half of the grazing curve
+/// with `Interrupted` (the first half after the five steps it allowed, the second at once),
+/// keeping the points found, each on the closed form `A_g(w)` to 1e-10 as above.
+#[test]
+fn a_stop_ends_the_curve_with_interrupted_and_keeps_its_points() {
+    let w0 = 0.8;
+    let branch = continue_in_amplitude(&oscillator(w0), 4.0, 400).expect("branch");
+    let g1 = branch
+        .special_points
+        .iter()
+        .find(|s| s.kind == SpecialPointKind::Grazing)
+        .expect("G1 on the one-parameter branch");
+    let mut system = oscillator(w0);
+    system.amplitude = g1.parameter;
+    let problem = TwoParameterProblem::new(system, w0, 1, Settings::default()).expect("problem");
+    let settings = CurveSettings {
+        second_range: (0.5, 1.6),
+        max_second_step: 0.02,
+        corrector: NewtonSettings {
+            tolerance: 1e-12,
+            max_iterations: 10,
+            ..NewtonSettings::default()
+        },
+        ..CurveSettings::default()
+    };
+    let start = CurveStart {
+        state: g1.state.as_slice().to_vec(),
+        section_time: 0.0,
+        parameter: g1.parameter,
+        second_parameter: w0,
+    };
+    let asked = std::cell::Cell::new(0);
+    let stop = || {
+        asked.set(asked.get() + 1);
+        asked.get() > 5
+    };
+    let curve = continue_curve_until(&problem, CodimOneKind::Grazing, &start, &settings, &stop)
+        .expect("curve");
+    assert_eq!(
+        [curve.ends[0].reason, curve.ends[1].reason],
+        [CurveStop::Interrupted, CurveStop::Interrupted],
+        "{:?}",
+        curve.ends
+    );
+    // Five steps accepted (a step is a point, or a cut step retried), and the start.
+    assert!(
+        (2..=6).contains(&curve.points.len()),
+        "{} points",
+        curve.points.len()
+    );
+    assert_eq!(curve.start_index, curve.points.len() - 1);
+    for point in &curve.points {
+        let exact = oscillator(point.second_parameter).grazing_amplitude_closed_form();
+        assert!((point.parameter - exact).abs() <= 1e-10, "{point:?}");
+    }
 }
