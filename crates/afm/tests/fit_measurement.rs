@@ -203,8 +203,8 @@ fn quiet_curve_returns_the_truth() {
 /// built-in `maclever-mica` case: the data cannot separate the sample modulus, tip radius and
 /// first mode, and Levenberg-Marquardt's early steps push the modulus past its range (to an
 /// overflow of its logarithm). Such trial steps are rejected and the fit goes on: it returns a
-/// result whose values all lie in their ranges and which says how many steps were rejected. Before the
-/// rejection this fit failed with "field `sample-modulus` = inf is invalid".
+/// result whose values all lie in their ranges and which says how many steps were rejected.
+/// Before the rejection this fit failed with "field `sample-modulus` = inf is invalid".
 #[test]
 fn trial_steps_out_of_the_models_range_are_rejected_and_the_fit_goes_on() {
     let path = concat!(
@@ -239,10 +239,9 @@ fn trial_steps_out_of_the_models_range_are_rejected_and_the_fit_goes_on() {
     settings.max_evaluations = 8;
     let result = fit_measurement(&case, &measurement, &settings).unwrap();
     assert!(
-        result
-            .warnings
-            .iter()
-            .any(|w| w.contains("trial steps left the model's valid range and were rejected")),
+        result.warnings.iter().any(
+            |w| w.contains("trial steps could not be evaluated") && w.contains("were rejected")
+        ),
         "{:?}",
         result.warnings
     );

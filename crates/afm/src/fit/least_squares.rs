@@ -767,7 +767,7 @@ pub fn fit_measurement_until(
         .collect();
     if let Some(rejection) = rejection {
         warnings.push(format!(
-            "{rejected} trial step{} left the model's valid range and {} rejected (the first: {rejection})",
+            "{rejected} trial step{} could not be evaluated (a parameter out of its range, or a branch that could not be followed) and {} rejected (the first: {rejection})",
             if rejected == 1 { "" } else { "s" },
             if rejected == 1 { "was" } else { "were" },
         ));
