@@ -6,6 +6,7 @@
 use afm::fit::least_squares::{fit_measurement, FitParameter, FitResult, FitSettings};
 use afm::fit::measurement::Measurement;
 use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings};
+use afm::Case;
 use anyhow::Result;
 use clap::Args;
 use serde_json::{json, Map, Value};
@@ -131,7 +132,6 @@ pub fn fit_json(
 /// # Errors
 /// A bad file or option, a model that cannot be built or continued.
 pub fn run(args: &FitArgs) -> Result<()> {
-    let case = args.model.case()?;
     if let Some(path) = &args.csv {
         check_writable(path, "--csv")?;
     }
@@ -140,36 +140,12 @@ pub fn run(args: &FitArgs) -> Result<()> {
         .as_ref()
         .map(|path| FigureFile::new(path, "--plot"))
         .transpose()?;
-    if !(1..=10_000).contains(&args.max_evaluations) {
-        anyhow::bail!(
-            "command line: field `--max-evaluations` = {} is invalid; allowed: [1, 10000]",
-            args.max_evaluations
-        );
-    }
-    let modes = case.cantilever.mode_count();
-    let parameters = args
-        .fit
-        .split(',')
-        .filter(|s| !s.trim().is_empty())
-        .map(|name| FitParameter::parse(name, modes))
-        .collect::<Result<Vec<_>, _>>()?;
-    let measurement = args.measurement.read(args.model.a0)?;
-    let mut settings = FitSettings::new(parameters);
-    settings.max_evaluations = args.max_evaluations;
-    // The fit and the detection of the measured transitions are independent: both run at
-    // once (rayon), the fit's error first, as when they ran one after the other.
-    let (result, detection) = rayon::join(
-        || fit_measurement(&case, &measurement, &settings),
-        || {
-            detect_transitions(
-                &measurement.approach,
-                measurement.a0_nm,
-                &DetectionSettings::default(),
-            )
-        },
-    );
-    let result = result?;
-    let detection = detection?;
+    let Fitted {
+        case,
+        measurement,
+        result,
+        detection,
+    } = compute_fit(args)?;
     let object = fit_json(&case.name, &measurement, &result, &detection);
     for warning in &result.warnings {
         eprintln!("drumroll: warning: {warning}");
@@ -239,4 +215,61 @@ pub fn run(args: &FitArgs) -> Result<()> {
         print_stdout(&text)?;
     }
     Ok(())
+}
+
+/// What [`compute_fit`] gives: the case, the measurement as read, the fit and the detected
+/// transitions.
+pub struct Fitted {
+    /// The model's case (with the command line's overrides).
+    pub case: Case,
+    /// The measured curve, in nm and degrees.
+    pub measurement: Measurement,
+    /// The fit (MODEL.md section 13.3).
+    pub result: FitResult,
+    /// The transitions detected in the measured curve (MODEL.md section 13.2).
+    pub detection: Detection,
+}
+
+/// The fit of `drumroll fit` for `args` and the transitions detected alongside it, without
+/// writing anything: the options checked (naming the one at fault), the data read, then both
+/// at once.
+///
+/// # Errors
+/// A bad option, an unreadable or malformed data file, or a fit that fails at its start.
+pub fn compute_fit(args: &FitArgs) -> Result<Fitted> {
+    let case = args.model.case()?;
+    if !(1..=10_000).contains(&args.max_evaluations) {
+        anyhow::bail!(
+            "command line: field `--max-evaluations` = {} is invalid; allowed: [1, 10000]",
+            args.max_evaluations
+        );
+    }
+    let modes = case.cantilever.mode_count();
+    let parameters = args
+        .fit
+        .split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|name| FitParameter::parse(name, modes))
+        .collect::<Result<Vec<_>, _>>()?;
+    let measurement = args.measurement.read(args.model.a0)?;
+    let mut settings = FitSettings::new(parameters);
+    settings.max_evaluations = args.max_evaluations;
+    // The fit and the detection of the measured transitions are independent: both run at
+    // once (rayon), the fit's error first, as when they ran one after the other.
+    let (result, detection) = rayon::join(
+        || fit_measurement(&case, &measurement, &settings),
+        || {
+            detect_transitions(
+                &measurement.approach,
+                measurement.a0_nm,
+                &DetectionSettings::default(),
+            )
+        },
+    );
+    Ok(Fitted {
+        result: result?,
+        detection: detection?,
+        case,
+        measurement,
+    })
 }

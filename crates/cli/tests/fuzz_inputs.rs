@@ -11,8 +11,9 @@
 //! but not integrated, so that an input stays quick). Files may start with a UTF-8 byte-order
 //! mark, and a case file's references may be `.` or a name that is no file.
 //!
-//! A second test draws scan line files, raster files and measurement CSVs with `scan` and
-//! `detect` options ([`file_input`]), and every sample file may carry a contact law, a
+//! A second test draws scan line files, raster files and measurement CSVs with `scan`,
+//! `detect` and `fit` options ([`file_input`]; one detected measurement in [`FIT_EVERY`] is
+//! fitted, with one or two model parameters), and every sample file may carry a contact law, a
 //! hydration force and a double layer, every case file a `drive`. To cover a new input file:
 //! add a generator beside [`line_text`] (clean values near typical ones, and when not clean
 //! the malformed, extreme and wrong-typed values of [`json_number`] and [`json_name`]), a
@@ -917,6 +918,17 @@ struct DetectCommand {
     args: drumroll::detect::DetectArgs,
 }
 
+/// `drumroll fit`'s options, parsed as the binary parses them.
+#[derive(Debug, Parser)]
+struct FitCommand {
+    #[command(flatten)]
+    args: drumroll::fit::FitArgs,
+}
+
+/// One detected measurement in this many is also fitted (a fit follows several branches: 1 to
+/// 5 s for a generated curve's A0 of 20 nm with `--max-evaluations` of 1 to 3).
+const FIT_EVERY: u64 = 8;
+
 /// `Some` of `strategy` with probability `p`, never when `clean`.
 fn unless_clean<T: std::fmt::Debug + Clone + 'static>(
     clean: bool,
@@ -1168,6 +1180,9 @@ struct FileInput {
     columns: Option<&'static str>,
     significance: Option<String>,
     window: Option<String>,
+    /// `fit`'s `--fit` list and `--max-evaluations`.
+    fit: Option<&'static str>,
+    fit_evaluations: String,
 }
 
 fn file_input() -> impl Strategy<Value = FileInput> {
@@ -1220,13 +1235,41 @@ fn file_input() -> impl Strategy<Value = FileInput> {
                 ]),
                 prop::option::weighted(0.3, option_value(0.01, clean)),
                 prop::option::weighted(0.2, count_value(12, clean)),
+                prop::option::weighted(
+                    0.8,
+                    prop::sample::select(vec![
+                        "z-offset,phase-offset,sample-modulus",
+                        "amplitude-calibration,tip-radius",
+                        "z-offset,stiffness-1",
+                        "drive-frequency,phase-offset",
+                        "sample-modulus,tip-radius",
+                        "stiffness-9",
+                        "a0",
+                        "z-offset,z-offset",
+                        "bogus",
+                        ",",
+                    ]),
+                ),
+                prop_oneof![
+                    8 => (1u32..=3).prop_map(|n| n.to_string()),
+                    1 => prop::sample::select(vec!["0", "10001", "-1", "x"]).prop_map(String::from),
+                ],
             ),
         )
             .prop_map(
                 |(
                     (line, raster, sample, measurement, d1, d2, d3, d4),
                     (scan_source, case, a0, drive_frequency, setpoint, pixels, harmonics, pi),
-                    (z_unit, amplitude_unit, invols, columns, significance, window),
+                    (
+                        z_unit,
+                        amplitude_unit,
+                        invols,
+                        columns,
+                        significance,
+                        window,
+                        fit,
+                        fit_evaluations,
+                    ),
                 )| FileInput {
                     line: corrupt(line, d1),
                     raster: corrupt(raster, d2),
@@ -1246,6 +1289,8 @@ fn file_input() -> impl Strategy<Value = FileInput> {
                     columns,
                     significance,
                     window,
+                    fit,
+                    fit_evaluations,
                 },
             )
     })
@@ -1260,6 +1305,8 @@ struct FileTally {
     scans_accepted: u64,
     measurements_refused: u64,
     measurements_detected: u64,
+    fits_refused: u64,
+    fits_made: u64,
     binary_runs: u64,
     slowest: Duration,
 }
@@ -1308,6 +1355,30 @@ fn scan_words(input: &FileInput, dir: &Path) -> Vec<String> {
         ],
     );
     words.push(format!("--out={}", dir.join("out.csv").display()));
+    words
+}
+
+/// The words of `drumroll fit` for `input`: the detection's data and reading options, the
+/// Biolever on mica (the quickest diagrams), the `--fit` list (at most two model parameters,
+/// each a pair of branches per Jacobian) and `--max-evaluations`.
+fn fit_words(input: &FileInput, dir: &Path) -> Vec<String> {
+    let mut words = vec![
+        String::from("fit"),
+        format!("--data={}", dir.join("data.csv").display()),
+        String::from("--case=biolever-mica"),
+        format!("--max-evaluations={}", input.fit_evaluations),
+    ];
+    push_options(
+        &mut words,
+        &[
+            ("fit", input.fit),
+            ("a0", input.a0.as_deref()),
+            ("z-unit", input.z_unit),
+            ("amplitude-unit", input.amplitude_unit),
+            ("invols", input.invols.as_deref()),
+            ("columns", input.columns),
+        ],
+    );
     words
 }
 
@@ -1512,6 +1583,32 @@ fn run_file_one(input: &FileInput, dir: &Path, tally: &mut FileTally) -> Result<
         tally.binary_runs += 1;
         run_binary(&detect, dir, &sources, refused)?;
     }
+    // A fit of one detected measurement in FIT_EVERY: a result (its values in their ranges),
+    // or a refusal that names what is wrong.
+    if !refused && tally.measurements_detected.is_multiple_of(FIT_EVERY) {
+        match FitCommand::try_parse_from(fit_words(input, dir)) {
+            Err(error) => {
+                tally.refused_by_clap += 1;
+                let message = error.to_string();
+                prop_assert!(message.contains("'--"), "{message}");
+            }
+            Ok(command) => match drumroll::fit::compute_fit(&command.args) {
+                Err(error) => {
+                    tally.fits_refused += 1;
+                    if std::env::var_os("DRUMROLL_FUZZ_SHOW").is_some() {
+                        println!("fit refused: {}", chain(&error));
+                    }
+                    check_rejection(&chain(&error), &sources)?;
+                }
+                Ok(fitted) => {
+                    tally.fits_made += 1;
+                    for value in &fitted.result.parameters {
+                        prop_assert!(value.value.is_finite(), "{value:?}");
+                    }
+                }
+            },
+        }
+    }
     prop_assert!(leftovers(dir).is_empty(), "{:?}", leftovers(dir));
     let elapsed = started.elapsed();
     tally.slowest = tally.slowest.max(elapsed);
@@ -1534,8 +1631,8 @@ fn generated_scan_and_measurement_files_never_panic_hang_or_leave_files_and_are_
     let tally = tally.into_inner();
     println!(
         "fuzz_inputs (files): {} inputs in {:.1} s: {} refused by clap; scan: {} refused by the \
-         checks, {} accepted; detect: {} refused, {} detected; {} runs of the binary; slowest \
-         input {:?}",
+         checks, {} accepted; detect: {} refused, {} detected; fit: {} refused, {} made; {} runs \
+         of the binary; slowest input {:?}",
         tally.inputs,
         started.elapsed().as_secs_f64(),
         tally.refused_by_clap,
@@ -1543,6 +1640,8 @@ fn generated_scan_and_measurement_files_never_panic_hang_or_leave_files_and_are_
         tally.scans_accepted,
         tally.measurements_refused,
         tally.measurements_detected,
+        tally.fits_refused,
+        tally.fits_made,
         tally.binary_runs,
         tally.slowest
     );
