@@ -123,7 +123,9 @@ class Case:
         """Fit this case's approach branch to `measurement` over the parameters in `fit`
         ("z-offset", "amplitude-calibration", "phase-offset", "sample-modulus", "tip-radius",
         ...), as `drumroll fit` (MODEL.md section 13.3): Levenberg-Marquardt on the followed
-        branch, at most `max_evaluations` evaluations. Releases the GIL; Ctrl-C stops it."""
+        branch, about `max_evaluations` residual evaluations (rounded up to a multiple of the
+        varied quantities plus one, as `drumroll fit --max-evaluations`). Releases the GIL;
+        Ctrl-C stops it."""
     def scan(
         self,
         line: Union[str, Dict[str, Any], None] = None,

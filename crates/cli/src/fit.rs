@@ -38,7 +38,9 @@ pub struct FitArgs {
         default_value = "z-offset,phase-offset,sample-modulus"
     )]
     pub fit: String,
-    /// Largest number of model evaluations, in [1, 10000].
+    /// Budget of Levenberg-Marquardt's evaluations of the residuals (a followed branch each),
+    /// in [1, 10000]; rounded up to a multiple of the varied quantities plus one (MINPACK's
+    /// patience; `amplitude-calibration` varies two), and the Jacobian's branches come on top.
     #[arg(long, default_value_t = 40)]
     pub max_evaluations: usize,
     /// Print JSON instead of the summary.

@@ -141,7 +141,9 @@ pub struct FitSettings {
     /// Step of the central differences in the logarithm of the model's free amplitude and case
     /// parameters (default 0.002).
     pub difference_step: f64,
-    /// Largest number of residual evaluations of Levenberg-Marquardt (default 40).
+    /// Budget of Levenberg-Marquardt's residual evaluations (default 40): MINPACK's patience,
+    /// `ceil(max_evaluations / (q + 1))` times `q + 1` for `q` varied quantities, so rounded up
+    /// to that multiple; the Jacobian's central differences are not counted.
     pub max_evaluations: usize,
 }
 
