@@ -726,7 +726,7 @@ pub fn fit_measurement_until(
             let margin = settings.difference_step.exp();
             if value * margin > range.max || value / margin < range.min {
                 warnings.push(format!(
-                    "{}: stopped at the bound of its range {} (the data pull it out of the model's range)",
+                    "{}: stopped at the bound of its range, {}: the data pull it out of the model's range",
                     parameter.key(),
                     range.describe()
                 ));
