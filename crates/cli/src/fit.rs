@@ -3,7 +3,7 @@
 //! correlations, the fitted grazing points in data coordinates and their match with the
 //! detected transitions, and the contrast observables at every measured point.
 
-use afm::fit::least_squares::{fit_measurement, FitParameter, FitResult, FitSettings};
+use afm::fit::least_squares::{fit_measurement_until, FitParameter, FitResult, FitSettings};
 use afm::fit::measurement::Measurement;
 use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings};
 use afm::Case;
@@ -256,10 +256,30 @@ pub fn compute_fit(args: &FitArgs) -> Result<Fitted> {
     let measurement = args.measurement.read(args.model.a0)?;
     let mut settings = FitSettings::new(parameters);
     settings.max_evaluations = args.max_evaluations;
-    // The fit and the detection of the measured transitions are independent: both run at
-    // once (rayon), the fit's error first, as when they ran one after the other.
+    let (result, detection) = fit_and_detect(&case, &measurement, &settings, &|| false)?;
+    Ok(Fitted {
+        result,
+        detection,
+        case,
+        measurement,
+    })
+}
+
+/// The fit of `case` to `measurement` with `settings` and the transitions detected in it
+/// (default detection settings), asking `stop` between the fit's branch points
+/// ([`fit_measurement_until`]). The two are independent: both run at once (rayon), the fit's
+/// error first, as when they ran one after the other.
+///
+/// # Errors
+/// The fit's error, else the detection's.
+pub fn fit_and_detect(
+    case: &Case,
+    measurement: &Measurement,
+    settings: &FitSettings,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<(FitResult, Detection), afm::AfmError> {
     let (result, detection) = rayon::join(
-        || fit_measurement(&case, &measurement, &settings),
+        || fit_measurement_until(case, measurement, settings, stop),
         || {
             detect_transitions(
                 &measurement.approach,
@@ -268,10 +288,5 @@ pub fn compute_fit(args: &FitArgs) -> Result<Fitted> {
             )
         },
     );
-    Ok(Fitted {
-        result: result?,
-        detection: detection?,
-        case,
-        measurement,
-    })
+    Ok((result?, detection?))
 }

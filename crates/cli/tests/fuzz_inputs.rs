@@ -1358,20 +1358,21 @@ fn scan_words(input: &FileInput, dir: &Path) -> Vec<String> {
     words
 }
 
-/// The words of `drumroll fit` for `input`: the detection's data and reading options, the
-/// Biolever on mica (the quickest diagrams), the `--fit` list (at most two model parameters,
-/// each a pair of branches per Jacobian) and `--max-evaluations`.
-fn fit_words(input: &FileInput, dir: &Path) -> Vec<String> {
+/// The words of `command` (`detect` or `fit`) reading `input`'s measurement in `dir`: its
+/// data file, `--a0` and how to read the columns, then `more`.
+fn measurement_words(
+    command: &str,
+    input: &FileInput,
+    dir: &Path,
+    more: &[(&str, Option<&str>)],
+) -> Vec<String> {
     let mut words = vec![
-        String::from("fit"),
+        String::from(command),
         format!("--data={}", dir.join("data.csv").display()),
-        String::from("--case=biolever-mica"),
-        format!("--max-evaluations={}", input.fit_evaluations),
     ];
     push_options(
         &mut words,
         &[
-            ("fit", input.fit),
             ("a0", input.a0.as_deref()),
             ("z-unit", input.z_unit),
             ("amplitude-unit", input.amplitude_unit),
@@ -1379,28 +1380,37 @@ fn fit_words(input: &FileInput, dir: &Path) -> Vec<String> {
             ("columns", input.columns),
         ],
     );
+    push_options(&mut words, more);
     words
+}
+
+/// The words of `drumroll fit` for `input`: the measurement as `detect` reads it, the
+/// Biolever on mica (the quickest diagrams), the `--fit` list (at most two model parameters,
+/// each a pair of branches per Jacobian) and `--max-evaluations`.
+fn fit_words(input: &FileInput, dir: &Path) -> Vec<String> {
+    measurement_words(
+        "fit",
+        input,
+        dir,
+        &[
+            ("case", Some("biolever-mica")),
+            ("max-evaluations", Some(&input.fit_evaluations)),
+            ("fit", input.fit),
+        ],
+    )
 }
 
 /// The words of `drumroll detect` for `input`.
 fn detect_words(input: &FileInput, dir: &Path) -> Vec<String> {
-    let mut words = vec![
-        String::from("detect"),
-        format!("--data={}", dir.join("data.csv").display()),
-    ];
-    push_options(
-        &mut words,
+    measurement_words(
+        "detect",
+        input,
+        dir,
         &[
-            ("a0", input.a0.as_deref()),
-            ("z-unit", input.z_unit),
-            ("amplitude-unit", input.amplitude_unit),
-            ("invols", input.invols.as_deref()),
-            ("columns", input.columns),
             ("significance", input.significance.as_deref()),
             ("window", input.window.as_deref()),
         ],
-    );
-    words
+    )
 }
 
 /// `drumroll scan`'s reading and checks on `args`, as its `run` makes them before the first

@@ -23,16 +23,9 @@ fn oscillator(w: f64) -> ImpactOscillator {
     }
 }
 
-/// The grazing curve continued in `(w, A)` from the G1 of a one-parameter branch at `w = 0.8`
-/// over `w` in `[0.5, 1.6]` (through resonance at `w = 1`) lies on the closed form
-/// `A_g(w) = d sqrt((k - w^2)^2 + (c w)^2)` to 1e-10 at every point. Error budget: the
-/// corrector stops at a residual of 1e-12 (gap and rate of order 1), which moves `A` by at
-/// most that over `|dh/dA| = |G| >= 1/3.01` (3e-12); the integration error of the orbit at
-/// tolerances 1e-12 relative over one period is of the same order; 1e-10 leaves a margin of 10.
-/// Both ends are on the range ends, and the requested `w = 1` is a point computed there.
-#[test]
-fn grazing_curve_matches_the_closed_form_through_resonance() {
-    let w0 = 0.8;
+/// The curve problem in `(w, A)` of the oscillator at `w0` and the start of its grazing curve:
+/// the G1 located on the one-parameter branch in the amplitude `A` at `w0`.
+fn first_grazing_at(w0: f64) -> (TwoParameterProblem<ImpactOscillator>, CurveStart) {
     let branch = continue_in_amplitude(&oscillator(w0), 4.0, 400).expect("branch");
     let g1 = branch
         .special_points
@@ -42,6 +35,25 @@ fn grazing_curve_matches_the_closed_form_through_resonance() {
     let mut system = oscillator(w0);
     system.amplitude = g1.parameter;
     let problem = TwoParameterProblem::new(system, w0, 1, Settings::default()).expect("problem");
+    let start = CurveStart {
+        state: g1.state.as_slice().to_vec(),
+        section_time: 0.0,
+        parameter: g1.parameter,
+        second_parameter: w0,
+    };
+    (problem, start)
+}
+
+/// The grazing curve continued in `(w, A)` from the G1 of a one-parameter branch at `w = 0.8`
+/// over `w` in `[0.5, 1.6]` (through resonance at `w = 1`) lies on the closed form
+/// `A_g(w) = d sqrt((k - w^2)^2 + (c w)^2)` to 1e-10 at every point. Error budget: the
+/// corrector stops at a residual of 1e-12 (gap and rate of order 1), which moves `A` by at
+/// most that over `|dh/dA| = |G| >= 1/3.01` (3e-12); the integration error of the orbit at
+/// tolerances 1e-12 relative over one period is of the same order; 1e-10 leaves a margin of 10.
+/// Both ends are on the range ends, and the requested `w = 1` is a point computed there.
+#[test]
+fn grazing_curve_matches_the_closed_form_through_resonance() {
+    let (problem, start) = first_grazing_at(0.8);
     let settings = CurveSettings {
         second_range: (0.5, 1.6),
         targets: vec![1.0],
@@ -52,12 +64,6 @@ fn grazing_curve_matches_the_closed_form_through_resonance() {
             ..NewtonSettings::default()
         },
         ..CurveSettings::default()
-    };
-    let start = CurveStart {
-        state: g1.state.as_slice().to_vec(),
-        section_time: 0.0,
-        parameter: g1.parameter,
-        second_parameter: w0,
     };
     let curve = continue_curve(&problem, CodimOneKind::Grazing, &start, &settings).expect("curve");
     assert_eq!(
@@ -217,16 +223,7 @@ fn fold_curve_of_the_cusp_normal_form_is_exact_and_turns_at_the_cusp() {
 /// keeping the points found, each on the closed form `A_g(w)` to 1e-10 as above.
 #[test]
 fn a_stop_ends_the_curve_with_interrupted_and_keeps_its_points() {
-    let w0 = 0.8;
-    let branch = continue_in_amplitude(&oscillator(w0), 4.0, 400).expect("branch");
-    let g1 = branch
-        .special_points
-        .iter()
-        .find(|s| s.kind == SpecialPointKind::Grazing)
-        .expect("G1 on the one-parameter branch");
-    let mut system = oscillator(w0);
-    system.amplitude = g1.parameter;
-    let problem = TwoParameterProblem::new(system, w0, 1, Settings::default()).expect("problem");
+    let (problem, start) = first_grazing_at(0.8);
     let settings = CurveSettings {
         second_range: (0.5, 1.6),
         max_second_step: 0.02,
@@ -236,12 +233,6 @@ fn a_stop_ends_the_curve_with_interrupted_and_keeps_its_points() {
             ..NewtonSettings::default()
         },
         ..CurveSettings::default()
-    };
-    let start = CurveStart {
-        state: g1.state.as_slice().to_vec(),
-        section_time: 0.0,
-        parameter: g1.parameter,
-        second_parameter: w0,
     };
     let asked = std::cell::Cell::new(0);
     let stop = || {

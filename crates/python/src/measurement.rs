@@ -2,11 +2,11 @@
 //! (`drumroll detect`) and a fit of the model to it (`drumroll fit`), whose dicts are the CLI's
 //! JSON built by the cli crate's own functions (MODEL.md section 13).
 
-use afm::fit::least_squares::{fit_measurement_until, FitParameter, FitSettings};
+use afm::fit::least_squares::{FitParameter, FitSettings};
 use afm::fit::measurement::Measurement as AfmMeasurement;
 use afm::fit::transitions::{detect_transitions, DetectionSettings};
 use drumroll::detect::detect_json;
-use drumroll::fit::fit_json;
+use drumroll::fit::{fit_and_detect, fit_json};
 use drumroll::measurement_args::MeasurementArgs;
 use pyo3::prelude::*;
 use serde_json::Value;
@@ -172,19 +172,7 @@ pub fn fit_case(
     // The fit runs on rayon's threads (its Jacobian's columns), each asking between branch
     // points whether Ctrl-C came.
     let json = without_gil_on_workers(py, |interrupted| {
-        // The fit and the detection are independent: both at once, the fit's error first
-        // (as `drumroll fit`).
-        let (result, detection) = rayon::join(
-            || fit_measurement_until(&resolved.case, measured, &settings, interrupted),
-            || {
-                detect_transitions(
-                    &measured.approach,
-                    measured.a0_nm,
-                    &DetectionSettings::default(),
-                )
-            },
-        );
-        let (result, detection) = (result?, detection?);
+        let (result, detection) = fit_and_detect(&resolved.case, measured, &settings, interrupted)?;
         Ok::<Value, afm::AfmError>(fit_json(&resolved.case.name, measured, &result, &detection))
     })?
     .map_err(afm_to_py_err)?;
