@@ -3,10 +3,11 @@
 //! correlations, the fitted grazing points in data coordinates and their match with the
 //! detected transitions, and the contrast observables at every measured point.
 
+use afm::error::AfmError;
 use afm::fit::least_squares::{fit_measurement_until, FitParameter, FitResult, FitSettings};
 use afm::fit::measurement::Measurement;
 use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings};
-use afm::Case;
+use afm::model::case::Case;
 use anyhow::Result;
 use clap::Args;
 use serde_json::{json, Map, Value};
@@ -277,7 +278,7 @@ pub fn fit_and_detect(
     measurement: &Measurement,
     settings: &FitSettings,
     stop: &(dyn Fn() -> bool + Sync),
-) -> Result<(FitResult, Detection), afm::AfmError> {
+) -> Result<(FitResult, Detection), AfmError> {
     let (result, detection) = rayon::join(
         || fit_measurement_until(case, measurement, settings, stop),
         || {

@@ -2,9 +2,9 @@
 //! fold and period-doubling points of the approach diagram continued from the case's own value
 //! over a range (`afm::map::regime_map`), as curves in the `(p, Z)` and `(p, A/A0)` planes.
 
+use afm::map::regime_map::regime_map_until;
 use afm::{
-    regime_map_until, Case, MapCodim2Point, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings,
-    TappingModel,
+    Case, MapCodim2Point, MapCurve, ParameterAxis, RegimeMap, RegimeMapSettings, TappingModel,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -170,7 +170,7 @@ pub fn compute_map(
 }
 
 /// As [`compute_map`], asking `stop` (from any thread) between the map's steps whether to give
-/// up ([`afm::regime_map_until`]).
+/// up ([`regime_map_until`]).
 pub fn compute_map_until(
     case: &Case,
     axis: ParameterAxis,
