@@ -35,7 +35,9 @@ use serde::Serialize;
 use crate::cantilever::{check_mode, Beam};
 use crate::error::BeamError;
 use crate::fluid::{check_range, Fluid};
-use crate::hydrodynamic::{rectangular_hydrodynamic_function, reynolds_number};
+use crate::hydrodynamic::{
+    rectangular_hydrodynamic_function, reynolds_number, MAX_REYNOLDS, MIN_REYNOLDS,
+};
 use crate::mode_shape::ModeShape;
 
 /// Accepted lengths, um.
@@ -238,7 +240,11 @@ impl RectangularCantilever {
             .collect()
     }
 
-    /// The fixed point of mode `index`'s frequency in `fluid`, and its mode shape there.
+    /// The fixed point of mode `index`'s frequency in `fluid`, and its mode shape there. The
+    /// iteration starts at the vacuum frequency, whose Reynolds number exceeds the fluid's
+    /// `Re_n` by `sqrt(1 + T Gamma_r)`; so an iterate evaluates `Gamma` at its `Re` clamped into
+    /// Sader's fit, and only the converged `Re_n` must lie in the fit's range (MODEL.md
+    /// section 11).
     fn solve_mode(
         &self,
         fluid: &Fluid,
@@ -257,7 +263,10 @@ impl RectangularCantilever {
                 angular_frequency,
                 width,
             );
-            let gamma = rectangular_hydrodynamic_function(reynolds, index)?;
+            let gamma = rectangular_hydrodynamic_function(
+                reynolds.clamp(MIN_REYNOLDS, MAX_REYNOLDS),
+                index,
+            )?;
             let added = 1.0 + loading * gamma.re;
             let effective_tip_mass_ratio = self.tip_mass_ratio / added;
             let b = Beam::new(effective_tip_mass_ratio)?.eigenvalue(index)?;

@@ -244,6 +244,68 @@ fn water_modes_follow_sader_equations() {
     assert!(modes[0].frequency_khz < 0.6 * modes[0].vacuum_frequency_khz);
 }
 
+/// A wide beam in water whose modes' Reynolds numbers lie inside Sader's fit, though the
+/// vacuum frequencies' do not (2000 x 1000 x 10 um silicon: `Re` at the vacuum frequency of
+/// mode 2 is `(1 + T Gamma_r)^{1/2}` times its fluid value and above 1e4): the modes are built,
+/// each converged `Re_n` is in the fit's range, and each frequency obeys Sader 1998 Eq. 22 with
+/// `Gamma` at its own `Re_n` (to 1e-12); a thicker beam whose mode 2 converges above 1e4 is
+/// refused naming mode 2 and that converged value.
+#[test]
+fn modes_are_built_where_only_the_vacuum_frequency_leaves_the_fit() {
+    let water = Fluid::water();
+    let wide = |thickness_um: f64| RectangularCantilever {
+        length_um: 2000.0,
+        width_um: 1000.0,
+        thickness_um,
+        ..silicon()
+    };
+    let cantilever = wide(10.0);
+    let modes = cantilever.modes_in_fluid(&water, 2).unwrap();
+    let loading = PI * water.density_kg_m3 * 1000.0 / (4.0 * 2330.0 * 10.0);
+    let vacuum_reynolds = |mode: &beam::FluidMode| {
+        reynolds_number(
+            water.density_kg_m3,
+            water.viscosity_pa_s,
+            2.0 * PI * mode.vacuum_frequency_khz * 1e3,
+            1e-3,
+        )
+    };
+    assert!(
+        vacuum_reynolds(&modes[1]) > 1e4,
+        "{}",
+        vacuum_reynolds(&modes[1])
+    );
+    for mode in &modes {
+        assert!(
+            (1e-6..=1e4).contains(&mode.reynolds_number),
+            "mode {}: Re {}",
+            mode.index,
+            mode.reynolds_number
+        );
+        let w = 2.0 * PI * mode.frequency_khz * 1e3;
+        let reynolds = reynolds_number(water.density_kg_m3, water.viscosity_pa_s, w, 1e-3);
+        let gamma = rectangular_hydrodynamic_function(reynolds, mode.index).unwrap();
+        let predicted = mode.vacuum_frequency_khz / (1.0 + loading * gamma.re).sqrt();
+        assert!((mode.frequency_khz / predicted - 1.0).abs() < 1e-12);
+    }
+    let error = wide(30.0).modes_in_fluid(&water, 2).unwrap_err();
+    match &error {
+        BeamError::ReynoldsOutOfRange { mode, value, .. } => {
+            assert_eq!(*mode, 2);
+            assert!(*value > 1e4, "{value}");
+            // The value reported is the converged mode's, below the vacuum frequency's `Re`
+            // (the textbook `f_2 = (4.6941^2 / 2 pi) sqrt(E I / (rho_c b h L^4))`).
+            let (e, rho_c, b, h, l): (f64, f64, f64, f64, f64) = (169e9, 2330.0, 1e-3, 30e-6, 2e-3);
+            let inertia = b * h.powi(3) / 12.0;
+            let w_vacuum =
+                4.694_091_f64.powi(2) * (e * inertia / (rho_c * b * h * l.powi(4))).sqrt();
+            let vacuum = reynolds_number(water.density_kg_m3, water.viscosity_pa_s, w_vacuum, b);
+            assert!(*value < vacuum, "{value} vs {vacuum}");
+        }
+        other => panic!("{other}"),
+    }
+}
+
 /// A tip mass: the loaded beam's mass ratio `mu_eff = mu / (1 + T Gamma_r)` is smaller than
 /// `mu`, and in a thin gas the fluid modes tend to the vacuum table at `mu`.
 #[test]
