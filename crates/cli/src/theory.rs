@@ -93,8 +93,9 @@ fn orbit(
 }
 
 /// The warnings of a comparison: every assumption of the theory that the orbit violates
-/// ([`afm::AssumptionFailure`], in words), and a contact law that acts outside contact (DMT, a
-/// double layer: Eqs. 3-4 assume force-free flight between impacts; MODEL.md section 9);
+/// ([`afm::AssumptionFailure`], in words), and a force that acts outside contact (DMT, a
+/// double layer, a hydration force; JKR's neck and the meniscus, attached beyond `d = 0` up to
+/// their release gap: Eqs. 3-4 assume force-free flight between impacts; MODEL.md section 9);
 /// printed on stderr, in the table and in the JSON's `warnings`.
 pub fn warnings(model: &TappingModel, comparison: &TheoryComparison) -> Vec<String> {
     let mut warnings: Vec<String> = comparison
@@ -102,13 +103,23 @@ pub fn warnings(model: &TappingModel, comparison: &TheoryComparison) -> Vec<Stri
         .iter()
         .map(ToString::to_string)
         .collect();
-    if model.contact_force().acts_outside_contact() {
+    let force = model.contact_force();
+    if force.acts_outside_contact() {
         warnings.push(
-            "the sample's contact law acts outside contact (van der Waals or double layer): \
+            "the sample's force acts outside contact (van der Waals, double layer or hydration): \
              Eqs. 3-4 assume short impacts and force-free flight between them and do not apply \
              (MODEL.md section 9); computed anyway"
                 .to_string(),
         );
+    }
+    if let Some(release) = force.release_gap_nm() {
+        warnings.push(format!(
+            "the sample's contact stays attached after the tip leaves d = 0, pulling until the \
+             release gap {} nm (JKR's pull-off or the meniscus's rupture): Eqs. 3-4 assume \
+             force-free flight between impacts and hold only as far as that pull is small \
+             (MODEL.md section 9); computed anyway",
+            afm::validation::format_number(release)
+        ));
     }
     warnings
 }

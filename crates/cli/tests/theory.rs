@@ -254,3 +254,49 @@ fn where_the_assumptions_fail_no_number_looks_valid() {
     let deep = json_of(&["theory", "--case", "biolever-mica", "--z", "-5"]);
     assert!(deep["simulated"]["ringing"]["effective_decay_time_us"].is_null());
 }
+
+/// Eqs. 3-4 assume force-free flight between impacts: the theory warns where the sample pulls
+/// beyond `d = 0`, whether by a force outside contact (the hydration force) or by a contact
+/// that stays attached up to its release gap (JKR's pull-off gap, named in nm), and not for
+/// Hertz.
+#[test]
+fn forces_beyond_contact_are_warned_of() {
+    let warnings = |case: &str| -> Vec<String> {
+        let theory = json_of(&["theory", "--case", case, "--amplitude-ratio", "0.9"]);
+        theory["warnings"]
+            .as_array()
+            .expect("warnings")
+            .iter()
+            .map(|w| w.as_str().expect("text").to_string())
+            .collect()
+    };
+    let outside = warnings("biolever-mica-hydration");
+    assert!(
+        outside
+            .iter()
+            .any(|w| w.contains("acts outside contact") && w.contains("hydration")),
+        "{outside:?}"
+    );
+    // JKR's pull-off gap `d_po = (3/4) (pi^2 W^2 R / E*^2)^{1/3}` (MODEL.md section 9) for
+    // `adhesive-soft` (W = 0.5 mJ/m^2 = 5e-4 nN/nm, E = 1 GPa, nu = 0.3) under the Biolever's tip
+    // (R = 30 nm, 130 GPa, nu = 0.3): `1/E* = 0.91/1 + 0.91/130` per GPa.
+    let reduced: f64 = 1.0 / (0.91 / 1.0 + 0.91 / 130.0);
+    let pull_off =
+        0.75 * (std::f64::consts::PI.powi(2) * 5e-4f64.powi(2) * 30.0 / reduced.powi(2)).cbrt();
+    let attached = warnings("biolever-adhesive");
+    let gap: f64 = attached
+        .iter()
+        .find(|w| w.contains("stays attached"))
+        .and_then(|w| w.split("release gap ").nth(1))
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|number| number.parse().ok())
+        .unwrap_or_else(|| panic!("no release gap in {attached:?}"));
+    assert!((gap - pull_off).abs() < 1e-9, "{gap} vs {pull_off}");
+    let hertz = warnings("biolever-mica");
+    assert!(
+        hertz
+            .iter()
+            .all(|w| !w.contains("outside contact") && !w.contains("attached")),
+        "{hertz:?}"
+    );
+}
