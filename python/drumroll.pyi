@@ -224,7 +224,8 @@ class Orbit:
     virial_ev: float
     """The virial (1/T) int F_ts w dt, eV."""
     max_indentation_nm: float
-    """Largest indentation of the law's contact geometry over the orbit, nm."""
+    """Largest indentation over the orbit, nm: the depth below the contact surface (a standard
+    linear solid's below its unrecovered surface; MODEL.md section 10)."""
     mean_indentation_nm: float
     """Mean indentation over the time in contact, nm."""
     energy_balance_residual: float

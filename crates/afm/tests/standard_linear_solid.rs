@@ -47,7 +47,8 @@ fn dashpot_rate(model: &TappingModel, gap: f64, rho: f64) -> f64 {
 /// trapezoidal lock-in's below 1e-9). The energy the tip puts into the sample per period,
 /// `-int F_ts w' dt`, and the dashpot's loss `int D dt`, both by the trapezoidal rule on the
 /// brute-force grid, agree with `dissipated_ev` to 1e-5 relative (the grid's second-order error
-/// at the contacts' kinks of `D'`); the energy balance closes to 1e-9.
+/// at the contacts' kinks of `D'`); the energy balance closes to 1e-9; the largest and the mean
+/// indentation below the unrecovered surface agree with the grid's.
 #[test]
 fn orbit_and_dissipation_match_the_brute_force() {
     let z = 8.5;
@@ -106,6 +107,35 @@ fn orbit_and_dissipation_match_the_brute_force() {
         "residual {:e}",
         o.energy_balance_residual
     );
+    // The indentation below the unrecovered surface, `s = -h_0 = -(d + rho^{2/3})` (MODEL.md
+    // section 10), on the brute-force grid: its largest value (the grid's error about
+    // `s'' h^2 / 8`, 1e-6 nm) and its mean over the time in contact (trapezoidal), to 1e-5 and
+    // 1e-4 relative.
+    let depth = |x: &[f64]| -(model.gap(0.0, x) + x[4].powf(2.0 / 3.0));
+    let depths: Vec<f64> = last.states.iter().map(|x| depth(x)).collect();
+    let deepest = depths.iter().copied().fold(0.0, f64::max);
+    assert!(
+        (deepest - o.max_indentation_nm).abs() < 1e-5 * o.max_indentation_nm,
+        "deepest {deepest} vs max_indentation_nm {}",
+        o.max_indentation_nm
+    );
+    let (mut indented, mut in_contact) = (0.0, 0.0);
+    for pair in depths.windows(2) {
+        indented += 0.5 * h * (pair[0].max(0.0) + pair[1].max(0.0));
+        in_contact += match (pair[0] > 0.0, pair[1] > 0.0) {
+            (true, true) => h,
+            (false, false) => 0.0,
+            // The crossing by linear interpolation.
+            _ => h * pair[0].max(pair[1]) / (pair[0] - pair[1]).abs(),
+        };
+    }
+    let mean = indented / in_contact;
+    assert!(
+        (mean - o.mean_indentation_nm).abs() < 1e-4 * mean,
+        "mean {mean} vs mean_indentation_nm {}",
+        o.mean_indentation_nm
+    );
+    assert!(o.mean_indentation_nm < o.max_indentation_nm);
 }
 
 /// G2 (the second impact's onset, on the unrecovered surface) from the diagram against the

@@ -77,7 +77,7 @@ impl CapillaryContact {
 
 /// The Kelvin radius `r_K = gamma V_m / (R_g T ln(1/RH))`, nm, for surface tension `gamma`
 /// (mN/m), temperature `T` (K), molar volume `V_m` (m^3/mol) and relative humidity `RH`
-/// (Israelachvili 2011, Eq. 17.19; 0.53 nm / ln(1/RH) for water at 20 C).
+/// (Israelachvili 2011, Eq. 17.19; 0.54 nm / ln(1/RH) for water at 20 C).
 pub fn kelvin_radius_nm(
     relative_humidity: f64,
     surface_tension_mn_per_m: f64,

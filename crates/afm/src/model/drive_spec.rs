@@ -106,13 +106,31 @@ impl DriveSpec {
 }
 
 /// The ratio `f_b / f = p / q` of a bimodal drive, or the error naming `file`, the field
-/// `drive.second_frequency_khz` and the nearest commensurate frequencies.
+/// `drive.second_frequency_khz` and the nearest commensurate frequencies. The ratio 1/1 is
+/// refused too: a second drive at the first's frequency is one drive of another amplitude, and
+/// neither `A0` nor `A0_b` would be the free amplitude at its frequency (MODEL.md section 14).
 pub fn bimodal_ratio(
     file: &str,
     drive_frequency_khz: f64,
     second_frequency_khz: f64,
 ) -> Result<Ratio, AfmError> {
     let ratio = second_frequency_khz / drive_frequency_khz;
+    if let Some(Ratio {
+        numerator: 1,
+        denominator: 1,
+    }) = commensurate_ratio(ratio)
+    {
+        return Err(invalid(
+            file,
+            "drive.second_frequency_khz",
+            second_frequency_khz,
+            format!(
+                "a frequency other than the drive's {} kHz (the same frequency is one drive: \
+                 set free_amplitude_nm to the sum instead)",
+                crate::validation::format_number(drive_frequency_khz)
+            ),
+        ));
+    }
     commensurate_ratio(ratio).ok_or_else(|| {
         let choices: Vec<String> = nearest_ratios(ratio, 3)
             .iter()

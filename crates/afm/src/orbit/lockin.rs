@@ -67,7 +67,8 @@ pub struct CycleLockIn {
     /// `[int u cos(n w t) dt, int u sin(n w t) dt]`, `n = 1..=harmonic_count`.
     fourier: [[f64; 2]; MAX_LOCKIN_HARMONICS],
     harmonic_count: usize,
-    /// `int F_ts w' dt` over the cycle, nN nm.
+    /// `int F_ts (w' + y_base') dt` over the cycle, nN nm (`y_base' = 0` but under an acoustic
+    /// drive).
     contact_work: f64,
     impacts: usize,
     peak_force: f64,
@@ -209,10 +210,11 @@ impl CycleLockIn {
                 coefficient[1] += node.weight * u * sin_k;
                 (sin_k, cos_k) = (sin_k * cos + cos_k * sin, cos_k * cos - sin_k * sin);
             }
+            // `w' + y_base'`: the gap's rate less the ramp's (MODEL.md sections 10 and 14).
             let deflection_rate: f64 = state.chunks_exact(2).map(|mode| mode[1]).sum();
             self.contact_work += node.weight
                 * model.tip_sample_force_in_mode(self.mode, node.t, state)
-                * deflection_rate;
+                * (deflection_rate + model.base_velocity(node.t));
         }
     }
 

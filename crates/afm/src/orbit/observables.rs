@@ -187,10 +187,11 @@ pub struct OrbitObservables {
     pub base_work_ev: f64,
     /// The virial `V_ts = (1/(k T)) int F_ts w dt` over the window, eV.
     pub virial_ev: f64,
-    /// The largest indentation `s = d_c - d` of the law's contact geometry in the window, nm
-    /// (0 without contact).
+    /// The largest indentation in the window, nm (0 without contact): the depth `s = -h_0`
+    /// below the contact surface, `d_c - d` in the law's contact geometry, and for a standard
+    /// linear solid `-d - sigma`, below its unrecovered surface (MODEL.md section 10).
     pub max_indentation_nm: f64,
-    /// The mean indentation over the time in contact, `int s dt / t_contact`, nm (0 without
+    /// The mean indentation `s` over the time in contact, `int s dt / t_contact`, nm (0 without
     /// contact).
     pub mean_indentation_nm: f64,
     /// The energy balance's relative residual: the largest `|W_i - D_i - E_i - dE_i|` of the
@@ -514,7 +515,7 @@ impl PeriodObserver {
             self.dashpot_loss +=
                 weight * sls.dissipation_rate(model.gap(t, state), model.sample_state(state));
         }
-        self.indentation += weight * (self.contact_gap - model.gap(t, state)).max(0.0);
+        self.indentation += weight * (-model.switching(GAP_SURFACE, t, state)).max(0.0);
         let (mut sin_k, mut cos_k) = (sin, cos);
         for coefficient in self.fourier.iter_mut() {
             coefficient[0] += weight * u * cos_k;
@@ -575,16 +576,19 @@ impl PeriodObserver {
         } else {
             0.0
         };
-        // The deepest point: a gap minimum below the contact surface, or a window end in
-        // contact (the minima are recorded as `d`; the ends as `d`).
+        // The deepest point below the contact surface `h_0 = 0`: a gap minimum (recorded as
+        // `h_0 + d_c`), or a window end in contact.
         let max_indentation_nm = gap_minima
             .iter()
             .map(|minimum| self.contact_gap - minimum.gap_nm)
             .chain(
-                [self.gap_at_start, self.gap_at_end]
-                    .into_iter()
-                    .filter(|gap| gap.is_finite())
-                    .map(|gap| self.contact_gap - gap),
+                [
+                    (self.gap_at_start, self.start, &self.start_state),
+                    (self.gap_at_end, self.end, &self.end_state),
+                ]
+                .into_iter()
+                .filter(|(gap, _, _)| gap.is_finite())
+                .map(|(_, t, x)| -model.switching(GAP_SURFACE, t, x)),
             )
             .fold(0.0, f64::max);
         let contact_time_us = contact_time_periods * k * self.period;
@@ -645,9 +649,11 @@ impl PeriodObserver {
         }
     }
 
-    /// A standard linear solid's balance `E_ts = D_s + dU_s` per drive period (MODEL.md
-    /// section 10): the work on the sample `-sum_i int F_ts q_i' dt - Z' int F_ts dt` against
-    /// the dashpot's loss and the change of the sample's stored energy, eV (0 for other laws).
+    /// A standard linear solid's balance `W_s = D_s + dU_s` per drive period (MODEL.md
+    /// section 10): the work done on the sample along the whole gap, `W_s = -int F_ts d' dt =
+    /// -sum_i int F_ts q_i' dt - int F_ts y_base' dt - Z' int F_ts dt`, against the dashpot's
+    /// loss and the change of the sample's stored energy (both functions of the gap `d`), eV
+    /// (0 for other laws).
     fn sample_residual_ev(&self, model: &TappingModel, mode_energy: &[ModeEnergy]) -> f64 {
         let Some(sls) = &self.relaxing else {
             return 0.0;
@@ -658,7 +664,7 @@ impl PeriodObserver {
             .iter()
             .map(|mode| mode.dissipated_share_ev)
             .sum::<f64>()
-            - per_period * model.separation().rate() * self.impulse;
+            - per_period * (self.base_work + model.separation().rate() * self.impulse);
         let stored = |t: f64, x: &[f64]| sls.stored_energy(model.gap(t, x), model.sample_state(x));
         let change = stored(self.end, &self.end_state) - stored(self.start, &self.start_state);
         (work - per_period * (self.dashpot_loss + change)).abs()
