@@ -7,7 +7,9 @@
 use afm::fit::followed_branch::FollowedBranch;
 use afm::fit::measurement::MeasuredPoint;
 use afm::fit::synthetic::{model_branch, synthetic_approach, SyntheticInstrument};
-use afm::fit::transitions::{detect_transitions, DetectionSettings, LONG_WINDOW_FACTOR};
+use afm::fit::transitions::{
+    detect_transitions, DetectionSettings, TransitionKind, LONG_WINDOW_FACTOR,
+};
 use afm::fit::window_models::KINK_ROUNDING;
 use afm::{builtin_case, TappingModel};
 
@@ -61,6 +63,61 @@ fn detection_counts(case: &str, seeds: std::ops::Range<u64>) -> Vec<(String, usi
         }
     }
     counts
+}
+
+/// A straight approach curve (1000 rows, Z from 20 to 0 nm every 0.02 nm; A/A0 = 0.5 + 0.02 Z
+/// and the phase 60 + 1.5 Z deg) with a jump between two rows at Z = 10.01 nm, and white
+/// Gaussian noise of 0.3% of A0 and 0.2 deg (a seeded Box-Muller): for jumps of A/A0 by 0.01 to
+/// 0.2 (3 to 67 noise levels; the strongest have T far beyond 1489, where `exp(-T/2)` underflows
+/// to zero for both alternatives) and of the phase by as many tenths of the noise, exactly one
+/// transition, a jump, between the two rows (its Z the gap's middle, its sigma the gap over
+/// sqrt(12)).
+#[test]
+fn jumps_are_found_as_jumps_at_their_gap_however_strong() {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    let mut gaussian = move || {
+        let (u, v) = (uniform(), uniform());
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+    };
+    let a0 = 10.0;
+    for jump in [0.01, 0.03, 0.1, 0.2] {
+        let points: Vec<MeasuredPoint> = (0..1000)
+            .map(|row| {
+                let z = 20.0 - 0.02 * row as f64;
+                let below = if z < 10.01 { 1.0 } else { 0.0 };
+                MeasuredPoint {
+                    line: row + 1,
+                    z_nm: z,
+                    amplitude_nm: a0 * (0.5 + 0.02 * z - jump * below + 0.003 * gaussian()),
+                    phase_deg: 60.0 + 1.5 * z + 20.0 * jump * below + 0.2 * gaussian(),
+                }
+            })
+            .collect();
+        let detection = detect_transitions(&points, a0, &DetectionSettings::default()).unwrap();
+        let found: Vec<(f64, TransitionKind)> = detection
+            .transitions
+            .iter()
+            .map(|t| (t.z_nm, t.kind))
+            .collect();
+        assert_eq!(found.len(), 1, "jump {jump}: {found:?}");
+        let transition = &detection.transitions[0];
+        assert_eq!(
+            transition.kind,
+            TransitionKind::Jump,
+            "jump {jump}: {found:?}"
+        );
+        assert!(
+            (transition.z_nm - 10.01).abs() < 1e-9,
+            "jump {jump}: {found:?}"
+        );
+        assert!((transition.z_uncertainty_nm - 0.02 / 12f64.sqrt()).abs() < 1e-12);
+    }
 }
 
 /// The criterion on the paper's experiment: G2 (A/A0 = 0.55) found within 3 of its

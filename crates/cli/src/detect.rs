@@ -2,7 +2,7 @@
 //! Z, 1-sigma uncertainty, A/A0, phase and significance (MODEL.md section 13.2).
 
 use afm::fit::measurement::Measurement;
-use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings};
+use afm::fit::transitions::{detect_transitions, Detection, DetectionSettings, MIN_HALF_WINDOW};
 use afm::validation::Interval;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -25,7 +25,7 @@ pub struct DetectArgs {
     /// Family-wise false-alarm probability on a smooth curve, in (0, 0.5].
     #[arg(long, default_value_t = 0.01)]
     pub significance: f64,
-    /// Rows on each side of a test window (0: n/25 clamped to 12..80), 0 or at least 6.
+    /// Rows on each side of a test window (0: n/25 clamped to 12..80), 0 or at least 12.
     #[arg(long, default_value_t = 0)]
     pub window: usize,
     /// Print JSON instead of the table.
@@ -57,13 +57,13 @@ pub const MAX_WINDOW: usize = 100_000;
 /// option and its allowed range).
 ///
 /// # Errors
-/// A significance outside `(0, 0.5]`, a window from 1 to 5 or above [`MAX_WINDOW`].
+/// A significance outside `(0, 0.5]`, a window from 1 to 11 or above [`MAX_WINDOW`].
 pub fn detection_settings(args: &DetectArgs) -> Result<DetectionSettings> {
     OptionRange::new("--significance", Interval::left_open(0.0, 0.5, ""))
         .check(args.significance)?;
-    if args.window != 0 && !(6..=MAX_WINDOW).contains(&args.window) {
+    if args.window != 0 && !(MIN_HALF_WINDOW..=MAX_WINDOW).contains(&args.window) {
         bail!(
-            "--window {}: allowed: 0 (automatic) or 6 to {MAX_WINDOW} rows",
+            "--window {}: allowed: 0 (automatic) or {MIN_HALF_WINDOW} to {MAX_WINDOW} rows",
             args.window
         );
     }

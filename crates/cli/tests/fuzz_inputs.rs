@@ -1716,7 +1716,7 @@ fn inputs_found_by_the_fuzzer_are_named_or_accepted() {
         ],
     );
     assert!(
-        !ok && stderr.contains("--window") && stderr.contains("6 to 100000"),
+        !ok && stderr.contains("--window") && stderr.contains("12 to 100000"),
         "{stderr}"
     );
     // A byte-order mark before the header is skipped (was "missing column z_nm").

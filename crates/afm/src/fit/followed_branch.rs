@@ -14,7 +14,8 @@ use crate::diagram::bifurcation_diagram::{BifurcationDiagram, DiagramPoint};
 struct Piece {
     indices: Vec<usize>,
     /// For each interval `(indices[j], indices[j + 1])`: whether no special point of the diagram
-    /// lies on it (its ends included), so that the observables are smooth there.
+    /// lies strictly inside it (a special point at an end is that point's `corner`), so that
+    /// the observables are smooth there.
     smooth: Vec<bool>,
     /// For each point: whether a special point sits on it (a corner: the slope jumps there).
     corner: Vec<bool>,

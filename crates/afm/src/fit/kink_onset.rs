@@ -29,9 +29,10 @@ const PROFILE_MARGIN: usize = 6;
 /// the rounding width ([`KINK_PROFILE_ROUNDING`]), profiled over the onset `c` on a 200-step
 /// grid across the window (all but [`PROFILE_MARGIN`] rows at each end); if the minimum falls
 /// in the outer quarter of that range the window is re-centred on it and the profile repeated
-/// (at most 4 times), so that the scan's candidate, which maximises the statistic rather than
-/// locating the onset, never truncates the profile. The onset is the minimum, the uncertainty
-/// the half width of the set where `chi^2 <= min + 1` (profile likelihood).
+/// (4 profiles at most), so that the scan's candidate, which maximises the statistic rather than
+/// locating the onset, never truncates the profile. The onset is the minimum; the uncertainty
+/// the largest of the half width of the set where `chi^2 <= min + 1` (profile likelihood), one
+/// grid step, and the parametric bootstrap's spread ([`bootstrap_spread`]).
 pub(crate) fn kink_onset(signals: &Signals, g: usize, scale: Scale) -> (f64, f64) {
     let (w, degree) = (scale.half_window, scale.degree);
     let n = signals.z.len();

@@ -199,7 +199,8 @@ pub struct FittedPoint {
     pub phase_deg: f64,
     /// drumroll's separation `Z = z_nm - z_offset`, nm.
     pub separation_nm: f64,
-    /// The model's amplitude as the instrument reports it (`A/A0` times the measured `A0`), nm.
+    /// The model's amplitude as the instrument reports it (`A/A0` times the fitted reported
+    /// `A0`, `c A0`), nm.
     pub model_amplitude_nm: f64,
     /// The model's phase plus the offset, degrees.
     pub model_phase_deg: f64,

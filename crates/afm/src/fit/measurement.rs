@@ -551,7 +551,7 @@ fn keep_strict(
 
 /// The standard deviation of white noise on a smooth sampled signal, from its second
 /// differences: `1.4826 MAD(y_{i-1} - 2 y_i + y_{i+1}) / sqrt(6)` (robust to kinks and jumps;
-/// MODEL.md section 13.2).
+/// MODEL.md section 13.1).
 pub fn noise_sigma(values: &[f64]) -> f64 {
     if values.len() < 3 {
         return 0.0;
@@ -596,7 +596,6 @@ fn free_amplitude(approach: &[MeasuredPoint]) -> Option<(f64, f64, usize)> {
     if count < MIN_FREE_ROWS || reference <= 0.0 {
         return None;
     }
-    // The top rows must be free: their amplitude must not trend by more than the tolerance.
     let mean = amplitudes[..count].iter().sum::<f64>() / count as f64;
     Some((mean, sigma / (count as f64).sqrt(), count))
 }

@@ -59,12 +59,12 @@ impl DetectionSettings {
                 allowed: String::from("(0, 0.5]: the false-alarm probability per curve"),
             });
         }
-        if self.half_window != 0 && self.half_window < 6 {
+        if self.half_window != 0 && self.half_window < MIN_HALF_WINDOW {
             return Err(AfmError::InvalidField {
                 file: source.to_string(),
                 field: String::from("window"),
                 value: self.half_window.to_string(),
-                allowed: String::from("0 (automatic) or at least 6 rows"),
+                allowed: format!("0 (automatic) or at least {MIN_HALF_WINDOW} rows"),
             });
         }
         Ok(())
@@ -95,8 +95,9 @@ pub enum TransitionKind {
 pub struct Transition {
     /// Its `Z` in data coordinates, nm.
     pub z_nm: f64,
-    /// 1-sigma uncertainty of `z_nm`, nm (kink: the `Delta chi^2 = 1` profile interval's half
-    /// width; jump: the gap between the rows over `sqrt(12)`).
+    /// 1-sigma uncertainty of `z_nm`, nm (kink: the larger of the `Delta chi^2 = 1` profile
+    /// interval's half width, with one grid step as a floor, and the parametric bootstrap's
+    /// spread; jump: the gap between the rows over `sqrt(12)`).
     pub z_uncertainty_nm: f64,
     /// Measured `A/A0` there (the curve's smooth fit at `z_nm`, upper side).
     pub amplitude_ratio: f64,
@@ -139,9 +140,14 @@ pub struct Detection {
 /// section 13.2).
 pub const LONG_WINDOW_FACTOR: usize = 3;
 
+/// The fewest rows on each side of a test window (the automatic window's lower clamp): a
+/// kink's onset is profiled over all but 6 rows at each end of its `2 w` rows (MODEL.md
+/// section 13.2), which leaves a grid only where `w` is well above 6.
+pub const MIN_HALF_WINDOW: usize = 12;
+
 /// The statistic at candidate gap `g` (between rows `g` and `g + 1`) on `scale`: the larger of
-/// the kink's (maximised over [`KINK_ROUNDING`]) and the jump's, its kind and its single-test
-/// tail probability.
+/// the kink's (maximised over [`KINK_ROUNDING`]) and the jump's (the one with the smaller tail
+/// probability), its kind and the natural logarithm of its single-test tail probability.
 fn candidate_score(signals: &Signals, g: usize, scale: Scale) -> (f64, TransitionKind, f64) {
     let w = scale.half_window;
     let c = 0.5 * (signals.z[g] + signals.z[g + 1]);
@@ -159,12 +165,14 @@ fn candidate_score(signals: &Signals, g: usize, scale: Scale) -> (f64, Transitio
         .map(|&epsilon| drop(Extra::Hinge(epsilon)))
         .fold(f64::NEG_INFINITY, f64::max);
     let jump = drop(Extra::Step);
-    let kink_tail = (-0.5 * kink).exp() * (1.0 + 0.5 * kink);
-    let jump_tail = (-0.5 * jump).exp();
-    if jump_tail < kink_tail {
-        (jump, TransitionKind::Jump, jump_tail)
+    // The tails' logarithms: `exp(-T/2)` underflows to 0 beyond T = 1489, where a strong jump
+    // and its kink alternative would tie.
+    let kink_log_tail = -0.5 * kink + (0.5 * kink).ln_1p();
+    let jump_log_tail = -0.5 * jump;
+    if jump_log_tail < kink_log_tail {
+        (jump, TransitionKind::Jump, jump_log_tail)
     } else {
-        (kink, TransitionKind::Kink, kink_tail)
+        (kink, TransitionKind::Kink, kink_log_tail)
     }
 }
 
@@ -186,7 +194,7 @@ pub fn detect_transitions(
     sorted.sort_by(|a, b| b.z_nm.total_cmp(&a.z_nm));
     let n = sorted.len();
     let w = if settings.half_window == 0 {
-        (n / 25).clamp(12, 80)
+        (n / 25).clamp(MIN_HALF_WINDOW, 80)
     } else {
         settings.half_window
     };
@@ -243,7 +251,7 @@ pub fn detect_transitions(
         // chosen one of its scale (within 2 w rows) is that one's shadow, and a longer scale
         // adds only what lies 2 of its windows away from every transition already found.
         let mut order: Vec<usize> = (0..candidates.len())
-            .filter(|&k| tests as f64 * scores[k].2 < settings.significance)
+            .filter(|&k| (tests as f64).ln() + scores[k].2 < settings.significance.ln())
             .collect();
         order.sort_by(|&a, &b| scores[a].2.total_cmp(&scores[b].2));
         let before = chosen.len();
@@ -263,7 +271,7 @@ pub fn detect_transitions(
     // Each transition's onset and values in parallel (rayon), collected in order.
     let mut transitions: Vec<Transition> = chosen
         .into_par_iter()
-        .map(|(g, scale, score, kind, tail)| {
+        .map(|(g, scale, score, kind, log_tail)| {
             let w = scale.half_window;
             let range = g + 1 - w..g + w + 1;
             let (z_nm, z_uncertainty_nm) = match kind {
@@ -280,7 +288,7 @@ pub fn detect_transitions(
                 amplitude_ratio: ratio,
                 phase_deg: phase,
                 kind,
-                significance: (tests as f64 * tail).min(1.0),
+                significance: ((tests as f64).ln() + log_tail).exp().min(1.0),
                 statistic: score,
                 half_window: w,
             }
