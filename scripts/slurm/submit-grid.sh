@@ -58,7 +58,7 @@ parts_dir=$(cd "$parts_dir" && pwd)
 array_job=$(sbatch --parsable "${wait[@]}" "${sbatch_options[@]}" \
     --array="0-$((tasks - 1))" \
     --output="${parts_dir}/slurm-%A_%a.out" \
-    "${script_dir}/grid-array.sbatch" "$parts_dir" "$@")
+    "${script_dir}/grid-array.sbatch" "$tasks" "$parts_dir" "$@")
 array_job=${array_job%%;*}
 echo "grid shards: job array ${array_job} (${tasks} tasks, parts in ${parts_dir})"
 

@@ -4,7 +4,8 @@
 # this host (its hostname, its `nproc` CPUs, proctrack/linuxproc, task/none), starts munged,
 # slurmctld and slurmd, submits a grid as a job array with scripts/slurm/submit-grid.sh --wait
 # (then its dependent merge), and checks that the merged map equals a single-process
-# `drumroll grid` byte for byte (cmp). Stops the daemons it started, whatever happens.
+# `drumroll grid` byte for byte (cmp), and again after one task's part file is deleted and the
+# task resubmitted alone, as docs/guide/grid.md tells. Stops the daemons it started, whatever happens.
 #
 #   bash scripts/slurm/test-cluster.sh        # exit status 0: the maps are identical
 #
@@ -137,4 +138,11 @@ bash "$repo/scripts/slurm/submit-grid.sh" --tasks 4 --output "$work/map.jsonl" -
 echo "array and merge: $(($(date +%s) - started_at)) s"
 "$DRUMROLL" grid "${grid[@]}" --output "$work/single.jsonl"
 cmp "$work/map.jsonl" "$work/single.jsonl"
-echo "test-cluster.sh: the Slurm map ($(wc -l <"$work/map.jsonl") lines, 4 array tasks) equals the single-process map byte for byte"
+# The documented recovery of a failed task: its part file lost, the task resubmitted alone
+# (`--array=2`, the shard count given), then the merge again.
+rm "$work/map.jsonl.parts/part-2.jsonl"
+sbatch --wait --array=2 --output="$work/map.jsonl.parts/slurm-again-%A_%a.out" \
+    "$repo/scripts/slurm/grid-array.sbatch" 4 "$work/map.jsonl.parts" "${grid[@]}" >/dev/null
+"$DRUMROLL" grid merge "$work"/map.jsonl.parts/part-{0,1,2,3}.jsonl --output "$work/again.jsonl"
+cmp "$work/again.jsonl" "$work/single.jsonl"
+echo "test-cluster.sh: the Slurm map ($(wc -l <"$work/map.jsonl") lines, 4 array tasks, task 2 resubmitted alone) equals the single-process map byte for byte"
