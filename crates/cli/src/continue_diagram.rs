@@ -163,7 +163,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     continue_cases(args, &models, |done, (case, model), continued| {
         progress.update(done as u64 + 1, || case.name.clone());
         if let Some(warning) = &continued.warning {
-            eprintln!("warning: {warning}");
+            crate::output::print_stderr(&format!("warning: {warning}"));
         }
         print_report(args, case, model, &continued)?;
         if let Some(path) = &csv_path {

@@ -151,7 +151,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
     } = compute_fit(args)?;
     let object = fit_json(&case.name, &measurement, &result, &detection);
     for warning in &result.warnings {
-        eprintln!("drumroll: warning: {warning}");
+        crate::output::print_stderr(&format!("drumroll: warning: {warning}"));
     }
     let points = object["points"].as_array().cloned().unwrap_or_default();
     if let Some(path) = &args.csv {

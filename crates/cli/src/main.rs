@@ -103,12 +103,12 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             if let Some(incomplete) = error.downcast_ref::<drumroll::exit_status::Incomplete>() {
-                eprintln!("drumroll: {incomplete}");
+                drumroll::output::print_stderr(&format!("drumroll: {incomplete}"));
                 return ExitCode::from(drumroll::exit_status::INCOMPLETE);
             }
-            eprintln!("drumroll: error: {error}");
+            drumroll::output::print_stderr(&format!("drumroll: error: {error}"));
             for cause in distinct_causes(&error) {
-                eprintln!("  caused by: {cause}");
+                drumroll::output::print_stderr(&format!("  caused by: {cause}"));
             }
             ExitCode::FAILURE
         }

@@ -62,7 +62,7 @@ impl MeasurementArgs {
     pub fn read(&self, a0_nm: Option<f64>) -> Result<Measurement> {
         let measurement = Measurement::from_file(&self.data, &self.options(a0_nm)?)?;
         for bad in measurement.bad_rows.iter().take(20) {
-            eprintln!(
+            crate::output::print_stderr(&format!(
                 "drumroll: warning: {} line {}{}: {}; row left out",
                 self.data,
                 bad.line,
@@ -70,14 +70,14 @@ impl MeasurementArgs {
                     .as_ref()
                     .map_or_else(String::new, |c| format!(" column `{c}`")),
                 bad.reason
-            );
+            ));
         }
         if measurement.bad_rows.len() > 20 {
-            eprintln!(
+            crate::output::print_stderr(&format!(
                 "drumroll: warning: {}: {} more bad rows (all listed in the JSON's bad_rows)",
                 self.data,
                 measurement.bad_rows.len() - 20
-            );
+            ));
         }
         Ok(measurement)
     }

@@ -187,7 +187,7 @@ pub fn apply_overrides(
         option_ranges::drive_frequency_for(&case.cantilever).check(frequency)?;
         case.drive_frequency_khz = Some(frequency);
         if let Some(warning) = case.drive_warning() {
-            eprintln!("drumroll: warning: --drive-frequency {warning}");
+            crate::output::print_stderr(&format!("drumroll: warning: --drive-frequency {warning}"));
         }
     }
     // A case file's bimodal drive may not be commensurate with an overriding frequency: the
@@ -203,7 +203,7 @@ pub fn apply_overrides(
 /// Print each warning on stderr.
 fn warn_all(warnings: Vec<String>) {
     for warning in warnings {
-        eprintln!("drumroll: warning: {warning}");
+        crate::output::print_stderr(&format!("drumroll: warning: {warning}"));
     }
 }
 

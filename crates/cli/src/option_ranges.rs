@@ -127,7 +127,7 @@ impl OptionRange {
     /// the likely unit mistake), a warning on stderr outside the typical range.
     pub fn check(&self, value: f64) -> Result<()> {
         if let Some(warning) = self.warning(value)? {
-            eprintln!("drumroll: warning: {warning}");
+            crate::output::print_stderr(&format!("drumroll: warning: {warning}"));
         }
         Ok(())
     }
@@ -148,7 +148,7 @@ impl OptionRange {
 /// [`OptionRange::check`] does.
 pub fn check_option(option: &str, interval: Interval, value: f64) -> Result<()> {
     if let Some(warning) = option_warning(option, interval, value)? {
-        eprintln!("drumroll: warning: {warning}");
+        crate::output::print_stderr(&format!("drumroll: warning: {warning}"));
     }
     Ok(())
 }

@@ -57,6 +57,15 @@ pub fn print_stdout(text: &str) -> Result<()> {
     }
 }
 
+/// Print `line` and a newline on standard error, ignoring a failure (a closed pipe, a full
+/// disk): a note or a message must never make the program panic, as `eprintln!` would.
+pub fn print_stderr(line: &str) {
+    let mut stderr = std::io::stderr().lock();
+    let _ = stderr
+        .write_all(line.as_bytes())
+        .and_then(|()| stderr.write_all(b"\n"));
+}
+
 /// Write `content` to `path` atomically: into `path` + a temporary suffix in the same
 /// directory, flushed and synced, then renamed to `path`. On any error the temporary file is
 /// removed and the target is left as it was. Every output file of every command is written by

@@ -26,7 +26,7 @@ pub fn quiet() -> bool {
 /// Print a note (a file written, ...) on standard error unless `--quiet`.
 pub fn note(text: &str) {
     if !quiet() {
-        eprintln!("{text}");
+        crate::output::print_stderr(text);
     }
 }
 

@@ -125,7 +125,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let min_gap = orbit.observables().min_gap_nm();
     let orbits = [(orbit.z_nm, min_gap.is_finite().then_some(min_gap))];
     if let Some(warning) = afm::film_range_warning(&model, orbits) {
-        eprintln!("warning: {warning}");
+        crate::output::print_stderr(&format!("warning: {warning}"));
     }
     if args.json {
         let coexisting = coexisting

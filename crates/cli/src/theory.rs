@@ -58,7 +58,7 @@ pub fn run(args: &TheoryArgs) -> Result<()> {
         )
     })?;
     for warning in warnings(&model, &comparison) {
-        eprintln!("drumroll: warning: {warning}");
+        crate::output::print_stderr(&format!("drumroll: warning: {warning}"));
     }
     if args.json {
         let mut object = comparison_json(&case.name, &model, &comparison);

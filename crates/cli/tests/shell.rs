@@ -58,3 +58,27 @@ fn the_manual_has_a_page_per_subcommand() {
     let continue_page = std::fs::read_to_string(pages.join("drumroll-continue.1")).expect("page");
     assert!(continue_page.contains("overlay"));
 }
+
+/// A standard output or error that cannot be written (`/dev/full`: no space left) is an error
+/// with exit status 1 for a command's output and its messages, never a panic (101): the
+/// completion script, the manual page, and an error message itself.
+#[test]
+fn a_full_output_stream_is_an_error_not_a_panic() {
+    let full = || std::fs::File::create("/dev/full").expect("/dev/full");
+    let binary = || std::process::Command::new(env!("CARGO_BIN_EXE_drumroll"));
+    for args in [&["completions", "bash"][..], &["man"][..]] {
+        let output = binary().args(args).stdout(full()).output().expect("runs");
+        assert_eq!(output.status.code(), Some(1), "{args:?}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            stderr.contains("cannot write to standard output"),
+            "{args:?}: {stderr}"
+        );
+    }
+    let output = binary()
+        .args(["simulate", "--case", "no-such-case", "--z", "5"])
+        .stderr(full())
+        .output()
+        .expect("runs");
+    assert_eq!(output.status.code(), Some(1));
+}
