@@ -26,7 +26,7 @@ use crate::orbit::observables::Harmonic;
 use crate::orbit::steady_orbit::SteadyOrbitWorkspace;
 use crate::scan::line::ScanLine;
 use crate::scan::materials::line_models;
-use crate::scan::pixel::{set_measured_heights, ScanDirection, ScanPixel};
+use crate::scan::pixel::{set_heights_from_bases, ScanDirection, ScanPixel};
 use crate::scan::setpoint_branch::SetpointBranch;
 use crate::scan::settings::ScanSettings;
 use crate::sweep::amplitude_ratio::AmplitudeRatioSearch;
@@ -124,7 +124,6 @@ pub fn pi_scan_until(
     let period_us = models[0].period_us();
     let (start, end) = (line.start_nm(), line.end_nm());
     let length = end - start;
-    let pixel_width = length / settings.pixels as f64;
     let travel_per_cycle = pi.scan_rate_nm_per_s * 1e-6 * period_us;
     let cycles = (length / travel_per_cycle).round();
     if cycles < settings.pixels as f64 || cycles > MAX_CYCLE_COUNT as f64 {
@@ -143,10 +142,14 @@ pub fn pi_scan_until(
     let cycles = cycles as usize;
     // The exact travel per cycle, so that the last cycle ends at the line's end.
     let travel = length / cycles as f64;
-    let pixel_of = |x_mid: f64| (((x_mid - start) / pixel_width) as usize).min(settings.pixels - 1);
+    // The pixel holding the middle of the `j`-th cycle counted from the line's start,
+    // `floor((j + 1/2) N / K)`, in integers: a middle on a pixel boundary goes to the same
+    // pixel in the count and in both passes.
+    let pixel_of =
+        |j: usize| ((2 * j + 1) * settings.pixels / (2 * cycles)).min(settings.pixels - 1);
     let mut cycles_in_pixel = vec![0usize; settings.pixels];
-    for k in 0..cycles {
-        cycles_in_pixel[pixel_of(start + (k as f64 + 0.5) * travel)] += 1;
+    for j in 0..cycles {
+        cycles_in_pixel[pixel_of(j)] += 1;
     }
     let centres = line.pixel_centres(settings.pixels);
     let harmonics = settings
@@ -187,7 +190,9 @@ pub fn pi_scan_until(
             ScanDirection::Retrace => end - k as f64 * travel,
         };
         let pass_start = pixels.len();
-        let mut average: Option<(usize, BlockAverage)> = None;
+        // The pixel's block of cycles and the sum of their mean base heights (nm).
+        let mut average: Option<(usize, BlockAverage, f64)> = None;
+        let mut bases = Vec::with_capacity(settings.pixels);
         for k in 0..cycles {
             let (x0, x1) = (x_at(k), x_at(k + 1));
             let x_mid = 0.5 * (x0 + x1);
@@ -215,21 +220,27 @@ pub fn pi_scan_until(
                 &mut workspace,
                 &mut lockins[material],
             )?;
-            let pixel = pixel_of(x_mid);
-            let block = match &mut average {
-                Some((p, block)) if *p == pixel => block,
+            let pixel = pixel_of(match direction {
+                ScanDirection::Trace => k,
+                ScanDirection::Retrace => cycles - 1 - k,
+            });
+            let (block, base_sum) = match &mut average {
+                Some((p, block, base_sum)) if *p == pixel => (block, base_sum),
                 _ => {
-                    average = Some((pixel, BlockAverage::new(cycles_in_pixel[pixel], a0)));
-                    &mut average.as_mut().expect("just set").1
+                    average = Some((pixel, BlockAverage::new(cycles_in_pixel[pixel], a0), 0.0));
+                    let (_, block, base_sum) = average.as_mut().expect("just set");
+                    (block, base_sum)
                 }
             };
+            *base_sum += 0.5 * (base_start + base_end);
             if let Some(done) = block.push(k as u64, 0.5 * (z_start + z_end), &reading) {
                 let x = centres[pixel];
+                bases.push(*base_sum / cycles_in_pixel[pixel] as f64);
                 pixels.push(ScanPixel {
                     index: pixel,
                     x_nm: x,
                     direction,
-                    sample: line.materials[material].name.clone(),
+                    sample: line.materials[line.material_at(x)].name.clone(),
                     height_true_nm: line.height_at(x),
                     height_nm: f64::NAN,
                     height_error_nm: f64::NAN,
@@ -268,7 +279,16 @@ pub fn pi_scan_until(
             base_start = base_end;
             base_end = hold - pi.gain_p * error - pi.gain_i_per_ms * integral;
         }
-        set_measured_heights(&mut pixels[pass_start..]);
+        if pixels.len() - pass_start != settings.pixels {
+            return Err(AfmError::NotReached {
+                what: format!("{} pixels in the PI pass", settings.pixels),
+                reason: format!(
+                    "{} were read: the cycles were not shared out among the pixels",
+                    pixels.len() - pass_start
+                ),
+            });
+        }
+        set_heights_from_bases(&mut pixels[pass_start..], &bases);
     }
     Ok(pixels)
 }

@@ -132,6 +132,26 @@ impl ScanPixel {
     }
 }
 
+/// Set `height_nm = b(x) - b(x_0) + h(x_0)` and its error on every pixel of one pass of the
+/// PI feedback, `b` the base's height averaged over the pixel's cycles (`bases[i]` that of
+/// `pass[i]`, nm), `x_0` the pixel of index 0 of the same pass (MODEL.md section 12): over a
+/// pixel where `h` is constant, `h(x) + Z(x) - Z(x_0)` as [`set_measured_heights`]; over one
+/// straddling a step, the base's mean height, as a recorded image has it.
+pub fn set_heights_from_bases(pass: &mut [ScanPixel], bases: &[f64]) {
+    let Some(reference) = pass
+        .iter()
+        .zip(bases)
+        .find(|(p, _)| p.index == 0)
+        .map(|(p, &b)| b - p.height_true_nm)
+    else {
+        return;
+    };
+    for (pixel, &base) in pass.iter_mut().zip(bases) {
+        pixel.height_nm = base - reference;
+        pixel.height_error_nm = pixel.height_nm - pixel.height_true_nm;
+    }
+}
+
 /// Set `height_nm = h(x) + Z(x) - Z(x_0)` and its error on every pixel of one pass, `x_0`
 /// being the pixel of index 0 (the line's start) of the same pass (MODEL.md section 12).
 pub fn set_measured_heights(pass: &mut [ScanPixel]) {

@@ -224,7 +224,7 @@ impl SetpointBranch {
         let ratio = self.search.ratio;
         let points = &self.diagram.points;
         let mut first_jump: Option<BranchJump> = None;
-        for _ in 0..=MAX_JUMPS {
+        for walk in 0..=MAX_JUMPS {
             let current = entry.orbit.lockin(a0).0;
             if current == ratio {
                 return Ok((entry.orbit, first_jump));
@@ -300,15 +300,56 @@ impl SetpointBranch {
                     end.z_nm, end.amplitude_ratio, self.diagram.stop
                 )));
             }
+            if walk == MAX_JUMPS {
+                break;
+            }
+            // Where the stable part loses its stability: the special point (a fold) the
+            // diagram located on the branch step from its last point to the next, else that
+            // last point. At a fold `Z` is extremal, so both points may lie on one side of the
+            // fold's `Z`: the step's point is told by its state, on the branch between theirs
+            // (the two distances add up to at most 1.5 times the step's).
+            let beyond = &points[if forward { index + 1 } else { index - 1 }];
+            let distance = |a: &[f64], b: &[f64]| {
+                a.iter()
+                    .zip(b)
+                    .map(|(x, y)| (x - y) * (x - y))
+                    .sum::<f64>()
+                    .sqrt()
+            };
+            let chord = distance(&end.state, &beyond.state);
+            let detour = |state: &[f64]| {
+                distance(state, &end.state) + distance(state, &beyond.state) - chord
+            };
+            let (from_z, from_ratio, from_impacts, from_state) = match self
+                .diagram
+                .special_points
+                .iter()
+                .filter(|s| s.converged && s.state.len() == end.state.len())
+                .filter(|s| detour(&s.state) <= 0.5 * chord)
+                .min_by(|a, b| detour(&a.state).total_cmp(&detour(&b.state)))
+            {
+                Some(fold) => (
+                    fold.z_nm,
+                    fold.amplitude_ratio,
+                    fold.impacts_before.max(fold.impacts_after) as f64,
+                    fold.state.as_slice(),
+                ),
+                None => (
+                    end.z_nm,
+                    end.amplitude_ratio,
+                    end.impacts_per_period,
+                    end.state.as_slice(),
+                ),
+            };
             if first_jump.is_none() {
                 first_jump = Some(BranchJump {
-                    from_z_nm: end.z_nm,
-                    from_amplitude_ratio: end.amplitude_ratio,
-                    from_impacts_per_period: end.impacts_per_period,
+                    from_z_nm: from_z,
+                    from_amplitude_ratio: from_ratio,
+                    from_impacts_per_period: from_impacts,
                 });
             }
-            let release = end.z_nm + z_sign * JUMP_PAST_FOLD * a0;
-            entry = self.settle(release, &end.state, workspace)?;
+            let release = from_z + z_sign * JUMP_PAST_FOLD * a0;
+            entry = self.settle(release, from_state, workspace)?;
         }
         Err(self.not_reached(&format!(
             "the feedback jumped {MAX_JUMPS} times without settling (no stable orbit at the \
