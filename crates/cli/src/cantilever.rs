@@ -249,15 +249,7 @@ pub fn run(args: &CantileverArgs) -> Result<()> {
         None
     };
     if let (Some(path), Some((cantilever, _))) = (&out, &built) {
-        let mut text = serde_json::to_string_pretty(cantilever)?;
-        text.push('\n');
-        write_atomically(path, text.as_bytes())?;
-        afm::fixtures::load_cantilever(path).with_context(|| {
-            format!(
-                "the written file {} does not load back as a cantilever",
-                path.display()
-            )
-        })?;
+        write_cantilever_file(path, cantilever)?;
     }
     if args.json {
         let json = table_json(args, &table, built.as_ref(), out.as_deref());
@@ -566,4 +558,20 @@ fn summary(
         }
     }
     s
+}
+
+/// Write `cantilever` as a cantilever file at `path` (`--out`), once its text has been read
+/// back as a valid cantilever: a text that would not load is an error and leaves an existing
+/// file as it was; the file is written atomically ([`write_atomically`]).
+pub(crate) fn write_cantilever_file(path: &Path, cantilever: &afm::Cantilever) -> Result<()> {
+    let mut text = serde_json::to_string_pretty(cantilever)?;
+    text.push('\n');
+    afm::fixtures::parse_cantilever(&path.display().to_string(), &text).with_context(|| {
+        format!(
+            "{}: the cantilever built does not read back as a valid cantilever file; nothing \
+             was written",
+            path.display()
+        )
+    })?;
+    write_atomically(path, text.as_bytes())
 }

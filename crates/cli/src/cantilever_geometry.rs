@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 
 use crate::model_args::output_path;
 use crate::option_ranges;
-use crate::output::{print_stdout, write_atomically};
+use crate::output::print_stdout;
 
 /// The cantilever geometries `--geometry` accepts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -193,15 +193,7 @@ pub fn run(geometry: &GeometryArgs, args: &CommonOptions) -> Result<()> {
         .map(|radius| build(args, &inputs, &modes, radius, out.as_deref()))
         .transpose()?;
     if let (Some(path), Some(cantilever)) = (&out, &built) {
-        let mut text = serde_json::to_string_pretty(cantilever)?;
-        text.push('\n');
-        write_atomically(path, text.as_bytes())?;
-        afm::fixtures::load_cantilever(path).with_context(|| {
-            format!(
-                "the written file {} does not load back as a cantilever",
-                path.display()
-            )
-        })?;
+        crate::cantilever::write_cantilever_file(path, cantilever)?;
     }
     if args.json {
         let value = report_json(args, &inputs, &modes, built.as_ref(), out.as_deref());

@@ -103,6 +103,22 @@ pub fn holder_in_proc_locks(locks: &str, dev: u64, ino: u64, own_pid: u32) -> Op
     })
 }
 
+/// Whether the open `file` is still the file at `path` (not removed or replaced meanwhile).
+#[cfg(unix)]
+pub fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Whether the open `file` is still the file at `path`: assumed on this platform.
+#[cfg(not(unix))]
+pub fn same_file(_file: &File, path: &Path) -> bool {
+    path.exists()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,7 +14,7 @@ use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use crate::file_lock::{lock_exclusive, lock_shared};
+use crate::file_lock::{lock_exclusive, lock_shared, same_file};
 use crate::grid_row::GridShape;
 use crate::output::write_atomically_with;
 
@@ -158,7 +158,16 @@ fn read_part_from(mut file: File, path: &Path) -> Result<PartContent> {
 #[derive(Debug)]
 pub struct PartWriter {
     path: PathBuf,
-    file: Mutex<File>,
+    file: Mutex<AppendState>,
+}
+
+/// The part file and the length of its complete lines; `failed` once an append failed (the
+/// file was cut back to `length`, and no line goes after it).
+#[derive(Debug)]
+struct AppendState {
+    file: File,
+    length: u64,
+    failed: bool,
 }
 
 impl PartWriter {
@@ -198,7 +207,19 @@ impl PartWriter {
         }
         let mut file = file;
         if content.header.is_none() {
-            // New, or killed before its header was written: start the file afresh.
+            // New, or killed before its header was written (its bytes a beginning of the
+            // header): start the file afresh. Anything else is not this run's to wipe.
+            let length = file
+                .metadata()
+                .with_context(|| format!("cannot read {}", path.display()))?
+                .len();
+            if length > 0 && !starts_the_header(&file, length, header) {
+                bail!(
+                    "{option} {}: the file exists and is not a drumroll grid file (no header \
+                     line); remove it or choose another file",
+                    path.display()
+                );
+            }
             file.set_len(0)
                 .and_then(|()| file.seek(SeekFrom::Start(0)).map(|_| ()))
                 .and_then(|()| file.write_all(header.as_bytes()))
@@ -208,43 +229,74 @@ impl PartWriter {
             file.set_len(content.complete_length)
                 .with_context(|| format!("cannot truncate {}", path.display()))?;
         }
-        file.seek(SeekFrom::End(0))
+        let length = file
+            .seek(SeekFrom::End(0))
             .with_context(|| format!("cannot append to {}", path.display()))?;
         Ok((
             Self {
                 path: path.to_path_buf(),
-                file: Mutex::new(file),
+                file: Mutex::new(AppendState {
+                    file,
+                    length,
+                    failed: false,
+                }),
             },
             content.row_indices(),
         ))
     }
 
-    /// Append one row's line (newline included) in one write, flushed to the file.
+    /// Append one row's line (newline included) in one write and sync its data to the disk
+    /// (a row costs far more to compute than to sync, and a synced row survives a crash of the
+    /// machine). A write that fails part way (a full disk) is cut back off the file, and no
+    /// later line is appended: the file keeps whole lines only, for the rerun to resume.
     pub fn append(&self, line: &str) -> Result<()> {
-        let mut file = self
+        let mut state = self
             .file
             .lock()
             .map_err(|_| anyhow::anyhow!("{}: a writer thread failed", self.path.display()))?;
-        file.write_all(line.as_bytes())
-            .and_then(|()| file.flush())
-            .with_context(|| format!("cannot write {}", self.path.display()))
+        if state.failed {
+            bail!(
+                "cannot write {}: an earlier row failed to be written",
+                self.path.display()
+            );
+        }
+        let written = state
+            .file
+            .write_all(line.as_bytes())
+            .and_then(|()| state.file.sync_data());
+        match written {
+            Ok(()) => {
+                state.length += line.len() as u64;
+                Ok(())
+            }
+            Err(error) => {
+                state.failed = true;
+                let length = state.length;
+                let _ = state
+                    .file
+                    .set_len(length)
+                    .and_then(|()| state.file.seek(SeekFrom::Start(length)).map(|_| ()));
+                Err(error).with_context(|| format!("cannot write {}", self.path.display()))
+            }
+        }
     }
 }
 
-/// Whether the open `file` is still the file at `path` (not removed or replaced meanwhile).
-#[cfg(unix)]
-fn same_file(file: &File, path: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    match (file.metadata(), std::fs::metadata(path)) {
-        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
-        _ => false,
+/// Whether the `length` bytes of `file` (which holds no complete line) are a beginning of
+/// `header`: what a run killed while writing the header leaves.
+fn starts_the_header(file: &File, length: u64, header: &str) -> bool {
+    if length > header.len() as u64 {
+        return false;
     }
-}
-
-/// Whether the open `file` is still the file at `path`: assumed on this platform.
-#[cfg(not(unix))]
-fn same_file(_file: &File, path: &Path) -> bool {
-    path.exists()
+    let mut bytes = Vec::with_capacity(length as usize);
+    let read = file
+        .try_clone()
+        .and_then(|mut reading| {
+            reading.seek(SeekFrom::Start(0))?;
+            reading.take(length).read_to_end(&mut bytes)
+        })
+        .is_ok();
+    read && header.as_bytes().starts_with(&bytes)
 }
 
 /// The number of rows of the grid a header describes (`inputs.options.steps`).

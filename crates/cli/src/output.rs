@@ -89,17 +89,16 @@ pub fn write_atomically_with(
     let file_name = path
         .file_name()
         .with_context(|| format!("output path {} names no file", path.display()))?;
-    let mut temporary_name = file_name.to_os_string();
-    temporary_name.push(format!(".{}.partial", std::process::id()));
-    let temporary = path.with_file_name(temporary_name);
     remove_stale_temporaries(path);
+    let (file, temporary) = create_temporary(path, file_name)
+        .with_context(|| format!("cannot write {}", path.display()))?;
     let result = (|| -> Result<()> {
-        let file = std::fs::File::create(&temporary)?;
         let mut writer = BufWriter::new(file);
         write(&mut writer)?;
         let file = writer.into_inner().map_err(|error| error.into_error())?;
         file.sync_all()?;
         std::fs::rename(&temporary, path)?;
+        sync_directory(path);
         Ok(())
     })()
     .with_context(|| format!("cannot write {}", path.display()));
@@ -109,9 +108,71 @@ pub fn write_atomically_with(
     result
 }
 
-/// Remove the temporary files `<path>.<PID>.partial` (and the probes `.<name>.<PID>.probe` of
-/// [`check_writable`]) that killed runs left beside `path` (Linux: those whose process no
-/// longer runs, `/proc/<PID>` absent); elsewhere nothing.
+/// A new temporary file beside `path` (file name `file_name`), `<name>.<host>.<PID>-<n>.partial`
+/// with `n` counting this process's temporaries, created exclusively (`create_new`): two
+/// writers never share one, even on a file system several hosts mount (a cluster's nodes,
+/// where process ids repeat).
+fn create_temporary(
+    path: &Path,
+    file_name: &std::ffi::OsStr,
+) -> std::io::Result<(std::fs::File, std::path::PathBuf)> {
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    loop {
+        let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let mut name = file_name.to_os_string();
+        name.push(format!(
+            ".{}.{}-{n}.partial",
+            host_name(),
+            std::process::id()
+        ));
+        let temporary = path.with_file_name(name);
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&temporary)
+        {
+            Ok(file) => return Ok((file, temporary)),
+            Err(error) if error.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(error) => return Err(error),
+        }
+    }
+}
+
+/// This machine's name as a file-name part (letters, digits, `-` and `_`; `host` where it
+/// cannot be told): what tells one host's temporary files from another's.
+fn host_name() -> String {
+    let name = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .unwrap_or_default();
+    let name: String = name
+        .trim()
+        .chars()
+        .filter(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
+        .collect();
+    if name.is_empty() {
+        String::from("host")
+    } else {
+        name
+    }
+}
+
+/// Sync the directory holding `path`, so that a rename into it survives a crash of the
+/// machine (best effort: not every platform opens a directory).
+pub fn sync_directory(path: &Path) {
+    let directory = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    if let Ok(directory) = std::fs::File::open(directory) {
+        let _ = directory.sync_all();
+    }
+}
+
+/// Remove the temporary files `<path>.<host>.<PID>-<n>.partial` (and the probes
+/// `.<name>.<PID>.probe` of [`check_writable`]) that killed runs on this host left beside
+/// `path` (Linux: those whose process no longer runs, `/proc/<PID>` absent); another host's
+/// are left alone (their processes cannot be seen from here); elsewhere nothing.
 fn remove_stale_temporaries(path: &Path) {
     if !cfg!(target_os = "linux") || !Path::new("/proc/self").exists() {
         return;
@@ -129,14 +190,16 @@ fn remove_stale_temporaries(path: &Path) {
     let Some(prefix) = prefix.to_str().map(str::to_owned) else {
         return;
     };
+    let this_host = format!("{prefix}{}.", host_name());
     let Ok(entries) = std::fs::read_dir(directory) else {
         return;
     };
     for entry in entries.flatten() {
         let file_name = entry.file_name();
         let Some(pid) = file_name.to_str().and_then(|n| {
-            n.strip_prefix(prefix.as_str())
+            n.strip_prefix(this_host.as_str())
                 .and_then(|rest| rest.strip_suffix(".partial"))
+                .and_then(|rest| rest.split_once('-').map(|(pid, _)| pid))
                 .or_else(|| {
                     n.strip_prefix('.')
                         .and_then(|n| n.strip_prefix(prefix.as_str()))
@@ -192,6 +255,13 @@ impl StreamedFile {
             .open(&part)
             .with_context(|| format!("{option} {}: cannot create it", part.display()))?;
         crate::file_lock::lock_exclusive(&file, &part, option)?;
+        if !crate::file_lock::same_file(&file, &part) {
+            bail!(
+                "{option} {}: the file was renamed or replaced while this run opened it (by \
+                 another run finishing?); run again",
+                part.display()
+            );
+        }
         file.set_len(0)
             .with_context(|| format!("cannot write {}", part.display()))?;
         Ok(Self {
@@ -220,7 +290,9 @@ impl StreamedFile {
         self.file
             .sync_all()
             .and_then(|()| std::fs::rename(&self.part, &self.path))
-            .with_context(|| format!("cannot write {}", self.path.display()))
+            .with_context(|| format!("cannot write {}", self.path.display()))?;
+        sync_directory(&self.path);
+        Ok(())
     }
 }
 

@@ -134,9 +134,39 @@ fn a_killed_shard_resumes_where_it_stopped() {
 
     // The resumed part without the marked row merges into the single run's file.
     std::fs::write(&part, resumed.replacen(&kept_row, lines[1], 1).as_bytes()).expect("unmark");
-    let (ok, stderr) = merge(&[part], &at("merged.jsonl"));
+    let (ok, stderr) = merge(&[part.clone()], &at("merged.jsonl"));
     assert!(ok, "{stderr}");
     assert_eq!(read(&at("merged.jsonl")), read(&at("single.jsonl")));
+
+    // Killed while writing its header: the part holds a beginning of the header, and the
+    // rerun starts it afresh into the same part.
+    std::fs::write(&part, &lines[0][..lines[0].len() / 3]).expect("cut header");
+    grid(&part, &["--shard", "0/1"]);
+    let rerun = String::from_utf8(read(&part)).expect("utf-8");
+    let mut rerun_lines: Vec<&str> = rerun.split_inclusive('\n').collect();
+    let mut complete_lines = lines.clone();
+    // The rows in the order their threads finished them: the same lines.
+    rerun_lines.sort_unstable();
+    complete_lines.sort_unstable();
+    assert!(
+        rerun_lines == complete_lines,
+        "the part rewritten from a cut header differs from the complete one"
+    );
+
+    // A file with no header line that is not the beginning of one (a mistyped --output) is
+    // refused and left as it was.
+    let notes = at("notes.json");
+    std::fs::write(&notes, "{\"my\": \"notes\"}").expect("notes");
+    let words = grid_words(&SMALL_GRID, &["--retract", "--shard", "0/1", "--output"]);
+    let mut args: Vec<&str> = words;
+    let notes_arg = notes.to_str().expect("utf-8 path");
+    args.push(notes_arg);
+    let stderr = failure(&args);
+    assert!(
+        stderr.contains("not a drumroll grid file") && stderr.contains("notes.json"),
+        "{stderr}"
+    );
+    assert_eq!(read(&notes), b"{\"my\": \"notes\"}");
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! `map` with `--csv` and `--plot`, each killed (SIGKILL) at seeded random moments of its
 //! measured run time and then run again. After each kill every output file is absent or byte
 //! for byte the uninterrupted run's (never partial or malformed), and the only other files
-//! left are the resumable `.part` file and the `.<PID>.partial` temporary of the killed
+//! left are the resumable `.part` file and the `.<host>.<PID>-<n>.partial` temporary of the killed
 //! process (or its writability probe); after the rerun every output is the uninterrupted run's and nothing else is left.
 //!
 //! `cargo test --release -p drumroll --test kill_fault` kills each command 3 times;
@@ -144,13 +144,19 @@ fn files(directory: &Path) -> BTreeMap<String, Vec<u8>> {
 }
 
 /// Whether `name` is a file a killed run may leave beside the outputs: the resumable
-/// `OUTPUT.part`, or a temporary `OUTPUT.<PID>.partial` or writability probe
+/// `OUTPUT.part`, or a temporary `OUTPUT.<host>.<PID>-<n>.partial` or writability probe
 /// `.OUTPUT.<PID>.probe` of process `pid` (removed by the next run writing `OUTPUT`).
 fn left_by_a_kill(name: &str, outputs: &[&str], pid: u32) -> bool {
     outputs.iter().any(|output| {
-        name == format!("{output}.part")
-            || name == format!("{output}.{pid}.partial")
-            || name == format!(".{output}.{pid}.probe")
+        let temporary = name
+            .strip_prefix(&format!("{output}."))
+            .and_then(|rest| rest.strip_suffix(".partial"))
+            .and_then(|rest| rest.rsplit_once('.'))
+            .and_then(|(_, process)| process.split_once('-'))
+            .is_some_and(|(process, n)| {
+                process == pid.to_string() && n.chars().all(|c| c.is_ascii_digit())
+            });
+        name == format!("{output}.part") || temporary || name == format!(".{output}.{pid}.probe")
     })
 }
 
