@@ -194,7 +194,7 @@ pub mod ranges {
     /// against the lever that steps underflow.
     pub const STIFFNESS_N_PER_M: Interval =
         Interval::closed(1e-6, 1e6, "N/m").with_typical(1e-3, 1e3);
-    /// Quality factor `Q_i`: a mode damped a thousand times past critical to 1e6 (vacuum).
+    /// Quality factor `Q_i`: from 1e-3 (a damping ratio `1/(2Q)` of 500) to 1e6 (vacuum).
     pub const QUALITY_FACTOR: Interval = Interval::closed(1e-3, 1e6, "").with_typical(0.1, 1e5);
     /// Optical sensitivity `chi_i` or forcing ratio `F_i / F_1` of a higher mode.
     pub const MODE_RATIO: Interval = Interval::closed(-1e3, 1e3, "");

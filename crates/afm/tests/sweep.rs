@@ -368,6 +368,46 @@ fn cycle_lockin_matches_the_period_observables() {
     );
 }
 
+/// A cycle in contact throughout (the Biolever's rest position 10 nm, `A0`, inside mica: the
+/// tip never leaves the sample; its highest gap minimum is -0.016 nm) counts one impact, as the steady orbit's observables count an orbit in
+/// permanent contact (MODEL.md section 5); the lock-in read 0 before.
+#[test]
+fn a_cycle_in_permanent_contact_counts_one_impact() {
+    use afm::orbit::lockin::CycleLockIn;
+    use afm::{observe_period, steady_orbit, Separation, SteadyOrbitSettings};
+    use hybrid::{Sensitivity, Solver, StepOutcome};
+    let z = -10.0;
+    let mut model = biolever_on_mica();
+    let orbit = steady_orbit(
+        &model,
+        z,
+        OrbitStart::Transient,
+        &SteadyOrbitSettings::default(),
+    )
+    .expect("orbit");
+    model
+        .set_separation(Separation::Constant(z))
+        .expect("finite");
+    let settings = hybrid::Settings::default();
+    let (_, observables) =
+        observe_period(&model, 0.0, &orbit.state, Sensitivity::None, &settings, 1).expect("period");
+    assert!(observables.gap_minima.iter().all(|m| m.gap_nm < 0.0));
+    assert_eq!(observables.impacts_per_period, 1.0);
+    let mut lockin = CycleLockIn::new(&model);
+    let mut solver =
+        Solver::new(&model, 0.0, &orbit.state, Sensitivity::None, settings).expect("solver");
+    lockin.begin(&model, &orbit.state);
+    loop {
+        let outcome = solver.step(model.period_us()).expect("step");
+        assert!(!matches!(outcome, StepOutcome::Event(_)), "a crossing");
+        lockin.observe(&solver, &outcome);
+        if matches!(outcome, StepOutcome::EndTime) {
+            break;
+        }
+    }
+    assert_eq!(lockin.finish(&model, solver.state()).impacts, 1);
+}
+
 /// The closed-form free-flight integrals (harmonics 1 to 3) against composite 8-point
 /// Gauss-Legendre quadrature of the model's exact flow (100 panels over 1.7 periods: converged
 /// to rounding), for the Biolever (both modes under-damped) and for a copy with an over-damped

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use crate::model_args::output_path;
 use crate::option_ranges::{self, check_option};
-use crate::output::{print_stdout, write_atomically};
+use crate::output::print_stdout;
 
 /// Modes whose frequency and quality factor have their own option (`--f1 .. --f4`,
 /// `--q1 .. --q4`); more modes take the `--frequencies` and `--quality-factors` lists.
@@ -249,7 +249,7 @@ pub fn run(args: &CantileverArgs) -> Result<()> {
         None
     };
     if let (Some(path), Some((cantilever, _))) = (&out, &built) {
-        write_cantilever_file(path, cantilever)?;
+        crate::cantilever_file::write_cantilever_file(path, cantilever)?;
     }
     if args.json {
         let json = table_json(args, &table, built.as_ref(), out.as_deref());
@@ -558,20 +558,4 @@ fn summary(
         }
     }
     s
-}
-
-/// Write `cantilever` as a cantilever file at `path` (`--out`), once its text has been read
-/// back as a valid cantilever: a text that would not load is an error and leaves an existing
-/// file as it was; the file is written atomically ([`write_atomically`]).
-pub(crate) fn write_cantilever_file(path: &Path, cantilever: &afm::Cantilever) -> Result<()> {
-    let mut text = serde_json::to_string_pretty(cantilever)?;
-    text.push('\n');
-    afm::fixtures::parse_cantilever(&path.display().to_string(), &text).with_context(|| {
-        format!(
-            "{}: the cantilever built does not read back as a valid cantilever file; nothing \
-             was written",
-            path.display()
-        )
-    })?;
-    write_atomically(path, text.as_bytes())
 }

@@ -193,7 +193,7 @@ pub fn run(geometry: &GeometryArgs, args: &CommonOptions) -> Result<()> {
         .map(|radius| build(args, &inputs, &modes, radius, out.as_deref()))
         .transpose()?;
     if let (Some(path), Some(cantilever)) = (&out, &built) {
-        crate::cantilever::write_cantilever_file(path, cantilever)?;
+        crate::cantilever_file::write_cantilever_file(path, cantilever)?;
     }
     if args.json {
         let value = report_json(args, &inputs, &modes, built.as_ref(), out.as_deref());

@@ -4,6 +4,7 @@
 
 pub mod approach;
 pub mod cantilever;
+pub mod cantilever_file;
 pub mod cantilever_geometry;
 pub mod cases;
 pub mod continue_diagram;

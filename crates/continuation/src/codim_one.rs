@@ -1,5 +1,5 @@
 //! The defining systems of codimension-one points of periodic orbits, continued in two
-//! parameters `(p, q)` (MODEL.md Sec. 5).
+//! parameters `(p, q)` (MODEL.md section 8).
 //!
 //! * **Grazing**: unknowns `u = (x, s, p, q)`, `x` the state at the section time `t0` and `s`
 //!   the time of the grazing minimum of the gap `h`; equations `P(x) - x = 0` (the period map

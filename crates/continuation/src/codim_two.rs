@@ -1,5 +1,5 @@
 //! Codimension-two points along a codimension-one curve: where it meets another
-//! codimension-one condition (MODEL.md Sec. 5).
+//! codimension-one condition (MODEL.md section 8).
 //!
 //! Test functions between consecutive curve points:
 //!

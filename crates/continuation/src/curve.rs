@@ -1,6 +1,6 @@
 //! Two-parameter continuation of a codimension-one point of periodic orbits (a grazing, a
 //! fold, a period doubling) in `(p, q)` by pseudo-arclength, through turning points in either
-//! parameter (defining systems in `codim_one.rs`, MODEL.md Sec. 5).
+//! parameter (defining systems in `codim_one.rs`, MODEL.md section 8).
 //!
 //! A curve starts from a special point of a one-parameter branch at `q0` (corrected at fixed
 //! `q = q0`) and is traced both ways until it reaches an end of `second_range`, leaves the

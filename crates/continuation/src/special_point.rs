@@ -1,5 +1,6 @@
 //! Special points of a branch: where a test function changes sign, located by root finding
-//! along the branch, with the precision of the location (MODEL.md Sec. 5 for the labels).
+//! along the branch, with the precision of the location (MODEL.md sections 5 and 8 for the
+//! labels).
 
 use nalgebra::{Complex, DVector};
 
@@ -13,7 +14,8 @@ pub enum SpecialPointKind {
     /// A complex pair of multipliers crosses the unit circle.
     NeimarkSacker,
     /// A local minimum of the contact switching function crosses zero: a grazing trajectory
-    /// (MODEL.md Sec. 5), labelled `G<n>` with `n` the impacts per period after it.
+    /// (MODEL.md section 5), labelled `G<n>` with `n` the larger impact count on either side:
+    /// the grazing between `n - 1` and `n` impacts, whichever way the branch passes it.
     Grazing,
     /// A local maximum of the switching function between two contacts dips below zero: the
     /// two impacts merge into one.
@@ -38,15 +40,16 @@ pub enum SpecialPointKind {
 }
 
 impl SpecialPointKind {
-    /// The label of a point of this kind with `impacts_after` impacts per period after it:
-    /// `G<n>`, `fold`, `period-doubling`, `neimark-sacker`, `merge`, `split`,
-    /// `permanent-contact`, `lift-off`, `pull-off`, `impact-vanish`, `impact-appear`.
-    pub fn label(self, impacts_after: usize) -> String {
+    /// The label of a point of this kind with `impacts` the larger impact count per period on
+    /// either side of it: `G<n>`, `fold`, `period-doubling`, `neimark-sacker`, `merge`,
+    /// `split`, `permanent-contact`, `lift-off`, `pull-off`, `impact-vanish`,
+    /// `impact-appear`.
+    pub fn label(self, impacts: usize) -> String {
         match self {
             SpecialPointKind::Fold => "fold".into(),
             SpecialPointKind::PeriodDoubling => "period-doubling".into(),
             SpecialPointKind::NeimarkSacker => "neimark-sacker".into(),
-            SpecialPointKind::Grazing => format!("G{impacts_after}"),
+            SpecialPointKind::Grazing => format!("G{impacts}"),
             SpecialPointKind::Merge => "merge".into(),
             SpecialPointKind::Split => "split".into(),
             SpecialPointKind::PermanentContact => "permanent-contact".into(),

@@ -1,6 +1,6 @@
 //! A quasi-static sweep of the separation `Z`: at each of a list of separations the cantilever
 //! settles by time-domain transients from the orbit it had at the previous one, as in a lab
-//! approach slow enough that every orbit settles (MODEL.md section 5), and the attractor it
+//! approach slow enough that every orbit settles (MODEL.md section 8), and the attractor it
 //! settles on is polished by Newton ([`OrbitStart::AfterTransients`]). An approach follows one
 //! attractor down until it ends (a fold, a grazing that destroys it) and then lands on another;
 //! the retract back up from the lowest separation can follow another one, and where the two

@@ -41,7 +41,9 @@ pub struct CycleReading {
     /// `b = (2/T) int u sin(w t) dt`, nm.
     pub sine_nm: f64,
     /// Contact onsets in the cycle (`Direction::Down` crossings of `d = 0`); a contact in
-    /// progress at the cycle's start was counted in the cycle where it began.
+    /// progress at the cycle's start was counted in the cycle where it began; a cycle in
+    /// contact throughout (no crossing) counts one, as an orbit in permanent contact does
+    /// (MODEL.md section 5).
     pub impacts: usize,
     /// The largest Hertz force `F_ts(d)` in the cycle, nN (0 without contact): the deepest gap
     /// minimum of every contact, and the force at the cycle's ends for a contact that spans a
@@ -87,6 +89,10 @@ pub struct CycleLockIn {
     free_state: Vec<f64>,
     /// Scratch for the state at a gap minimum (a standard linear solid's force needs it).
     minimum_state: Vec<f64>,
+    /// Whether the cycle started in contact (`h_0 < 0`), and whether it crossed the contact
+    /// surface since: a cycle in contact throughout counts one impact (MODEL.md section 5).
+    starts_in_contact: bool,
+    crossed: bool,
 }
 
 impl CycleLockIn {
@@ -115,6 +121,8 @@ impl CycleLockIn {
             free_start: None,
             free_state: vec![0.0; model.dim()],
             minimum_state: vec![0.0; model.dim()],
+            starts_in_contact: false,
+            crossed: false,
         }
     }
 
@@ -129,6 +137,8 @@ impl CycleLockIn {
         self.previous_state.copy_from_slice(x0);
         self.previous_end = 0.0;
         self.free_start = None;
+        self.starts_in_contact = model.switching(GAP_SURFACE, 0.0, x0) < 0.0;
+        self.crossed = false;
     }
 
     /// Accumulate the solver's last step: over free flight (exact-flow steps), the closed form
@@ -172,8 +182,11 @@ impl CycleLockIn {
             }
         }
         if let StepOutcome::Event(event) = outcome {
-            if event.surface == GAP_SURFACE && event.direction == Direction::Down {
-                self.impacts += 1;
+            if event.surface == GAP_SURFACE {
+                self.crossed = true;
+                if event.direction == Direction::Down {
+                    self.impacts += 1;
+                }
             }
         }
     }
@@ -232,7 +245,11 @@ impl CycleLockIn {
             harmonics,
             harmonic_count: self.harmonic_count,
             dissipated_ev: -NN_NM_IN_EV * self.contact_work,
-            impacts: self.impacts,
+            impacts: if self.impacts == 0 && self.starts_in_contact && !self.crossed {
+                1
+            } else {
+                self.impacts
+            },
             peak_force_nn: self
                 .peak_force
                 .max(model.tip_sample_force(self.period, x_end)),

@@ -71,8 +71,8 @@ pub fn ideal_scan_until(
     let workspace = &mut SteadyOrbitWorkspace::default();
     let a0 = case.free_amplitude_nm;
     let mut pixels = Vec::with_capacity(centres.len() * settings.directions.passes().len());
-    // The material and orbit the cantilever is on.
-    let mut current: Option<(usize, SteadyOrbit)> = None;
+    // The material and orbit the cantilever is on, and where (nm).
+    let mut current: Option<(usize, SteadyOrbit, f64)> = None;
     for &direction in settings.directions.passes() {
         let order: Vec<usize> = match direction {
             ScanDirection::Trace => (0..centres.len()).collect(),
@@ -92,9 +92,15 @@ pub fn ideal_scan_until(
                 None => branch
                     .engage(workspace)
                     .map_err(|error| branch.named(error))?,
-                Some((on, orbit)) if *on == material => (orbit.clone(), None),
-                Some((_, orbit)) => branch
-                    .follow(orbit.z_nm, &orbit.state, workspace)
+                Some((on, orbit, _)) if *on == material => (orbit.clone(), None),
+                // A new material: the base is held across the boundary, so the tip arrives
+                // at the old Z less the height's step there (0 across a ramp).
+                Some((_, orbit, from)) => branch
+                    .follow(
+                        orbit.z_nm - line.height_step_between(*from, x),
+                        &orbit.state,
+                        workspace,
+                    )
                     .map_err(|error| branch.named(error))?,
             };
             pixels.push(ScanPixel::of_orbit(
@@ -107,7 +113,7 @@ pub fn ideal_scan_until(
                 a0,
                 jump,
             ));
-            current = Some((material, orbit));
+            current = Some((material, orbit, x));
             if progress(pixels.len()) {
                 return Err(AfmError::Interrupted);
             }

@@ -256,6 +256,28 @@ impl ScanLine {
         segment.height_nm
     }
 
+    /// How much the surface height jumps on the way from `from_nm` to `to_nm` (either
+    /// direction), nm: the sum over the segment boundaries between them of the height after the
+    /// boundary less the height before it. Zero where `edge_width_nm > 0` (the height is then
+    /// continuous: a ramp).
+    pub fn height_step_between(&self, from_nm: f64, to_nm: f64) -> f64 {
+        if self.edge_width_nm > 0.0 {
+            return 0.0;
+        }
+        let (low, high) = (from_nm.min(to_nm), from_nm.max(to_nm));
+        let rise: f64 = self
+            .segments
+            .windows(2)
+            .filter(|pair| pair[0].to_nm > low && pair[0].to_nm <= high)
+            .map(|pair| pair[1].height_nm - pair[0].height_nm)
+            .sum();
+        if to_nm >= from_nm {
+            rise
+        } else {
+            -rise
+        }
+    }
+
     /// The centres of `pixels` equal pixels covering the line, nm: `x_i = start + (i + 1/2)
     /// L / pixels`.
     pub fn pixel_centres(&self, pixels: usize) -> Vec<f64> {

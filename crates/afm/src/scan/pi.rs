@@ -27,7 +27,7 @@ use crate::orbit::steady_orbit::SteadyOrbitWorkspace;
 use crate::scan::line::ScanLine;
 use crate::scan::materials::line_models;
 use crate::scan::pixel::{set_heights_from_bases, ScanDirection, ScanPixel};
-use crate::scan::setpoint_branch::SetpointBranch;
+use crate::scan::setpoint_branch::{on_sample, SetpointBranch};
 use crate::scan::settings::ScanSettings;
 use crate::sweep::amplitude_ratio::AmplitudeRatioSearch;
 use crate::sweep::{integrate_cycle, SweepSettings, MAX_CYCLE_COUNT};
@@ -169,8 +169,10 @@ pub fn pi_scan_until(
     };
     let material = line.material_at(x_first);
     let search = AmplitudeRatioSearch::new(settings.setpoint)?;
-    let (orbit, _) = SetpointBranch::new(&models[material], &search, &settings.orbit)?
-        .engage(&mut SteadyOrbitWorkspace::default())?;
+    // Errors name the sample, as the ideal feedback's do.
+    let (orbit, _) = SetpointBranch::new(&models[material], &search, &settings.orbit)
+        .and_then(|branch| branch.engage(&mut SteadyOrbitWorkspace::default()))
+        .map_err(|error| on_sample(error, settings.setpoint, &line.materials[material].name))?;
     let mut state = orbit.state.clone();
     let hold = line.height_at(x_first) + orbit.z_nm;
     let (mut base_start, mut base_end) = (hold, hold);

@@ -485,7 +485,7 @@ impl<P: PeriodicProblem + ?Sized> Continuation<'_, P> {
         (
             point.sigma,
             SpecialPoint {
-                label: kind.label(impacts_after),
+                label: kind.label(impacts_before.max(impacts_after)),
                 kind,
                 parameter: point.parameter(),
                 bracket: (pl.min(ph), pl.max(ph)),

@@ -35,7 +35,7 @@ pub struct SteadyOrbit {
     pub stable: bool,
     /// The monodromy matrix `dP/dx` (dimensionless, `2N x 2N` in the state's order) whose
     /// eigenvalues are [`SteadyOrbit::multipliers`], for a period-1 orbit found by Newton
-    /// (MODEL.md section 4); `None` for an orbit of period `k T`, `k > 1`. The coexistence
+    /// (MODEL.md section 8); `None` for an orbit of period `k T`, `k > 1`. The coexistence
     /// check ([`crate::orbit::steady_orbit::coexisting_orbit`]) compares transients with it.
     #[serde(skip)]
     pub monodromy: Option<DMatrix<f64>>,
