@@ -373,9 +373,8 @@ fn cycle_lockin_matches_the_period_observables() {
 /// permanent contact (MODEL.md section 5); the lock-in read 0 before.
 #[test]
 fn a_cycle_in_permanent_contact_counts_one_impact() {
-    use afm::orbit::lockin::CycleLockIn;
     use afm::{observe_period, steady_orbit, Separation, SteadyOrbitSettings};
-    use hybrid::{Sensitivity, Solver, StepOutcome};
+    use hybrid::Sensitivity;
     let z = -10.0;
     let mut model = biolever_on_mica();
     let orbit = steady_orbit(
@@ -393,19 +392,40 @@ fn a_cycle_in_permanent_contact_counts_one_impact() {
         observe_period(&model, 0.0, &orbit.state, Sensitivity::None, &settings, 1).expect("period");
     assert!(observables.gap_minima.iter().all(|m| m.gap_nm < 0.0));
     assert_eq!(observables.impacts_per_period, 1.0);
-    let mut lockin = CycleLockIn::new(&model);
-    let mut solver =
-        Solver::new(&model, 0.0, &orbit.state, Sensitivity::None, settings).expect("solver");
-    lockin.begin(&model, &orbit.state);
+    let (reading, events) = read_one_cycle(&model, &orbit.state, 1);
+    assert_eq!(events, 0, "a crossing");
+    assert_eq!(reading.impacts, 1);
+}
+
+/// One drive cycle of `model` from `x0` read by a lock-in of `harmonics` harmonics (default
+/// settings): its reading and the number of events the solver met.
+fn read_one_cycle(
+    model: &afm::TappingModel,
+    x0: &[f64],
+    harmonics: usize,
+) -> (afm::orbit::lockin::CycleReading, usize) {
+    use afm::orbit::lockin::CycleLockIn;
+    use hybrid::{Sensitivity, Solver, StepOutcome};
+    let mut lockin = CycleLockIn::with_harmonics(model, harmonics);
+    let mut solver = Solver::new(
+        model,
+        0.0,
+        x0,
+        Sensitivity::None,
+        hybrid::Settings::default(),
+    )
+    .expect("solver");
+    lockin.begin(model, x0);
+    let mut events = 0;
     loop {
         let outcome = solver.step(model.period_us()).expect("step");
-        assert!(!matches!(outcome, StepOutcome::Event(_)), "a crossing");
+        events += usize::from(matches!(outcome, StepOutcome::Event(_)));
         lockin.observe(&solver, &outcome);
         if matches!(outcome, StepOutcome::EndTime) {
             break;
         }
     }
-    assert_eq!(lockin.finish(&model, solver.state()).impacts, 1);
+    (lockin.finish(model, solver.state()), events)
 }
 
 /// The closed-form free-flight integrals (harmonics 1 to 3) against composite 8-point
@@ -501,9 +521,8 @@ fn cycle_lockin_reads_harmonics_and_dissipation() {
 }
 
 fn lockin_reads_harmonics_and_dissipation(drive: &afm::model::drive_spec::DriveSpec) {
-    use afm::orbit::lockin::CycleLockIn;
     use afm::{observe_period, steady_orbit, Separation, SteadyOrbitSettings, TappingModel};
-    use hybrid::{Sensitivity, Solver, StepOutcome};
+    use hybrid::Sensitivity;
     let sample = afm::fixtures::parse_sample(
         "kv.json",
         r#"{"name": "kv", "youngs_modulus_gpa": 1.0, "poisson_ratio": 0.3,
@@ -531,18 +550,7 @@ fn lockin_reads_harmonics_and_dissipation(drive: &afm::model::drive_spec::DriveS
     let (_, observables) =
         observe_period(&model, 0.0, &orbit.state, Sensitivity::None, &settings, 6).expect("period");
     assert!(observables.dissipated_ev > 0.0);
-    let mut lockin = CycleLockIn::with_harmonics(&model, 6);
-    let mut solver =
-        Solver::new(&model, 0.0, &orbit.state, Sensitivity::None, settings).expect("solver");
-    lockin.begin(&model, &orbit.state);
-    loop {
-        let outcome = solver.step(model.period_us()).expect("step");
-        lockin.observe(&solver, &outcome);
-        if matches!(outcome, StepOutcome::EndTime) {
-            break;
-        }
-    }
-    let reading = lockin.finish(&model, solver.state());
+    let (reading, _) = read_one_cycle(&model, &orbit.state, 6);
     assert_eq!(reading.harmonic_count, 6);
     for (harmonic, [a, b]) in observables.harmonics.iter().zip(reading.harmonics) {
         assert!(

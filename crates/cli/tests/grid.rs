@@ -134,7 +134,7 @@ fn a_killed_shard_resumes_where_it_stopped() {
 
     // The resumed part without the marked row merges into the single run's file.
     std::fs::write(&part, resumed.replacen(&kept_row, lines[1], 1).as_bytes()).expect("unmark");
-    let (ok, stderr) = merge(&[part.clone()], &at("merged.jsonl"));
+    let (ok, stderr) = merge(std::slice::from_ref(&part), &at("merged.jsonl"));
     assert!(ok, "{stderr}");
     assert_eq!(read(&at("merged.jsonl")), read(&at("single.jsonl")));
 
