@@ -118,6 +118,16 @@ impl Reference {
     }
 }
 
+/// The model of built-in case `name` with its drive made acoustic (the beam's participation
+/// factors).
+fn driven_acoustically(name: &str) -> TappingModel {
+    let mut case = builtin_case(name).expect("case");
+    case.drive = DriveSpec::Acoustic {
+        base_participation: None,
+    };
+    TappingModel::from_case(&case).expect("model")
+}
+
 fn converged_orbit(model: &TappingModel, z: f64) -> SteadyOrbit {
     let orbit = steady_orbit(
         model,
@@ -275,11 +285,7 @@ fn acoustic_tapping_orbit_matches_brute_force() {
 /// below 1e-9 (as on every orbit); the sample dissipates (`dissipated_ev` > 0.01 eV).
 #[test]
 fn acoustic_drive_over_a_standard_linear_solid_closes_the_sample_balance() {
-    let mut case = builtin_case("biolever-soft-viscoelastic").expect("case");
-    case.drive = DriveSpec::Acoustic {
-        base_participation: None,
-    };
-    let model = TappingModel::from_case(&case).expect("model");
+    let model = driven_acoustically("biolever-soft-viscoelastic");
     let z = 0.7 * model.grazing_separation_nm();
     let model = at(&model, z);
     let orbit = converged_orbit(&model, z);
@@ -366,11 +372,7 @@ fn acoustic_contact_by_series_matches_finite_difference_monodromy() {
 /// diagram took 29 times as long.)
 #[test]
 fn acoustic_drive_over_the_hydration_force_locates_its_grazings() {
-    let mut case = builtin_case("biolever-mica-hydration").expect("case");
-    case.drive = DriveSpec::Acoustic {
-        base_participation: None,
-    };
-    let model = TappingModel::from_case(&case).expect("model");
+    let model = driven_acoustically("biolever-mica-hydration");
     let mut settings = DiagramSettings::approach(&model);
     settings.min_amplitude_ratio = 0.7;
     let diagram = approach_diagram(&model, &settings).expect("diagram");

@@ -139,22 +139,26 @@ fn create_temporary(
 }
 
 /// This machine's name as a file-name part (letters, digits, `-` and `_`; `host` where it
-/// cannot be told): what tells one host's temporary files from another's.
-fn host_name() -> String {
-    let name = std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .ok()
-        .or_else(|| std::env::var("HOSTNAME").ok())
-        .unwrap_or_default();
-    let name: String = name
-        .trim()
-        .chars()
-        .filter(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
-        .collect();
-    if name.is_empty() {
-        String::from("host")
-    } else {
-        name
-    }
+/// cannot be told): what tells one host's temporary files from another's. Read once per
+/// process.
+fn host_name() -> &'static str {
+    static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    NAME.get_or_init(|| {
+        let name = std::fs::read_to_string("/proc/sys/kernel/hostname")
+            .ok()
+            .or_else(|| std::env::var("HOSTNAME").ok())
+            .unwrap_or_default();
+        let name: String = name
+            .trim()
+            .chars()
+            .filter(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
+            .collect();
+        if name.is_empty() {
+            String::from("host")
+        } else {
+            name
+        }
+    })
 }
 
 /// Sync the directory holding `path`, so that a rename into it survives a crash of the

@@ -23,6 +23,21 @@ fn oscillator(w: f64) -> ImpactOscillator {
     }
 }
 
+/// The grazing curve's settings from 0.5 to 1.6 in the frequency ratio (through resonance),
+/// steps of at most 0.02, Newton to 1e-12 in at most 10 updates.
+fn through_resonance() -> CurveSettings {
+    CurveSettings {
+        second_range: (0.5, 1.6),
+        max_second_step: 0.02,
+        corrector: NewtonSettings {
+            tolerance: 1e-12,
+            max_iterations: 10,
+            ..NewtonSettings::default()
+        },
+        ..CurveSettings::default()
+    }
+}
+
 /// The curve problem in `(w, A)` of the oscillator at `w0` and the start of its grazing curve:
 /// the G1 located on the one-parameter branch in the amplitude `A` at `w0`.
 fn first_grazing_at(w0: f64) -> (TwoParameterProblem<ImpactOscillator>, CurveStart) {
@@ -55,15 +70,8 @@ fn first_grazing_at(w0: f64) -> (TwoParameterProblem<ImpactOscillator>, CurveSta
 fn grazing_curve_matches_the_closed_form_through_resonance() {
     let (problem, start) = first_grazing_at(0.8);
     let settings = CurveSettings {
-        second_range: (0.5, 1.6),
         targets: vec![1.0],
-        max_second_step: 0.02,
-        corrector: NewtonSettings {
-            tolerance: 1e-12,
-            max_iterations: 10,
-            ..NewtonSettings::default()
-        },
-        ..CurveSettings::default()
+        ..through_resonance()
     };
     let curve = continue_curve(&problem, CodimOneKind::Grazing, &start, &settings).expect("curve");
     assert_eq!(
@@ -224,16 +232,7 @@ fn fold_curve_of_the_cusp_normal_form_is_exact_and_turns_at_the_cusp() {
 #[test]
 fn a_stop_ends_the_curve_with_interrupted_and_keeps_its_points() {
     let (problem, start) = first_grazing_at(0.8);
-    let settings = CurveSettings {
-        second_range: (0.5, 1.6),
-        max_second_step: 0.02,
-        corrector: NewtonSettings {
-            tolerance: 1e-12,
-            max_iterations: 10,
-            ..NewtonSettings::default()
-        },
-        ..CurveSettings::default()
-    };
+    let settings = through_resonance();
     let asked = std::cell::Cell::new(0);
     let stop = || {
         asked.set(asked.get() + 1);

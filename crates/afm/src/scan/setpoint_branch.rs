@@ -325,8 +325,10 @@ impl SetpointBranch {
                 .special_points
                 .iter()
                 .filter(|s| s.converged && s.state.len() == end.state.len())
-                .filter(|s| detour(&s.state) <= 0.5 * chord)
-                .min_by(|a, b| detour(&a.state).total_cmp(&detour(&b.state)))
+                .map(|s| (detour(&s.state), s))
+                .filter(|(detour, _)| *detour <= 0.5 * chord)
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, point)| point)
             {
                 Some(fold) => (
                     fold.z_nm,
